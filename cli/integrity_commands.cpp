@@ -1,0 +1,326 @@
+#include "cli/integrity_commands.hpp"
+
+#include "cli/svg_plot.hpp"
+#include "integrity/geometry_file.hpp"
+#include "integrity/gnss/almanac.hpp"
+#include "integrity/gnss/parse_error.hpp"
+#include "integrity/predict.hpp"
+#include "integrity/raim/spp.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <unistd.h>
+
+namespace skylane::cli {
+namespace {
+
+using integrity::ParseError;
+using nlohmann::json;
+
+/// Rounds to 4 decimals (0.1 mm / 1e-4 of a unit); null when not finite (JSON has no NaN).
+json r4(double v) { return std::isfinite(v) ? json(std::round(v * 1e4) / 1e4) : json(nullptr); }
+
+json satList(const std::vector<integrity::SatId>& sats) {
+  json a = json::array();
+  for (const auto& s : sats) a.push_back(s.str());
+  return a;
+}
+
+/// A progress bar on stderr, only when stderr is a terminal or forced.
+class Progress {
+ public:
+  Progress(std::string what, bool force) : what_(std::move(what)), on_(force || isatty(STDERR_FILENO)) {}
+  void operator()(std::size_t done, std::size_t total) {
+    if (!on_ || total == 0) return;
+    const int width = 30;
+    const int filled = static_cast<int>(width * done / total);
+    std::fprintf(stderr, "\r%s [%.*s%*s] %zu/%zu", what_.c_str(), filled, "##############################",
+                 width - filled, "", done, total);
+    if (done == total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  std::string what_;
+  bool on_;
+};
+
+json plJson(const integrity::RaimPl& pl, const integrity::Requirements& req, bool verbose,
+            const std::vector<integrity::SatId>& sats) {
+  json j;
+  j["method"] = "raim";
+  j["available"] = pl.available && pl.hpl_m <= req.hal_m && pl.vpl_m <= req.val_m;
+  j["pl_computed"] = pl.available;
+  if (!pl.reason.empty()) j["reason"] = pl.reason;
+  j["hpl_m"] = pl.available ? r4(pl.hpl_m) : json(nullptr);
+  j["vpl_m"] = pl.available ? r4(pl.vpl_m) : json(nullptr);
+  j["hal_m"] = req.hal_m;
+  j["val_m"] = req.val_m;
+  j["satellites"] = sats.size();
+  if (verbose && pl.available) {
+    j["sigma_h_m"] = r4(pl.sigma_h_m);
+    j["sigma_v_m"] = r4(pl.sigma_v_m);
+    j["dof"] = pl.thresholds.dof;
+    j["threshold"] = r4(pl.thresholds.threshold);
+    j["p_bias"] = r4(pl.thresholds.p_bias);
+    j["max_hslope"] = r4(pl.max_hslope);
+    j["max_vslope"] = r4(pl.max_vslope);
+    j["critical_sat_h"] = sats[static_cast<std::size_t>(pl.critical_sat_h)].str();
+    j["critical_sat_v"] = sats[static_cast<std::size_t>(pl.critical_sat_v)].str();
+    json per = json::array();
+    for (std::size_t i = 0; i < sats.size(); ++i) {
+      per.push_back({{"id", sats[i].str()},
+                     {"hslope", r4(pl.hslope[static_cast<Eigen::Index>(i)])},
+                     {"vslope", r4(pl.vslope[static_cast<Eigen::Index>(i)])}});
+    }
+    j["per_satellite"] = per;
+  }
+  return j;
+}
+
+std::unique_ptr<std::ostream> openOutput(const std::string& path) {
+  if (path.empty() || path == "-") return nullptr;
+  auto f = std::make_unique<std::ofstream>(path);
+  if (!*f) throw ParseError(path, 0, "--output", path, "a writable file");
+  return f;
+}
+
+void writeText(const std::string& path, const std::string& text, const char* option) {
+  std::ofstream f(path);
+  if (!f) throw ParseError(path, 0, option, path, "a writable file");
+  f << text;
+}
+
+// ---------------------------------------------------------------------------
+struct PlOptions {
+  std::string geometry;
+  std::string method = "raim";
+  bool verbose = false;
+};
+
+void runPl(const PlOptions& o) {
+  if (o.method != "raim") {
+    throw ParseError("--method", 0, "--method", o.method, "\"raim\" (ARAIM arrives with issue 3)");
+  }
+  const integrity::GeometryInput in = integrity::loadGeometryFile(o.geometry);
+  const integrity::Geometry g = integrity::buildGeometry(in.satellites, in.model, in.tau_vert_m);
+  const integrity::RaimPl pl = integrity::raimProtectionLevels(g, in.raim);
+  std::cout << plJson(pl, in.requirements, o.verbose, g.sats).dump(2) << "\n";
+}
+
+// ---------------------------------------------------------------------------
+struct PredictOptions {
+  std::vector<std::string> almanacs;
+  std::vector<std::string> navs;
+  double lat_deg = NAN, lon_deg = NAN, alt_m = 0.0;
+  std::string start;
+  std::string duration = "24h";
+  std::string step = "10m";
+  double mask_deg = 5.0;
+  std::string format = "csv";
+  std::string output;
+  std::string plot;
+  std::string ism;
+  std::string user_model = "dual_frequency";
+  bool progress = false;
+};
+
+void runPredict(const PredictOptions& o) {
+  integrity::PredictRequest req;
+  if (!(o.lat_deg >= -90 && o.lat_deg <= 90)) throw ParseError("--lat", 0, "--lat", std::to_string(o.lat_deg), "a latitude in [-90, 90] degrees");
+  if (!(o.lon_deg >= -180 && o.lon_deg <= 360)) throw ParseError("--lon", 0, "--lon", std::to_string(o.lon_deg), "a longitude in degrees");
+  if (!std::isfinite(o.alt_m)) throw ParseError("--alt", 0, "--alt", std::to_string(o.alt_m), "an ellipsoidal height in metres");
+  req.place = {maps::deg2rad(o.lat_deg), maps::deg2rad(o.lon_deg), o.alt_m};
+  const auto start = integrity::parseRfc3339(o.start);
+  if (!start) throw ParseError("--start", 0, "--start", o.start, "an RFC 3339 UTC time such as 2026-11-23T14:00:00Z");
+  req.start = *start;
+  const auto dur = integrity::parseDuration(o.duration);
+  if (!dur) throw ParseError("--duration", 0, "--duration", o.duration, "a duration such as 24h, 90m, 3600s");
+  const auto step = integrity::parseDuration(o.step);
+  if (!step) throw ParseError("--step", 0, "--step", o.step, "a duration such as 10m or 30s");
+  if (*dur / *step > 1e6) throw ParseError("--step", 0, "--step", o.step, "at most a million epochs in --duration");
+  req.duration_s = *dur;
+  req.step_s = *step;
+  if (!(o.mask_deg >= 0 && o.mask_deg < 90)) throw ParseError("--mask-deg", 0, "--mask-deg", std::to_string(o.mask_deg), "an elevation mask in [0, 90) degrees");
+  req.mask_rad = maps::deg2rad(o.mask_deg);
+  if (o.user_model == "single_frequency") req.model.setUserModel(integrity::UserErrorModel::kSingleFrequency);
+  else if (o.user_model != "dual_frequency") throw ParseError("--user-model", 0, "--user-model", o.user_model, "dual_frequency or single_frequency");
+  if (!o.ism.empty()) {
+    const std::string text = integrity::readTextFile(o.ism);
+    json doc;
+    try { doc = json::parse(text); } catch (const json::parse_error& e) { throw ParseError(o.ism, 0, "(JSON syntax)", e.what(), "valid JSON"); }
+    integrity::parseIsm(doc.contains("ism") ? doc["ism"] : doc, req.model, o.ism, "ism");
+  }
+  if (o.format != "csv" && o.format != "jsonl") throw ParseError("--format", 0, "--format", o.format, "csv or jsonl");
+
+  integrity::OrbitSource orbits;
+  for (const auto& a : o.almanacs) orbits.addAlmanac(integrity::loadAlmanac(a));
+  for (const auto& n : o.navs) orbits.addNavigation(integrity::loadRinexNav(n));
+  if (orbits.empty()) throw ParseError("--almanac", 0, "--almanac/--nav", "", "at least one almanac or navigation file");
+  const double age = orbits.almanacAge_s(req.start);
+  if (age > 4 * integrity::kSecondsPerWeek) {
+    std::cerr << "skylane: warning: the almanac is " << std::lround(age / 86400) << " days from --start; "
+              << "positions are extrapolated (use an almanac of the flight's week for real predictions)\n";
+  }
+  Progress bar("predict", o.progress);
+  const auto samples = integrity::predictRaim(orbits, req, std::ref(bar));
+
+  const auto out_file = openOutput(o.output);
+  std::ostream& out = out_file ? *out_file : std::cout;
+  if (o.format == "csv") out << "time_utc,gps_week,gps_sow,satellites,hdop,vdop,hpl_m,vpl_m,available\n";
+  for (const auto& s : samples) {
+    if (o.format == "csv") {
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "%s,%d,%.1f,%zu,%.3f,%.3f,%.3f,%.3f,%d\n", integrity::formatRfc3339(s.t).c_str(),
+                    s.t.week, s.t.sow, s.sats.size(), s.dops.hdop, s.dops.vdop, s.pl.available ? s.pl.hpl_m : NAN,
+                    s.pl.available ? s.pl.vpl_m : NAN, s.available ? 1 : 0);
+      out << buf;
+    } else {
+      std::vector<integrity::SatId> ids;
+      for (const auto& l : s.sats) ids.push_back(l.sat);
+      json j = plJson(s.pl, req.requirements, false, ids);
+      j["time"] = integrity::formatRfc3339(s.t);
+      j["hdop"] = r4(s.dops.hdop);
+      j["vdop"] = r4(s.dops.vdop);
+      j["available"] = s.available;
+      j["satellites"] = satList(ids);
+      out << j.dump() << "\n";
+    }
+  }
+  if (!o.plot.empty()) {
+    std::vector<double> x, hpl, vpl, hal, val, nsat;
+    for (const auto& s : samples) {
+      x.push_back(s.t - req.start);
+      hpl.push_back(s.pl.available ? s.pl.hpl_m : NAN);
+      vpl.push_back(s.pl.available ? s.pl.vpl_m : NAN);
+      hal.push_back(req.requirements.hal_m);
+      val.push_back(req.requirements.val_m);
+      nsat.push_back(static_cast<double>(s.sats.size()));
+    }
+    char title[200];
+    std::snprintf(title, sizeof title, "RAIM protection levels at %.4f°, %.4f°, %.0f m from %s", o.lat_deg, o.lon_deg,
+                  o.alt_m, integrity::formatRfc3339(req.start).c_str());
+    const std::string svg = renderTimeSeriesSvg(
+        title, "time since start",
+        x,
+        {Panel{"protection level [m]",
+               {{"HPL", "#1f77b4", hpl}, {"VPL", "#d62728", vpl}, {"HAL", "#1f77b4", hal, true}, {"VAL", "#d62728", val, true}}},
+         Panel{"satellites in view", {{"satellites", "#2ca02c", nsat, false, true}}, 160}});
+    writeText(o.plot, svg, "--plot");
+  }
+}
+
+// ---------------------------------------------------------------------------
+struct SppOptions {
+  std::string obs;
+  std::vector<std::string> navs;
+  double mask_deg = 15.0;
+  std::string iono = "auto";
+  std::string output;
+  std::vector<std::string> inject;
+  bool progress = false;
+  bool no_galileo = false;
+};
+
+void runSpp(const SppOptions& o) {
+  integrity::SppConfig cfg;
+  if (!(o.mask_deg >= 0 && o.mask_deg < 90)) throw ParseError("--mask-deg", 0, "--mask-deg", std::to_string(o.mask_deg), "an elevation mask in [0, 90) degrees");
+  cfg.elevation_mask_rad = maps::deg2rad(o.mask_deg);
+  if (o.iono == "auto") cfg.iono = integrity::IonoMode::kAuto;
+  else if (o.iono == "iono_free") cfg.iono = integrity::IonoMode::kIonoFree;
+  else if (o.iono == "klobuchar") cfg.iono = integrity::IonoMode::kKlobuchar;
+  else throw ParseError("--iono", 0, "--iono", o.iono, "auto, iono_free or klobuchar");
+  cfg.use_galileo = !o.no_galileo;
+  for (const std::string& inj : o.inject) {  // "G05:50"
+    const auto colon = inj.find(':');
+    const auto sat = integrity::parseSatId(inj.substr(0, colon));
+    if (colon == std::string::npos || !sat) throw ParseError("--inject", 0, "--inject", inj, "SAT:BIAS_M such as G05:50");
+    cfg.injected_bias_m[*sat] = integrity::parseFortranReal(inj.substr(colon + 1), "--inject", 0, "--inject bias");
+  }
+  const integrity::ObservationData obs = integrity::loadRinexObs(o.obs);
+  integrity::NavigationData nav;
+  for (const auto& n : o.navs) nav.merge(integrity::loadRinexNav(n));
+  Progress bar("spp", o.progress);
+  const auto epochs = integrity::solveSpp(obs, nav, cfg, std::ref(bar));
+  const auto out_file = openOutput(o.output);
+  std::ostream& out = out_file ? *out_file : std::cout;
+  for (const auto& e : epochs) {
+    json j;
+    j["time"] = integrity::formatRfc3339(e.t, 3);
+    j["gps_week"] = e.t.week;
+    j["gps_sow"] = e.t.sow;
+    j["solved"] = e.solved;
+    if (e.solved) {
+      char lat[32], lon[32];
+      std::snprintf(lat, sizeof lat, "%.9f", maps::rad2deg(e.position.lat_rad));
+      std::snprintf(lon, sizeof lon, "%.9f", maps::rad2deg(e.position.lon_rad));
+      j["lat_deg"] = json::parse(lat);
+      j["lon_deg"] = json::parse(lon);
+      j["h_ell_m"] = r4(e.position.h_ell_m);
+      j["ecef_m"] = {r4(e.p_ecef.x()), r4(e.p_ecef.y()), r4(e.p_ecef.z())};
+      j["iono"] = e.iono_free ? "iono_free" : "klobuchar";
+      j["used"] = satList(e.used);
+      j["excluded"] = satList(e.excluded);
+      j["fault_detected"] = e.fault_detected;
+      j["test_statistic"] = r4(e.test_statistic);
+      j["threshold"] = r4(e.threshold);
+      j["hpl_m"] = e.pl.available ? r4(e.pl.hpl_m) : json(nullptr);
+      j["vpl_m"] = e.pl.available ? r4(e.pl.vpl_m) : json(nullptr);
+      j["pl_available"] = e.pl.available;
+    }
+    if (!e.note.empty()) j["note"] = e.note;
+    out << j.dump() << "\n";
+  }
+}
+
+}  // namespace
+
+void addIntegrityCommands(CLI::App& app) {
+  CLI::App* integ = app.add_subcommand("integrity", "GNSS integrity: protection levels, prediction, positioning");
+  integ->require_subcommand(1);
+
+  auto pl = std::make_shared<PlOptions>();
+  CLI::App* c = integ->add_subcommand("pl", "protection levels for one geometry file (JSON)");
+  c->add_option("--geometry", pl->geometry, "geometry JSON: satellites (id, az_deg, el_deg), ism, requirements")->required();
+  c->add_option("--method", pl->method, "integrity method (raim)");
+  c->add_flag("--verbose", pl->verbose, "per-satellite slopes and thresholds");
+  c->callback([pl] { runPl(*pl); });
+
+  auto pr = std::make_shared<PredictOptions>();
+  c = integ->add_subcommand("predict", "RAIM protection levels over time at one place");
+  c->add_option("--almanac", pr->almanacs, "YUMA or SEM almanac (repeatable)");
+  c->add_option("--nav", pr->navs, "RINEX navigation file (repeatable)");
+  c->add_option("--lat", pr->lat_deg, "latitude [deg]")->required();
+  c->add_option("--lon", pr->lon_deg, "longitude [deg]")->required();
+  c->add_option("--alt", pr->alt_m, "ellipsoidal height [m]");
+  c->add_option("--start", pr->start, "start, RFC 3339 UTC (2026-11-23T14:00:00Z)")->required();
+  c->add_option("--duration", pr->duration, "duration (24h, 90m, 3600s)");
+  c->add_option("--step", pr->step, "time step (10m, 30s)");
+  c->add_option("--mask-deg", pr->mask_deg, "elevation mask [deg]");
+  c->add_option("--format", pr->format, "csv or jsonl");
+  c->add_option("--output,-o", pr->output, "output file (default stdout)");
+  c->add_option("--plot", pr->plot, "write an SVG plot of HPL/VPL and satellites in view");
+  c->add_option("--ism", pr->ism, "JSON file with an ism object overriding the defaults");
+  c->add_option("--user-model", pr->user_model, "dual_frequency or single_frequency");
+  c->add_flag("--progress", pr->progress, "show a progress bar even when stderr is not a terminal");
+  c->callback([pr] { runPredict(*pr); });
+
+  auto sp = std::make_shared<SppOptions>();
+  c = integ->add_subcommand("spp", "single-point positioning with RAIM FDE and protection levels per epoch");
+  c->add_option("--obs", sp->obs, "RINEX 2/3 observation file")->required();
+  c->add_option("--nav", sp->navs, "RINEX 2/3 navigation file (repeatable)")->required();
+  c->add_option("--mask-deg", sp->mask_deg, "elevation mask [deg]");
+  c->add_option("--iono", sp->iono, "auto, iono_free or klobuchar");
+  c->add_option("--output,-o", sp->output, "output JSON-lines file (default stdout)");
+  c->add_option("--inject", sp->inject, "fault injection SAT:BIAS_M (e.g. G05:50), repeatable");
+  c->add_flag("--no-galileo", sp->no_galileo, "use GPS only");
+  c->add_flag("--progress", sp->progress, "show a progress bar even when stderr is not a terminal");
+  c->callback([sp] { runSpp(*sp); });
+}
+
+}  // namespace skylane::cli

@@ -1,0 +1,32 @@
+/// \file
+/// \brief The `skylane` command: parse, call, print; errors → one line on stderr, exit 2.
+
+#include "cli/integrity_commands.hpp"
+#include "integrity/gnss/parse_error.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <stdexcept>
+
+int main(int argc, char** argv) {
+  CLI::App app{"skylane: airspace geofence and path-planning integrity planner for unmanned aircraft"};
+  app.require_subcommand(1);
+  skylane::cli::addIntegrityCommands(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  } catch (const skylane::integrity::ParseError& e) {
+    std::cerr << "skylane: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "skylane: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "skylane: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,113 @@
+#include "cli/svg_plot.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace skylane::cli {
+namespace {
+
+/// A "nice" tick step (1, 2 or 5 × 10^k) for about `target` ticks over `span`.
+double niceStep(double span, int target) {
+  if (!(span > 0)) return 1.0;
+  const double raw = span / target;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  const double f = raw / mag;
+  return (f < 1.5 ? 1.0 : f < 3.5 ? 2.0 : f < 7.5 ? 5.0 : 10.0) * mag;
+}
+
+std::string fmt(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+std::string escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '<') o += "&lt;";
+    else if (c == '>') o += "&gt;";
+    else if (c == '&') o += "&amp;";
+    else o += c;
+  }
+  return o;
+}
+
+}  // namespace
+
+std::string renderTimeSeriesSvg(const std::string& title, const std::string& x_label, const std::vector<double>& x,
+                                const std::vector<Panel>& panels) {
+  const double width = 960, left = 70, right = 160, top = 40, gap = 40, bottom = 50;
+  double height = top + bottom;
+  for (const Panel& p : panels) height += p.height_px + gap;
+  const double plot_w = width - left - right;
+  const double x0 = x.empty() ? 0 : x.front(), x1 = x.empty() ? 1 : std::max(x.back(), x0 + 1e-9);
+  const bool hours = (x1 - x0) > 3 * 3600;
+  const double xscale = hours ? 3600.0 : 60.0;
+  std::ostringstream s;
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  s << "<text x=\"" << width / 2 << "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">" << escape(title) << "</text>\n";
+  double y_top = top;
+  for (const Panel& p : panels) {
+    const double h = p.height_px;
+    double lo = 0, hi = 0;
+    bool any = false;
+    for (const Series& se : p.series) {
+      for (double v : se.y) {
+        if (!std::isfinite(v)) continue;
+        hi = any ? std::max(hi, v) : v;
+        lo = std::min(lo, v);
+        any = true;
+      }
+    }
+    if (!any || hi <= lo) hi = lo + 1;
+    const double ystep = niceStep(hi - lo, 5);
+    hi = std::ceil(hi / ystep) * ystep;
+    auto X = [&](double v) { return left + (v - x0) / (x1 - x0) * plot_w; };
+    auto Y = [&](double v) { return y_top + h - (v - lo) / (hi - lo) * h; };
+    s << "<rect x=\"" << left << "\" y=\"" << y_top << "\" width=\"" << plot_w << "\" height=\"" << h
+      << "\" fill=\"none\" stroke=\"#444\"/>\n";
+    for (double v = lo; v <= hi + 1e-9; v += ystep) {
+      s << "<line x1=\"" << left << "\" x2=\"" << left + plot_w << "\" y1=\"" << Y(v) << "\" y2=\"" << Y(v)
+        << "\" stroke=\"#ddd\"/><text x=\"" << left - 6 << "\" y=\"" << Y(v) + 4 << "\" text-anchor=\"end\">" << fmt(v)
+        << "</text>\n";
+    }
+    const double xstep = niceStep((x1 - x0) / xscale, 8) * xscale;
+    for (double v = x0; v <= x1 + 1e-9; v += xstep) {
+      s << "<line x1=\"" << X(v) << "\" x2=\"" << X(v) << "\" y1=\"" << y_top << "\" y2=\"" << y_top + h
+        << "\" stroke=\"#eee\"/><text x=\"" << X(v) << "\" y=\"" << y_top + h + 15 << "\" text-anchor=\"middle\">"
+        << fmt((v - x0) / xscale) << "</text>\n";
+    }
+    s << "<text transform=\"translate(18," << y_top + h / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
+      << escape(p.y_label) << "</text>\n";
+    double legend_y = y_top + 14;
+    for (const Series& se : p.series) {
+      std::ostringstream d;
+      bool pen = false;
+      double prev_y = 0;
+      for (std::size_t i = 0; i < x.size() && i < se.y.size(); ++i) {
+        if (!std::isfinite(se.y[i])) { pen = false; continue; }
+        const double yv = std::clamp(se.y[i], lo, hi);
+        if (pen && se.step) d << " L" << fmt(X(x[i])) << "," << fmt(Y(prev_y));
+        d << (pen ? " L" : " M") << fmt(X(x[i])) << "," << fmt(Y(yv));
+        prev_y = yv;
+        pen = true;
+      }
+      s << "<path d=\"" << d.str() << "\" fill=\"none\" stroke=\"" << se.colour << "\" stroke-width=\"1.6\""
+        << (se.dashed ? " stroke-dasharray=\"6,4\"" : "") << "/>\n";
+      s << "<line x1=\"" << left + plot_w + 12 << "\" x2=\"" << left + plot_w + 36 << "\" y1=\"" << legend_y - 4
+        << "\" y2=\"" << legend_y - 4 << "\" stroke=\"" << se.colour << "\" stroke-width=\"2\""
+        << (se.dashed ? " stroke-dasharray=\"6,4\"" : "") << "/><text x=\"" << left + plot_w + 42 << "\" y=\""
+        << legend_y << "\">" << escape(se.label) << "</text>\n";
+      legend_y += 18;
+    }
+    y_top += h + gap;
+  }
+  s << "<text x=\"" << left + plot_w / 2 << "\" y=\"" << height - 12 << "\" text-anchor=\"middle\">"
+    << escape(x_label) << (hours ? " [h]" : " [min]") << "</text>\n</svg>\n";
+  return s.str();
+}
+
+}  // namespace skylane::cli

@@ -1,0 +1,30 @@
+#pragma once
+/// \file
+/// \brief A small SVG time-series plotter (no dependency): stacked panels sharing the time axis.
+
+#include <string>
+#include <vector>
+
+namespace skylane::cli {
+
+/// \brief One line in a panel.
+struct Series {
+  std::string label;
+  std::string colour;  ///< CSS colour
+  std::vector<double> y;  ///< NaN / inf = gap
+  bool dashed = false;
+  bool step = false;  ///< draw as a staircase (counts)
+};
+
+/// \brief One panel: its y-axis label and lines.
+struct Panel {
+  std::string y_label;
+  std::vector<Series> series;
+  double height_px = 260;
+};
+
+/// \brief Renders panels against x (seconds from the start) as an SVG document.
+[[nodiscard]] std::string renderTimeSeriesSvg(const std::string& title, const std::string& x_label,
+                                              const std::vector<double>& x_s, const std::vector<Panel>& panels);
+
+}  // namespace skylane::cli

@@ -1,0 +1,182 @@
+#include "integrity/gnss/gnss_time.hpp"
+
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace skylane::integrity {
+namespace {
+
+/// Days from 1970-01-01 to the GPS epoch 1980-01-06.
+constexpr long kGpsEpochDays = 3657;
+
+/// IERS leap seconds (Bulletin C): the first UTC day on which GPS − UTC took each value.
+struct LeapEntry {
+  int year, month, day;  // first UTC day with the new offset
+  int gps_minus_utc_s;
+};
+constexpr std::array<LeapEntry, 18> kLeapTable = {{
+    {1981, 7, 1, 1},  {1982, 7, 1, 2},  {1983, 7, 1, 3},  {1985, 7, 1, 4},  {1988, 1, 1, 5},
+    {1990, 1, 1, 6},  {1991, 1, 1, 7},  {1992, 7, 1, 8},  {1993, 7, 1, 9},  {1994, 7, 1, 10},
+    {1996, 1, 1, 11}, {1997, 7, 1, 12}, {1999, 1, 1, 13}, {2006, 1, 1, 14}, {2009, 1, 1, 15},
+    {2012, 7, 1, 16}, {2015, 7, 1, 17}, {2017, 1, 1, 18},
+}};
+
+double utcSecondsSinceGpsEpoch(const CalendarTime& c) {
+  const long days = daysFromCivil(c.year, c.month, c.day) - kGpsEpochDays;
+  return days * kSecondsPerDay + c.hour * 3600.0 + c.minute * 60.0 + c.second;
+}
+
+int leapSecondsAtUtc(double utc_s) {
+  int offset = 0;
+  for (const LeapEntry& e : kLeapTable) {
+    if (utc_s >= utcSecondsSinceGpsEpoch({e.year, e.month, e.day, 0, 0, 0.0})) {
+      offset = e.gps_minus_utc_s;
+    }
+  }
+  return offset;
+}
+
+CalendarTime calendarFromSeconds(double t_s) {
+  double days_f = std::floor(t_s / kSecondsPerDay);
+  double sod = t_s - days_f * kSecondsPerDay;
+  long z = static_cast<long>(days_f) + kGpsEpochDays + 719468;  // civil_from_days
+  const long era = (z >= 0 ? z : z - 146096) / 146097;
+  const long doe = z - era * 146097;
+  const long yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+  const long doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+  const long mp = (5 * doy + 2) / 153;
+  CalendarTime c;
+  c.day = static_cast<int>(doy - (153 * mp + 2) / 5 + 1);
+  c.month = static_cast<int>(mp < 10 ? mp + 3 : mp - 9);
+  c.year = static_cast<int>(yoe + era * 400 + (c.month <= 2 ? 1 : 0));
+  c.hour = static_cast<int>(sod / 3600.0);
+  sod -= c.hour * 3600.0;
+  c.minute = static_cast<int>(sod / 60.0);
+  c.second = sod - c.minute * 60.0;
+  return c;
+}
+
+}  // namespace
+
+long daysFromCivil(int y, int m, int d) {
+  y -= m <= 2 ? 1 : 0;
+  const long era = (y >= 0 ? y : y - 399) / 400;
+  const long yoe = y - era * 400;
+  const long doy = (153L * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const long doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + doe - 719468;
+}
+
+GpsTime GpsTime::fromTotalSeconds(double t_s) {
+  GpsTime t;
+  t.week = static_cast<int>(std::floor(t_s / kSecondsPerWeek));
+  t.sow = t_s - t.week * kSecondsPerWeek;
+  return t;
+}
+
+GpsTime gpsFromCalendar(const CalendarTime& c) {
+  return GpsTime::fromTotalSeconds(utcSecondsSinceGpsEpoch(c));
+}
+
+CalendarTime calendarFromGps(const GpsTime& t) { return calendarFromSeconds(t.totalSeconds()); }
+
+int leapSecondsAtGps(const GpsTime& t) {
+  // The offset in force at GPS instant t is the one in force at UTC instant t − offset.
+  const double gps_s = t.totalSeconds();
+  int offset = leapSecondsAtUtc(gps_s);
+  offset = leapSecondsAtUtc(gps_s - offset);
+  return offset;
+}
+
+GpsTime gpsFromUtc(const CalendarTime& utc) {
+  const double utc_s = utcSecondsSinceGpsEpoch(utc);
+  return GpsTime::fromTotalSeconds(utc_s + leapSecondsAtUtc(utc_s));
+}
+
+CalendarTime utcFromGps(const GpsTime& t) {
+  return calendarFromSeconds(t.totalSeconds() - leapSecondsAtGps(t));
+}
+
+std::optional<GpsTime> parseRfc3339(const std::string& text) {
+  // YYYY-MM-DDTHH:MM:SS[.frac](Z|±HH:MM)
+  int y = 0, mo = 0, d = 0, h = 0, mi = 0, consumed = 0;
+  double s = 0;
+  if (std::sscanf(text.c_str(), "%4d-%2d-%2d%*1[Tt ]%2d:%2d:%lf%n", &y, &mo, &d, &h, &mi, &s,
+                  &consumed) != 6) {
+    return std::nullopt;
+  }
+  if (mo < 1 || mo > 12 || d < 1 || d > 31 || h > 23 || mi > 59 || !(s >= 0.0 && s < 61.0)) {
+    return std::nullopt;
+  }
+  const std::string zone = text.substr(static_cast<std::size_t>(consumed));
+  int offset_min = 0;
+  if (zone == "Z" || zone == "z") {
+    offset_min = 0;
+  } else if (zone.size() == 6 && (zone[0] == '+' || zone[0] == '-') && zone[3] == ':' &&
+             std::isdigit(static_cast<unsigned char>(zone[1])) &&
+             std::isdigit(static_cast<unsigned char>(zone[2])) &&
+             std::isdigit(static_cast<unsigned char>(zone[4])) &&
+             std::isdigit(static_cast<unsigned char>(zone[5]))) {
+    const int oh = (zone[1] - '0') * 10 + (zone[2] - '0');
+    const int om = (zone[4] - '0') * 10 + (zone[5] - '0');
+    if (oh > 23 || om > 59) return std::nullopt;
+    offset_min = (zone[0] == '-' ? -1 : 1) * (oh * 60 + om);
+  } else {
+    return std::nullopt;
+  }
+  const double utc_s = utcSecondsSinceGpsEpoch({y, mo, d, h, mi, s}) - offset_min * 60.0;
+  return GpsTime::fromTotalSeconds(utc_s + leapSecondsAtUtc(utc_s));
+}
+
+std::string formatRfc3339(const GpsTime& t, int fraction_digits) {
+  const double scale = std::pow(10.0, fraction_digits);
+  // Round once in seconds so that 59.9996 does not print as 60.000.
+  const double utc_s =
+      std::round((t.totalSeconds() - leapSecondsAtGps(t)) * scale) / scale;
+  const CalendarTime c = calendarFromSeconds(utc_s);
+  char buf[64];
+  if (fraction_digits <= 0) {
+    std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02dZ", c.year, c.month, c.day, c.hour,
+                  c.minute, static_cast<int>(std::lround(c.second) % 60));
+  } else {
+    std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%0*.*fZ", c.year, c.month, c.day,
+                  c.hour, c.minute, fraction_digits + 3, fraction_digits, c.second);
+  }
+  return buf;
+}
+
+std::optional<double> parseDuration(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  double total = 0;
+  std::size_t i = 0;
+  bool any = false;
+  while (i < text.size()) {
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str() + i, &end);
+    const std::size_t used = static_cast<std::size_t>(end - (text.c_str() + i));
+    if (used == 0 || !std::isfinite(v) || v < 0) return std::nullopt;
+    i += used;
+    double unit = 1.0;
+    if (i < text.size()) {
+      switch (text[i]) {
+        case 'd': unit = 86400.0; break;
+        case 'h': unit = 3600.0; break;
+        case 'm': unit = 60.0; break;
+        case 's': unit = 1.0; break;
+        default: return std::nullopt;
+      }
+      ++i;
+    } else if (any) {
+      return std::nullopt;  // "1h30" is ambiguous
+    }
+    total += v * unit;
+    any = true;
+  }
+  if (!(total > 0)) return std::nullopt;
+  return total;
+}
+
+}  // namespace skylane::integrity

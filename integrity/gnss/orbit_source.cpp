@@ -1,0 +1,68 @@
+#include "integrity/gnss/orbit_source.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace skylane::integrity {
+namespace {
+
+/// Light-time iterations: 3 bring the transmit time to < 1 ns for any GNSS orbit.
+constexpr int kLightTimeIterations = 3;
+
+template <typename StateAt>
+VisibleSatellite locate(const SatId& sat, const Eigen::Vector3d& p_user, const GpsTime& t, StateAt state_at) {
+  double tau = 0.075;  // ≈ 22 000 km / c
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (int k = 0; k < kLightTimeIterations; ++k) {
+    p = earthRotationCorrection(state_at(t.plus(-tau)).p_ecef, tau);
+    tau = (p - p_user).norm() / kSpeedOfLight_mps;
+  }
+  VisibleSatellite v;
+  v.sat = sat;
+  v.p_ecef = p;
+  v.range_m = (p - p_user).norm();
+  v.look = maps::lookAngles(p_user, p);
+  return v;
+}
+
+}  // namespace
+
+void OrbitSource::addAlmanac(const std::vector<AlmanacRecord>& records) {
+  almanac_.insert(almanac_.end(), records.begin(), records.end());
+}
+
+void OrbitSource::addNavigation(const NavigationData& nav) { nav_.merge(nav); }
+
+std::vector<VisibleSatellite> OrbitSource::visible(const Eigen::Vector3d& p_user, const GpsTime& t,
+                                                   double mask_rad) const {
+  std::vector<VisibleSatellite> out;
+  std::set<SatId> done;
+  std::set<SatId> nav_sats;
+  for (const BroadcastEphemeris& e : nav_.ephemerides) nav_sats.insert(e.sat);
+  for (const SatId& sat : nav_sats) {
+    const BroadcastEphemeris* eph = selectEphemeris(nav_, sat, t);
+    if (!eph) continue;
+    done.insert(sat);
+    const VisibleSatellite v = locate(sat, p_user, t, [&](const GpsTime& tt) { return satelliteState(*eph, tt); });
+    if (v.look.elevation_rad >= mask_rad) out.push_back(v);
+  }
+  for (const AlmanacRecord& a : almanac_) {
+    if (a.health != 0 || done.count(a.sat)) continue;
+    done.insert(a.sat);
+    const VisibleSatellite v = locate(a.sat, p_user, t, [&](const GpsTime& tt) { return almanacState(a, tt); });
+    if (v.look.elevation_rad >= mask_rad) out.push_back(v);
+  }
+  std::sort(out.begin(), out.end(), [](const VisibleSatellite& a, const VisibleSatellite& b) { return a.sat < b.sat; });
+  return out;
+}
+
+double OrbitSource::almanacAge_s(const GpsTime& t) const {
+  double age = 0.0;
+  for (const AlmanacRecord& a : almanac_) {
+    age = std::max(age, std::abs(t - resolveAlmanacEpoch(a.week_field, a.orbit.toe.sow, t)));
+  }
+  return age;
+}
+
+}  // namespace skylane::integrity

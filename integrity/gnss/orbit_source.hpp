@@ -1,0 +1,45 @@
+#pragma once
+/// \file
+/// \brief Where satellite positions come from for prediction: almanacs or broadcast ephemerides.
+
+#include "integrity/gnss/almanac.hpp"
+#include "integrity/gnss/rinex_nav.hpp"
+
+#include "maps/geodesy.hpp"
+
+#include <vector>
+
+namespace skylane::integrity {
+
+/// \brief A satellite seen from a place at an instant.
+struct VisibleSatellite {
+  SatId sat;
+  Eigen::Vector3d p_ecef = Eigen::Vector3d::Zero();  ///< at transmit time, in the reception ECEF frame
+  maps::LookAngles look;
+  double range_m = 0.0;
+};
+
+/// \brief A set of orbits: almanac records and/or broadcast ephemerides.
+class OrbitSource {
+ public:
+  /// \brief Adds almanac records (unhealthy ones are kept and skipped at use).
+  void addAlmanac(const std::vector<AlmanacRecord>& records);
+  /// \brief Adds a navigation file's ephemerides.
+  void addNavigation(const NavigationData& nav);
+
+  /// \brief All satellites above `mask_rad` seen from `p_user_ecef` at reception time t, with the
+  /// light-time iteration and Earth-rotation correction applied. Ephemerides win over almanac
+  /// entries for the same satellite when one is valid at t.
+  [[nodiscard]] std::vector<VisibleSatellite> visible(const Eigen::Vector3d& p_user_ecef, const GpsTime& t,
+                                                      double mask_rad) const;
+  /// \brief Largest |t − t_oa| over the almanac records [s] (extrapolation warning).
+  [[nodiscard]] double almanacAge_s(const GpsTime& t) const;
+  [[nodiscard]] bool empty() const { return almanac_.empty() && nav_.ephemerides.empty(); }
+  [[nodiscard]] std::size_t size() const { return almanac_.size() + nav_.ephemerides.size(); }
+
+ private:
+  std::vector<AlmanacRecord> almanac_;
+  NavigationData nav_;
+};
+
+}  // namespace skylane::integrity

@@ -1,0 +1,71 @@
+#include "integrity/gnss/parse_error.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+namespace skylane::integrity {
+namespace {
+
+std::string describe(const std::string& source, int line, const std::string& field,
+                     const std::string& value, const std::string& expected) {
+  std::string msg = source;
+  if (line > 0) msg += ":" + std::to_string(line);
+  msg += ": field '" + field + "'";
+  msg += value.empty() ? std::string(" is missing") : ": got '" + value + "'";
+  msg += ", expected " + expected;
+  return msg;
+}
+
+}  // namespace
+
+ParseError::ParseError(std::string source, int line, std::string field, std::string value,
+                       std::string expected)
+    : std::runtime_error(describe(source, line, field, value, expected)),
+      source_(std::move(source)),
+      line_(line),
+      field_(std::move(field)) {}
+
+std::string trim(const std::string& s) {
+  const char* ws = " \t\r\n";
+  const auto b = s.find_first_not_of(ws);
+  if (b == std::string::npos) return {};
+  const auto e = s.find_last_not_of(ws);
+  return s.substr(b, e - b + 1);
+}
+
+std::string field(const std::string& line, std::size_t pos, std::size_t len) {
+  if (pos >= line.size()) return {};
+  return line.substr(pos, len);
+}
+
+double parseFortranReal(const std::string& text, const std::string& source, int line,
+                        const std::string& field_name, double blank_value) {
+  std::string t = trim(text);
+  if (t.empty()) return blank_value;
+  for (char& c : t) {
+    if (c == 'D' || c == 'd') c = 'E';
+  }
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(t.c_str(), &end);
+  if (end == t.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+    throw ParseError(source, line, field_name, t, "a finite real number");
+  }
+  return v;
+}
+
+int parseInt(const std::string& text, const std::string& source, int line,
+             const std::string& field_name, int blank_value) {
+  const std::string t = trim(text);
+  if (t.empty()) return blank_value;
+  errno = 0;
+  char* end = nullptr;
+  const long v = std::strtol(t.c_str(), &end, 10);
+  if (end == t.c_str() || *end != '\0' || errno == ERANGE || v < -2147483647L || v > 2147483647L) {
+    throw ParseError(source, line, field_name, t, "an integer");
+  }
+  return static_cast<int>(v);
+}
+
+}  // namespace skylane::integrity

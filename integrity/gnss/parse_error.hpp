@@ -1,0 +1,42 @@
+#pragma once
+/// \file
+/// \brief The one error type for malformed external input (files, JSON, command-line values).
+
+#include <stdexcept>
+#include <string>
+
+namespace skylane::integrity {
+
+/// \brief Bad external input: names the source (file), the line (0 = not line-based), the
+/// field, the offending value and what was expected.
+class ParseError : public std::runtime_error {
+ public:
+  ParseError(std::string source, int line, std::string field, std::string value,
+             std::string expected);
+
+  [[nodiscard]] const std::string& source() const { return source_; }
+  [[nodiscard]] int line() const { return line_; }
+  [[nodiscard]] const std::string& field() const { return field_; }
+
+ private:
+  std::string source_;
+  int line_;
+  std::string field_;
+};
+
+/// \brief Parses a Fortran-style real ("1.23D-04", "  .5E+01", "-0.1") from a fixed-width
+/// field. Blank fields give `blank_value`. Throws ParseError naming the field otherwise.
+[[nodiscard]] double parseFortranReal(const std::string& text, const std::string& source, int line,
+                                      const std::string& field, double blank_value = 0.0);
+
+/// \brief Parses an integer from a field (surrounding blanks allowed); blank → `blank_value`.
+[[nodiscard]] int parseInt(const std::string& text, const std::string& source, int line,
+                           const std::string& field, int blank_value = 0);
+
+/// \brief Substring that tolerates short lines (returns what exists, possibly empty).
+[[nodiscard]] std::string field(const std::string& line, std::size_t pos, std::size_t len);
+
+/// \brief Copy without leading and trailing blanks (space, tab, CR, LF).
+[[nodiscard]] std::string trim(const std::string& s);
+
+}  // namespace skylane::integrity

@@ -1,0 +1,46 @@
+#include "integrity/predict.hpp"
+
+#include "integrity/gnss/atmosphere.hpp"
+
+#include <Eigen/Cholesky>
+
+#include <cmath>
+#include <limits>
+
+namespace skylane::integrity {
+
+Dops computeDops(const Geometry& g) {
+  Dops d;
+  const double inf = std::numeric_limits<double>::infinity();
+  if (g.numSats() < g.numStates() || g.numStates() == 0) return {inf, inf, inf, inf};
+  const WlsSolution w = solveWls(g.G, Eigen::VectorXd::Ones(g.numSats()));
+  if (!w.ok) return {inf, inf, inf, inf};
+  d.gdop = std::sqrt(w.P.trace());
+  d.pdop = std::sqrt(w.P(0, 0) + w.P(1, 1) + w.P(2, 2));
+  d.hdop = std::sqrt(w.P(0, 0) + w.P(1, 1));
+  d.vdop = std::sqrt(w.P(2, 2));
+  return d;
+}
+
+std::vector<PredictSample> predictRaim(const OrbitSource& orbits, const PredictRequest& req,
+                                       const std::function<void(std::size_t, std::size_t)>& progress) {
+  const Eigen::Vector3d p_user = maps::geodeticToEcef(req.place);
+  const double tau = req.model.iono_tau_vert_m.value_or(ionoTauVert_m(geomagneticLatitude(req.place)));
+  const auto n = static_cast<std::size_t>(std::floor(req.duration_s / req.step_s + 1e-9)) + 1;
+  std::vector<PredictSample> out;
+  out.reserve(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    PredictSample s;
+    s.t = req.start.plus(static_cast<double>(k) * req.step_s);
+    for (const VisibleSatellite& v : orbits.visible(p_user, s.t, req.mask_rad)) s.sats.push_back({v.sat, v.look});
+    const Geometry g = buildGeometry(s.sats, req.model, tau);
+    s.dops = computeDops(g);
+    s.pl = raimProtectionLevels(g, req.raim);
+    s.available = s.pl.available && s.pl.hpl_m <= req.requirements.hal_m && s.pl.vpl_m <= req.requirements.val_m;
+    out.push_back(std::move(s));
+    if (progress && (k % 16 == 0 || k + 1 == n)) progress(k + 1, n);
+  }
+  return out;
+}
+
+}  // namespace skylane::integrity

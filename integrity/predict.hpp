@@ -1,0 +1,47 @@
+#pragma once
+/// \file
+/// \brief Protection-level prediction over time at one place from almanacs or ephemerides.
+
+#include "integrity/geometry_file.hpp"
+#include "integrity/gnss/orbit_source.hpp"
+#include "integrity/raim/raim.hpp"
+
+#include <functional>
+#include <vector>
+
+namespace skylane::integrity {
+
+/// \brief What to predict.
+struct PredictRequest {
+  maps::Geodetic place;
+  GpsTime start;
+  double duration_s = 86400.0;
+  double step_s = 600.0;
+  double mask_rad = 5.0 * M_PI / 180.0;
+  ErrorModel model;
+  RaimConfig raim;
+  Requirements requirements;
+};
+
+/// \brief Dilutions of precision of an unweighted geometry (∞ when singular).
+struct Dops {
+  double gdop = 0, pdop = 0, hdop = 0, vdop = 0;
+};
+
+/// \brief One predicted epoch.
+struct PredictSample {
+  GpsTime t;
+  std::vector<SatLook> sats;
+  Dops dops;
+  RaimPl pl;
+  bool available = false;  ///< PL computed and within HAL/VAL
+};
+
+/// \brief DOPs of the geometry's G (unit weights).
+[[nodiscard]] Dops computeDops(const Geometry& g);
+
+/// \brief RAIM PLs at every step from start to start + duration (inclusive).
+[[nodiscard]] std::vector<PredictSample> predictRaim(const OrbitSource& orbits, const PredictRequest& req,
+                                                     const std::function<void(std::size_t, std::size_t)>& progress = {});
+
+}  // namespace skylane::integrity

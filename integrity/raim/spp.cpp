@@ -1,0 +1,190 @@
+#include "integrity/raim/spp.hpp"
+
+#include "integrity/gnss/atmosphere.hpp"
+
+#include <Eigen/Cholesky>
+
+#include <cmath>
+
+namespace skylane::integrity {
+namespace {
+
+constexpr double kFreqL1_hz = 1575.42e6;
+constexpr double kFreqL2_hz = 1227.60e6;
+constexpr double kFreqE5a_hz = 1176.45e6;
+/// Gauss-Newton stops when the position update is below this [m].
+constexpr double kConvergence_m = 1e-4;
+constexpr int kMaxIterations = 12;
+/// Before this the receiver is too far from the Earth's surface for look angles to mean anything.
+constexpr double kMinEarthRadius_m = 6.0e6;
+
+struct Measurement {
+  SatId sat;
+  double pr_m = 0.0;
+  bool iono_free = false;
+  const BroadcastEphemeris* eph = nullptr;
+  Eigen::Vector3d p_sat_tx = Eigen::Vector3d::Zero();  ///< at transmit time, ECEF of transmit instant
+  double sat_clock_m = 0.0;                            ///< c·dt_sv incl. group delay when single frequency
+};
+
+bool valid(double v) { return std::isfinite(v) && v > 1e6; }
+
+/// Picks code observations: band 1 and the second band of each system.
+std::vector<Measurement> collect(const ObservationEpoch& ep, const ObservationData& obs, const NavigationData& nav,
+                                 const SppConfig& cfg, std::string& note) {
+  std::vector<Measurement> out;
+  int no_eph = 0;
+  for (const SatObservation& so : ep.sats) {
+    const Constellation c = so.sat.constellation;
+    if (c != Constellation::kGps && !(c == Constellation::kGalileo && cfg.use_galileo)) continue;
+    const auto& types = obs.types[static_cast<int>(c)];
+    const bool gps = c == Constellation::kGps;
+    const int i1 = findObsType(types, 'C', 1, gps ? "CWPXSLYM" : "CXBAZ");
+    const int i2 = gps ? findObsType(types, 'C', 2, "WPXLSCYM") : findObsType(types, 'C', 5, "QXI");
+    const double p1 = i1 >= 0 ? so.values[static_cast<std::size_t>(i1)] : NAN;
+    const double p2 = i2 >= 0 ? so.values[static_cast<std::size_t>(i2)] : NAN;
+    Measurement m;
+    m.sat = so.sat;
+    const double f1 = kFreqL1_hz, f2 = gps ? kFreqL2_hz : kFreqE5a_hz;
+    const bool have2 = valid(p1) && valid(p2);
+    if (cfg.iono == IonoMode::kIonoFree && !have2) continue;
+    if (cfg.iono != IonoMode::kKlobuchar && have2) {
+      m.pr_m = (f1 * f1 * p1 - f2 * f2 * p2) / (f1 * f1 - f2 * f2);
+      m.iono_free = true;
+    } else if (valid(p1)) {
+      m.pr_m = p1;
+    } else {
+      continue;
+    }
+    const auto inj = cfg.injected_bias_m.find(so.sat);
+    if (inj != cfg.injected_bias_m.end()) m.pr_m += inj->second;
+    m.eph = selectEphemeris(nav, so.sat, ep.t);
+    if (!m.eph) { ++no_eph; continue; }
+    // Transmit time in satellite time, then correct for the satellite clock (two passes).
+    GpsTime t_tx = ep.t.plus(-m.pr_m / kSpeedOfLight_mps);
+    SatelliteState st = satelliteState(*m.eph, t_tx);
+    t_tx = t_tx.plus(-st.clock_s);
+    st = satelliteState(*m.eph, t_tx);
+    m.p_sat_tx = st.p_ecef;
+    double dts = st.clock_s;
+    if (!m.iono_free) dts -= m.eph->sat.constellation == Constellation::kGalileo ? m.eph->bgd_e5b_s : m.eph->tgd_s;
+    m.sat_clock_m = kSpeedOfLight_mps * dts;
+    out.push_back(m);
+  }
+  if (no_eph > 0) note += std::to_string(no_eph) + " satellite(s) without a valid ephemeris; ";
+  return out;
+}
+
+}  // namespace
+
+SppEpoch solveSppEpoch(const ObservationEpoch& ep, const ObservationData& obs, const NavigationData& nav,
+                       const SppConfig& cfg, const std::optional<Eigen::Vector3d>& initial_ecef) {
+  SppEpoch out;
+  out.t = ep.t;
+  out.source_line = ep.source_line;
+  const std::vector<Measurement> meas = collect(ep, obs, nav, cfg, out.note);
+  Eigen::Vector3d x = initial_ecef.value_or(Eigen::Vector3d::Zero());
+  std::array<double, kNumConstellations> clock{};
+
+  // Phase A: unweighted, no atmosphere, no mask — brings any start point to the Earth's surface.
+  if (x.norm() < kMinEarthRadius_m) {
+    for (int it = 0; it < kMaxIterations; ++it) {
+      const int n = static_cast<int>(meas.size());
+      if (n < 4) break;
+      Eigen::MatrixXd G(n, 4);
+      Eigen::VectorXd y(n);
+      for (int i = 0; i < n; ++i) {
+        const Measurement& m = meas[static_cast<std::size_t>(i)];
+        const Eigen::Vector3d p = earthRotationCorrection(m.p_sat_tx, (m.p_sat_tx - x).norm() / kSpeedOfLight_mps);
+        const Eigen::Vector3d d = p - x;
+        const double rho = d.norm();
+        G.block<1, 3>(i, 0) = -(d / rho).transpose();
+        G(i, 3) = 1.0;
+        y[i] = m.pr_m - (rho + clock[0] - m.sat_clock_m);
+      }
+      const Eigen::Vector4d dx = (G.transpose() * G).ldlt().solve(G.transpose() * y);
+      if (!dx.allFinite()) break;
+      x += dx.head<3>();
+      clock[0] += dx[3];
+      if (dx.head<3>().norm() < 1.0) break;
+    }
+    for (double& c : clock) c = clock[0];
+  }
+  if (x.norm() < kMinEarthRadius_m) {
+    out.note += "no initial position could be found (" + std::to_string(meas.size()) + " satellites)";
+    return out;
+  }
+
+  // Phase B: weighted, corrected, masked, with RAIM FDE at each linearisation point.
+  RaimFdeResult fde;
+  std::vector<const Measurement*> in_view;
+  for (int it = 0; it < kMaxIterations; ++it) {
+    const maps::Geodetic user = maps::ecefToGeodetic(x);
+    const double tau = cfg.model.iono_tau_vert_m.value_or(ionoTauVert_m(geomagneticLatitude(user)));
+    ErrorModel model = cfg.model;
+    std::vector<SatLook> looks;
+    std::vector<double> prefit;
+    in_view.clear();
+    bool any_single = false;
+    for (const Measurement& m : meas) {
+      const Eigen::Vector3d p = earthRotationCorrection(m.p_sat_tx, (m.p_sat_tx - x).norm() / kSpeedOfLight_mps);
+      const maps::LookAngles look = maps::lookAngles(x, p);
+      if (look.elevation_rad < cfg.elevation_mask_rad) continue;
+      double iono = 0.0;
+      if (!m.iono_free) {
+        any_single = true;
+        // Galileo E1 shares L1's frequency; the GPS model stands in for NeQuick G here.
+        if (nav.klobuchar) iono = klobucharDelay_m(*nav.klobuchar, user, look, ep.t);
+      }
+      const double tropo = saastamoinenDelay_m(user, look.elevation_rad);
+      const double rho = (p - x).norm();
+      prefit.push_back(m.pr_m - (rho + clock[static_cast<int>(m.sat.constellation)] - m.sat_clock_m + iono + tropo));
+      looks.push_back({m.sat, look});
+      in_view.push_back(&m);
+    }
+    model.setUserModel(any_single ? UserErrorModel::kSingleFrequency : UserErrorModel::kDualFrequency);
+    const Geometry g = buildGeometry(looks, model, tau);
+    const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(prefit.data(), static_cast<Eigen::Index>(prefit.size()));
+    fde = raimFde(g, y, cfg.raim);
+    if (!fde.solution_ok) {
+      out.note += fde.pl.reason;
+      return out;
+    }
+    const maps::LocalFrame frame(user);
+    const Eigen::Vector3d dx_ecef = frame.enuToEcef(fde.dx.head<3>()) - x;
+    x += dx_ecef;
+    for (std::size_t k = 0; k < fde.final_geometry.clocks.size(); ++k) {
+      clock[static_cast<int>(fde.final_geometry.clocks[k])] += fde.dx[3 + static_cast<int>(k)];
+    }
+    out.iono_free = !any_single;
+    if (dx_ecef.norm() < kConvergence_m) break;
+  }
+  out.solved = true;
+  out.p_ecef = x;
+  out.position = maps::ecefToGeodetic(x);
+  out.clock_m = fde.final_geometry.clocks.empty() ? 0.0 : clock[static_cast<int>(fde.final_geometry.clocks[0])];
+  out.used = fde.final_geometry.sats;
+  for (int idx : fde.excluded) out.excluded.push_back(in_view[static_cast<std::size_t>(idx)]->sat);
+  out.fault_detected = fde.fault_detected;
+  out.test_statistic = fde.test_statistic;
+  out.threshold = fde.threshold;
+  out.pl = fde.pl;
+  if (!out.pl.available) out.note += out.pl.reason;
+  return out;
+}
+
+std::vector<SppEpoch> solveSpp(const ObservationData& obs, const NavigationData& nav, const SppConfig& cfg,
+                               const std::function<void(std::size_t, std::size_t)>& progress) {
+  std::vector<SppEpoch> out;
+  out.reserve(obs.epochs.size());
+  std::optional<Eigen::Vector3d> prior = obs.approx_position_ecef;
+  if (prior && prior->norm() < kMinEarthRadius_m) prior.reset();
+  for (std::size_t i = 0; i < obs.epochs.size(); ++i) {
+    out.push_back(solveSppEpoch(obs.epochs[i], obs, nav, cfg, prior));
+    if (out.back().solved) prior = out.back().p_ecef;
+    if (progress && (i % 64 == 0 || i + 1 == obs.epochs.size())) progress(i + 1, obs.epochs.size());
+  }
+  return out;
+}
+
+}  // namespace skylane::integrity

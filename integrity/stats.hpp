@@ -1,0 +1,19 @@
+#pragma once
+/// \file
+/// \brief The few distributions integrity needs: the normal tail Q, its inverse, chi-square and
+/// non-central chi-square quantiles (computed with Boost.Math, not tabled).
+
+namespace skylane::integrity {
+
+/// \brief Q(x) = 1 − Φ(x), the standard normal upper tail (via erfc, accurate to 1e-300).
+[[nodiscard]] double normalTail(double x);
+/// \brief Q⁻¹(p): the x with Q(x) = p, for p in (0, 1).
+[[nodiscard]] double normalTailInverse(double p);
+/// \brief The x with P(χ²_dof > x) = p (upper-tail quantile).
+[[nodiscard]] double chiSquareUpperQuantile(int dof, double p);
+/// \brief P(χ²_dof(λ) ≤ x): the non-central chi-square CDF with non-centrality λ.
+[[nodiscard]] double nonCentralChiSquareCdf(int dof, double lambda, double x);
+/// \brief The non-centrality λ with P(χ²_dof(λ) ≤ x) = p (bisection on the monotone CDF).
+[[nodiscard]] double nonCentralityForCdf(int dof, double x, double p);
+
+}  // namespace skylane::integrity
