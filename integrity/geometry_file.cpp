@@ -151,9 +151,9 @@ GeometryInput parseGeometry(const json& doc, const std::string& src) {
     in.raim.pmd = probability(r, "pmd", in.raim.pmd, src, "raim");
     in.raim.max_exclusions = static_cast<int>(number(r, "max_exclusions", in.raim.max_exclusions, src, "raim", 0, 10, "0 to 10"));
     if (const auto f = r.find("formula"); f != r.end()) {
-      if (*f == "walter_enge") in.raim.formula = RaimPlFormula::kSlopeThresholdPlusNoise;
+      if (*f == "pbias_plus_noise") in.raim.formula = RaimPlFormula::kSlopePbiasPlusNoise;
       else if (*f == "brown") in.raim.formula = RaimPlFormula::kSlopePbias;
-      else throw ParseError(src, 0, "raim.formula", shown(*f), "\"walter_enge\" or \"brown\"");
+      else throw ParseError(src, 0, "raim.formula", shown(*f), "\"pbias_plus_noise\" or \"brown\"");
     }
   }
   if (const auto it = doc.find("position"); it != doc.end()) {

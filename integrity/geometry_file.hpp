@@ -10,7 +10,7 @@
 ///  "requirements":{"phmi_vert":9.8e-8,"phmi_hor":2e-9,"pfa_vert":3.9e-6,"pfa_hor":9e-8,
 ///                  "p_thres":8e-8,"p_emt":1e-5,"tol_pl_m":0.05,"val_m":35,"hal_m":40,
 ///                  "emt_m":15,"sigma_acc_m":1.87},
-///  "raim":{"pfa":1e-6,"pmd":1e-3,"formula":"walter_enge"|"brown"},
+///  "raim":{"pfa":1e-6,"pmd":1e-3,"formula":"pbias_plus_noise"|"brown"},
 ///  "position":{"lat_deg":…,"lon_deg":…,"h_m":…},   // optional: single-frequency τ_vert
 ///  "iono_tau_vert_m": 9}                               // optional override
 /// ```

@@ -41,8 +41,9 @@ std::string field(const std::string& line, std::size_t pos, std::size_t len) {
 
 double parseFortranReal(const std::string& text, const std::string& source, int line,
                         const std::string& field_name, double blank_value) {
-  std::string t = trim(text);
-  if (t.empty()) return blank_value;
+  const std::string original = trim(text);
+  if (original.empty()) return blank_value;
+  std::string t = original;
   for (char& c : t) {
     if (c == 'D' || c == 'd') c = 'E';
   }
@@ -50,7 +51,7 @@ double parseFortranReal(const std::string& text, const std::string& source, int 
   char* end = nullptr;
   const double v = std::strtod(t.c_str(), &end);
   if (end == t.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
-    throw ParseError(source, line, field_name, t, "a finite real number");
+    throw ParseError(source, line, field_name, original, "a finite real number");
   }
   return v;
 }

@@ -80,9 +80,11 @@ RaimPl raimProtectionLevels(const Geometry& g, const RaimConfig& cfg) {
     hpl = out.max_hslope * out.thresholds.p_bias;
     vpl = out.max_vslope * out.thresholds.p_bias;
   } else {
-    const double k_md = normalTailInverse(cfg.pmd / 2.0);
-    hpl = out.max_hslope * out.thresholds.threshold + k_md * out.sigma_h_m;
-    vpl = out.max_vslope * out.thresholds.threshold + k_md * out.sigma_v_m;
+    // Horizontal noise: P(‖n‖ > x) ≤ exp(−x²/2σ²_major) for a 2-D Gaussian (χ²₂ tail bound).
+    const double k_md_h = std::sqrt(-2.0 * std::log(cfg.pmd));
+    const double k_md_v = normalTailInverse(cfg.pmd / 2.0);
+    hpl = out.max_hslope * out.thresholds.p_bias + k_md_h * out.sigma_h_m;
+    vpl = out.max_vslope * out.thresholds.p_bias + k_md_v * out.sigma_v_m;
   }
   // Never below the fault-free bound K_ff·σ.
   out.hpl_m = std::max(hpl, k_ff_h * out.sigma_h_m);

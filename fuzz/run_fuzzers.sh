@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Runs the skylane libFuzzer targets on scratch copies of their seed corpora.
+#
+#   fuzz/run_fuzzers.sh [build-dir] [seconds-per-target] [target ...]
+#
+# Defaults: build-fuzz, 60 s, all six targets. Work files go to $SKYLANE_FUZZ_WORK
+# (default /tmp/skylane-fuzz): <target>/corpus (grows), <target>/artifacts (crash-*, timeout-*,
+# oom-*), <target>/log. The repository is only read. Exits non-zero if any target found something.
+set -euo pipefail
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${1:-$root/build-fuzz}"
+seconds="${2:-60}"
+shift $(( $# > 2 ? 2 : $# ))
+targets=("$@")
+[ ${#targets[@]} -eq 0 ] && targets=(yuma sem rinex_nav rinex_obs geometry text_fields)
+work="${SKYLANE_FUZZ_WORK:-/tmp/skylane-fuzz}"
+data="$root/tests/data"
+
+# Header plus the first `records` lines after END OF HEADER: small seeds mutate faster.
+head_after_header() {  # file lines-after-header
+  local n
+  n=$(grep -n "END OF HEADER" "$1" | head -1 | cut -d: -f1)
+  head -n $(( n + $2 )) "$1"
+}
+
+seed() {  # target corpus-dir
+  local t="$1" c="$2" f
+  case "$t" in
+    yuma)
+      cp "$data"/gnss/*.txt "$c"/
+      for f in "$data"/gnss/*.txt; do head -n 28 "$f" > "$c/2rec_$(basename "$f")"; done ;;
+    sem) cp "$root"/fuzz/corpus/sem/* "$c"/ ;;
+    rinex_nav)
+      for f in "$data"/gnss/*.05n "$data"/gnss/*.06N "$data"/gnss/*.10n "$data"/rinex3/*MN.rnx; do
+        cp "$f" "$c"/
+        head_after_header "$f" 24 > "$c/3rec_$(basename "$f")"
+      done ;;
+    rinex_obs)
+      for f in "$data"/gnss/*.05o "$data"/rinex3/*MO.rnx; do
+        cp "$f" "$c"/
+        head_after_header "$f" 40 > "$c/short_$(basename "$f")"
+      done ;;
+    geometry) cp "$root"/fuzz/corpus/geometry/* "$c"/ ;;
+    text_fields) cp "$root"/fuzz/corpus/text_fields/* "$c"/ ;;
+    *) echo "unknown target $t" >&2; exit 2 ;;
+  esac
+}
+
+status=0
+for t in "${targets[@]}"; do
+  exe="$build/fuzz/fuzz_$t"
+  [ -x "$exe" ] || { echo "missing $exe (build it first)" >&2; exit 2; }
+  rm -rf "${work:?}/$t"
+  mkdir -p "$work/$t/corpus" "$work/$t/artifacts"
+  seed "$t" "$work/$t/corpus"
+  echo "== fuzz_$t: $seconds s, $(ls "$work/$t/corpus" | wc -l) seeds"
+  set +e
+  "$exe" "$work/$t/corpus" -max_total_time="$seconds" -timeout=10 -print_final_stats=1 \
+    -artifact_prefix="$work/$t/artifacts/" > "$work/$t/log" 2>&1
+  rc=$?
+  set -e
+  grep -E "^#[0-9]+ +DONE|^stat::number_of_executed_units|^stat::average_exec_per_sec" "$work/$t/log" || true
+  if [ $rc -ne 0 ]; then
+    status=1
+    echo "   FINDING (exit $rc): $(ls "$work/$t/artifacts")"
+    grep -m3 -E "ERROR: |runtime error|skylane fuzz:" "$work/$t/log" || true
+  fi
+done
+exit $status

@@ -1,0 +1,110 @@
+// End-to-end checks of the skylane command: output shape and the exit-status contract
+// (0 success, 2 bad input with one line naming file/field/value/expectation).
+#include "tests/test_util.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <sys/wait.h>
+
+namespace skylane {
+namespace {
+
+struct RunResult {
+  int status = -1;
+  std::string out;  ///< stdout and stderr together
+};
+
+RunResult run(const std::string& args) {
+  const std::string cmd = std::string(SKYLANE_BINARY) + " " + args + " 2>&1";
+  RunResult r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+std::string writeTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(Cli, PlPrintsProtectionLevelsAsJson) {
+  const std::string geo = writeTemp("geo.json", R"({"satellites":[
+    {"id":"G01","az_deg":0,"el_deg":88},{"id":"G05","az_deg":30,"el_deg":35},{"id":"G08","az_deg":95,"el_deg":20},
+    {"id":"G11","az_deg":150,"el_deg":55},{"id":"G17","az_deg":200,"el_deg":15},{"id":"G22","az_deg":260,"el_deg":42},
+    {"id":"G28","az_deg":320,"el_deg":25}]})");
+  const RunResult r = run("integrity pl --geometry " + geo + " --method raim --verbose");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["available"].get<bool>());
+  EXPECT_GT(j["hpl_m"].get<double>(), 0.0);
+  EXPECT_GT(j["vpl_m"].get<double>(), j["hpl_m"].get<double>() * 0.5);
+  EXPECT_EQ(j["per_satellite"].size(), 7u);
+  EXPECT_EQ(j["dof"].get<int>(), 3);
+}
+
+TEST(Cli, PlWithTooFewSatellitesSaysNotAvailable) {
+  const std::string geo = writeTemp("geo3.json", R"({"satellites":[{"id":"G01","az_deg":0,"el_deg":88},
+    {"id":"G05","az_deg":30,"el_deg":35},{"id":"G08","az_deg":95,"el_deg":20}]})");
+  const RunResult r = run("integrity pl --geometry " + geo);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j["available"].get<bool>());
+  EXPECT_TRUE(j["hpl_m"].is_null());
+  EXPECT_NE(j["reason"].get<std::string>().find("too few satellites"), std::string::npos);
+}
+
+TEST(Cli, BadInputExitsTwoWithOneLineNamingTheProblem) {
+  const std::string bad_geo = writeTemp("bad.json", R"({"satellites":[{"id":"G01","az_deg":0,"el_deg":"high"}]})");
+  const std::string bad_alm = writeTemp("bad_alm.txt", "******** Week 1 almanac for PRN-01 ********\nID: 1\nHealth: x\n");
+  struct Case { std::string args; std::string expected; };
+  const Case cases[] = {
+      {"integrity pl --geometry " + bad_geo, "satellites[0].el_deg': got '\"high\"'"},
+      {"integrity pl --geometry /no/such/file.json", "/no/such/file.json"},
+      {"integrity predict --almanac " + bad_alm + " --lat 1 --lon 2 --start 2020-01-01T00:00:00Z", "bad_alm.txt:3: field 'Health'"},
+      {"integrity predict --almanac x --lat 1 --lon 2 --start tomorrow", "field '--start': got 'tomorrow'"},
+      {"integrity predict --almanac x --lat 100 --lon 2 --start 2020-01-01T00:00:00Z", "field '--lat'"},
+      {"integrity spp --obs " + test::dataPath("gnss/30400920.05n") + " --nav " + test::dataPath("gnss/30400920.05n"),
+       "field 'file type': got 'N', expected 'O'"},
+      {"integrity pl", "--geometry is required"},
+  };
+  for (const auto& c : cases) {
+    const RunResult r = run(c.args);
+    EXPECT_EQ(r.status, 2) << c.args << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.expected), std::string::npos) << c.args << "\n" << r.out;
+  }
+}
+
+TEST(Cli, PredictWritesCsvAndSvg) {
+  const std::string svg = ::testing::TempDir() + "/predict.svg";
+  const RunResult r = run("integrity predict --almanac " + test::dataPath("gnss/alm01jan2020.txt") +
+                          " --lat 35.13 --lon 139.62 --start 2020-01-01T00:00:00Z --duration 2h --step 30m --plot " + svg);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(r.out.rfind("time_utc,gps_week,gps_sow,satellites,hdop,vdop,hpl_m,vpl_m,available\n", 0), 0u) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 6);  // header + 5 epochs
+  std::ifstream f(svg);
+  std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("<svg"), std::string::npos);
+  EXPECT_NE(text.find("HPL"), std::string::npos);
+}
+
+TEST(Cli, SppPrintsOneJsonLinePerEpoch) {
+  const RunResult r = run("integrity spp --obs " + test::dataPath("gnss/30400920.05o") + " --nav " +
+                          test::dataPath("gnss/30400920.05n") + " --inject G08:50");
+  ASSERT_EQ(r.status, 0) << r.out.substr(0, 500);
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 120);
+  const auto first = nlohmann::json::parse(r.out.substr(0, r.out.find('\n')));
+  EXPECT_EQ(first["time"], "2005-04-01T23:59:47.000Z");  // GPS 00:00:00 − 13 leap seconds
+  EXPECT_EQ(first["excluded"], nlohmann::json::array({"G08"}));
+  EXPECT_TRUE(first["fault_detected"].get<bool>());
+  EXPECT_NEAR(first["lat_deg"].get<double>(), 35.13207, 1e-4);
+}
+
+}  // namespace
+}  // namespace skylane

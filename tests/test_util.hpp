@@ -1,0 +1,48 @@
+#pragma once
+// Shared helpers for skylane's tests.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+
+namespace skylane::test {
+
+/// Path of a file under tests/data.
+inline std::string dataPath(const std::string& rel) { return std::string(SKYLANE_TEST_DATA) + "/" + rel; }
+
+/// Whole file as text.
+inline std::string readData(const std::string& rel) {
+  std::ifstream in(dataPath(rel), std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// Compares vectors element-wise with an absolute tolerance and names the component.
+inline ::testing::AssertionResult nearVec(const Eigen::VectorXd& a, const Eigen::VectorXd& b, double tol) {
+  if (a.size() != b.size()) return ::testing::AssertionFailure() << "sizes " << a.size() << " vs " << b.size();
+  for (Eigen::Index i = 0; i < a.size(); ++i) {
+    if (!(std::abs(a[i] - b[i]) <= tol)) {
+      return ::testing::AssertionFailure() << "component " << i << ": " << a[i] << " vs " << b[i] << " (tol " << tol << ")";
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+/// Runs `fn` and returns the message of the exception of type E it throws ("" if none).
+template <typename E>
+std::string messageOf(const std::function<void()>& fn) {
+  try {
+    fn();
+  } catch (const E& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace skylane::test
