@@ -253,7 +253,7 @@ void runSpp(const SppOptions& o) {
     json j;
     j["time"] = integrity::formatRfc3339(e.t, 3);
     j["gps_week"] = e.t.week;
-    j["gps_sow"] = e.t.sow;
+    j["gps_sow"] = std::round(e.t.sow * 1e6) / 1e6;  // µs: drop binary round-off
     j["solved"] = e.solved;
     if (e.solved) {
       char lat[32], lon[32];

@@ -137,6 +137,10 @@ TEST(Spp, Rinex3GpsPlusGalileoWithTwoReceiverClocks) {
     EXPECT_LT(std::hypot(d.x(), d.y()), 3.0);
     EXPECT_LT(std::abs(d.z()), 5.0);
     EXPECT_TRUE(e.pl.available);
+    // Galileo orbits, clocks and the second receiver clock are consistent with GPS: nothing is
+    // excluded and the residual test passes.
+    EXPECT_TRUE(e.excluded.empty());
+    EXPECT_LT(e.test_statistic, e.threshold);
   }
 }
 
