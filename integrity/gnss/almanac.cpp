@@ -15,17 +15,6 @@ constexpr double kSemicircle_rad = M_PI;
 /// MAAST numbers Galileo almanac entries from 75 (PRN = ID − 74).
 constexpr int kMaastGalileoIdOffset = 74;
 
-std::vector<std::string> splitLines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::string cur;
-  std::istringstream in(text);
-  while (std::getline(in, cur)) {
-    if (!cur.empty() && cur.back() == '\r') cur.pop_back();
-    lines.push_back(cur);
-  }
-  return lines;
-}
-
 SatId assignSat(int id, bool header_says_galileo, AlmanacSystem system) {
   SatId sat;
   const bool galileo = system == AlmanacSystem::kGalileo ||

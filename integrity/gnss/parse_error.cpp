@@ -34,6 +34,20 @@ std::string trim(const std::string& s) {
   return s.substr(b, e - b + 1);
 }
 
+std::vector<std::string> splitLines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::size_t len = end - start;
+    if (len > 0 && text[start + len - 1] == '\r') --len;
+    lines.emplace_back(text, start, len);
+    start = end + 1;
+  }
+  return lines;
+}
+
 std::string field(const std::string& line, std::size_t pos, std::size_t len) {
   if (pos >= line.size()) return {};
   return line.substr(pos, len);

@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace skylane::integrity {
 
@@ -38,5 +39,14 @@ class ParseError : public std::runtime_error {
 
 /// \brief Copy without leading and trailing blanks (space, tab, CR, LF).
 [[nodiscard]] std::string trim(const std::string& s);
+
+/// \brief Splits text into lines (LF or CRLF); line i of the file is element i − 1.
+[[nodiscard]] std::vector<std::string> splitLines(const std::string& text);
+
+/// \brief The header label of a RINEX line (columns 61–80, trimmed).
+[[nodiscard]] inline std::string rinexLabel(const std::string& line) { return trim(field(line, 60, 20)); }
+
+/// \brief RINEX 2 two-digit year: 80–99 → 19xx, 00–79 → 20xx (RINEX 2.11 §6.5).
+[[nodiscard]] inline int rinexFullYear(int yy) { return yy < 80 ? 2000 + yy : (yy < 100 ? 1900 + yy : yy); }
 
 }  // namespace skylane::integrity

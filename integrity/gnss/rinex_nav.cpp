@@ -15,19 +15,10 @@ constexpr double kMaxDtoeGalileo_s = 7200.0;
 
 struct Lines {
   std::vector<std::string> v;
-  explicit Lines(const std::string& text) {
-    std::istringstream in(text);
-    std::string cur;
-    while (std::getline(in, cur)) {
-      if (!cur.empty() && cur.back() == '\r') cur.pop_back();
-      v.push_back(cur);
-    }
-  }
+  explicit Lines(const std::string& text) : v(splitLines(text)) {}
 };
 
-std::string label(const std::string& line) { return trim(field(line, 60, 20)); }
-
-int fullYear(int yy) { return yy < 80 ? 2000 + yy : (yy < 100 ? 1900 + yy : yy); }
+std::string label(const std::string& line) { return rinexLabel(line); }
 
 /// The names of the 4 values on each broadcast-orbit line (GPS and Galileo share the layout).
 const char* const kOrbitFields[7][4] = {
@@ -218,7 +209,7 @@ NavigationData parseRinexNav(const std::string& text, const std::string& src) {
     } else {
       e.sat.constellation = Constellation::kGps;
       e.sat.prn = parseInt(field(line, 0, 2), src, ln, "PRN");
-      toc.year = fullYear(parseInt(field(line, 3, 2), src, ln, "toc year"));
+      toc.year = rinexFullYear(parseInt(field(line, 3, 2), src, ln, "toc year"));
       toc.month = parseInt(field(line, 6, 2), src, ln, "toc month");
       toc.day = parseInt(field(line, 9, 2), src, ln, "toc day");
       toc.hour = parseInt(field(line, 12, 2), src, ln, "toc hour");

@@ -15,9 +15,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// Width of one observation field: F14.3 + LLI + signal strength.
 constexpr std::size_t kObsWidth = 16;
 
-std::string label(const std::string& line) { return trim(field(line, 60, 20)); }
-
-int fullYear(int yy) { return yy < 80 ? 2000 + yy : (yy < 100 ? 1900 + yy : yy); }
+std::string label(const std::string& line) { return rinexLabel(line); }
 
 void checkEpoch(const CalendarTime& c, const std::string& src, int ln) {
   if (c.month < 1 || c.month > 12 || c.day < 1 || c.day > 31 || c.hour < 0 || c.hour > 23 ||
@@ -83,15 +81,7 @@ int findObsType(const std::vector<ObsCode>& types, char kind, int band, const st
 }
 
 ObservationData parseRinexObs(const std::string& text, const std::string& src) {
-  std::vector<std::string> L;
-  {
-    std::istringstream in(text);
-    std::string cur;
-    while (std::getline(in, cur)) {
-      if (!cur.empty() && cur.back() == '\r') cur.pop_back();
-      L.push_back(cur);
-    }
-  }
+  const std::vector<std::string> L = splitLines(text);
   ObservationData obs;
   if (L.empty()) throw ParseError(src, 1, "RINEX VERSION / TYPE", "", "a RINEX observation header (file is empty)");
   if (label(L[0]) != "RINEX VERSION / TYPE") {
@@ -199,7 +189,7 @@ ObservationData parseRinexObs(const std::string& text, const std::string& src) {
       ep.flag = parseInt(field(line, 31, 1), src, ln, "epoch flag");
       nsat = parseInt(field(line, 32, 3), src, ln, "number of satellites");
     } else {
-      c.year = fullYear(parseInt(field(line, 1, 2), src, ln, "epoch year"));
+      c.year = rinexFullYear(parseInt(field(line, 1, 2), src, ln, "epoch year"));
       c.month = parseInt(field(line, 4, 2), src, ln, "epoch month");
       c.day = parseInt(field(line, 7, 2), src, ln, "epoch day");
       c.hour = parseInt(field(line, 10, 2), src, ln, "epoch hour");
