@@ -127,10 +127,12 @@ struct PredictOptions {
   std::string plot;
   std::string ism;
   std::string user_model = "dual_frequency";
+  std::string method = "raim";
   bool progress = false;
 };
 
 void runPredict(const PredictOptions& o) {
+  if (o.method != "raim") throw ParseError("--method", 0, "--method", o.method, "\"raim\" (ARAIM arrives with issue 3)");
   integrity::PredictRequest req;
   if (!(o.lat_deg >= -90 && o.lat_deg <= 90)) throw ParseError("--lat", 0, "--lat", std::to_string(o.lat_deg), "a latitude in [-90, 90] degrees");
   if (!(o.lon_deg >= -180 && o.lon_deg <= 360)) throw ParseError("--lon", 0, "--lon", std::to_string(o.lon_deg), "a longitude in degrees");
@@ -307,6 +309,7 @@ void addIntegrityCommands(CLI::App& app) {
   c->add_option("--plot", pr->plot, "write an SVG plot of HPL/VPL and satellites in view");
   c->add_option("--ism", pr->ism, "JSON file with an ism object overriding the defaults");
   c->add_option("--user-model", pr->user_model, "dual_frequency or single_frequency");
+  c->add_option("--method", pr->method, "integrity method (raim)");
   c->add_flag("--progress", pr->progress, "show a progress bar even when stderr is not a terminal");
   c->callback([pr] { runPredict(*pr); });
 

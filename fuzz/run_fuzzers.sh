@@ -6,6 +6,7 @@
 # Defaults: build-fuzz, 60 s, all six targets. Work files go to $SKYLANE_FUZZ_WORK
 # (default /tmp/skylane-fuzz): <target>/corpus (grows), <target>/artifacts (crash-*, timeout-*,
 # oom-*), <target>/log. The repository is only read. Exits non-zero if any target found something.
+# Extra libFuzzer flags can be passed in $SKYLANE_FUZZ_ARGS (e.g. "-jobs=2 -workers=2").
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -54,13 +55,17 @@ for t in "${targets[@]}"; do
   rm -rf "${work:?}/$t"
   mkdir -p "$work/$t/corpus" "$work/$t/artifacts"
   seed "$t" "$work/$t/corpus"
-  echo "== fuzz_$t: $seconds s, $(ls "$work/$t/corpus" | wc -l) seeds"
+  echo "== fuzz_$t: $seconds s, $(find "$work/$t/corpus" -type f | wc -l) seeds"
+  extra=()
+  [ "$t" = geometry ] && extra+=(-dict="$root/fuzz/geometry.dict")
   set +e
+  # shellcheck disable=SC2086  # SKYLANE_FUZZ_ARGS is a list of flags
   "$exe" "$work/$t/corpus" -max_total_time="$seconds" -timeout=10 -print_final_stats=1 \
-    -artifact_prefix="$work/$t/artifacts/" > "$work/$t/log" 2>&1
+    -artifact_prefix="$work/$t/artifacts/" "${extra[@]}" ${SKYLANE_FUZZ_ARGS:-} > "$work/$t/log" 2>&1
   rc=$?
   set -e
-  grep -E "^#[0-9]+ +DONE|^stat::number_of_executed_units|^stat::average_exec_per_sec" "$work/$t/log" || true
+  grep -E "^#[0-9]+[[:space:]]+(DONE|NEW|REDUCE|pulse)" "$work/$t/log" | tail -1 || true
+  grep -E "^stat::(number_of_executed_units|average_exec_per_sec)" "$work/$t/log" || true
   if [ $rc -ne 0 ]; then
     status=1
     echo "   FINDING (exit $rc): $(ls "$work/$t/artifacts")"

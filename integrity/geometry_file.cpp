@@ -15,6 +15,10 @@ namespace {
 using nlohmann::json;
 
 std::string shown(const json& v) {
+  // Structured values are described, not dumped: dump() recurses and a hostile nesting depth
+  // would overflow the stack.
+  if (v.is_object()) return "an object";
+  if (v.is_array()) return "an array of " + std::to_string(v.size());
   std::string s = v.dump();
   if (s.size() > 40) s = s.substr(0, 37) + "...";
   return s;
@@ -41,9 +45,13 @@ double number(const json& obj, const std::string& key, double def, const std::st
   return v;
 }
 
+/// Integrity probabilities below this are not meaningful (and halving them must stay normal).
+constexpr double kMinProbability = 1e-15;
+
 double probability(const json& obj, const std::string& key, double def, const std::string& src, const std::string& path) {
-  const double v = number(obj, key, def, src, path, 0.0, 1.0, "a probability in (0, 1)");
-  if (!(v > 0.0 && v < 1.0)) throw ParseError(src, 0, path + "." + key, std::to_string(v), "a probability in (0, 1)");
+  const char* expected = "a probability in [1e-15, 1)";
+  const double v = number(obj, key, def, src, path, 0.0, 1.0, expected);
+  if (!(v >= kMinProbability && v < 1.0)) throw ParseError(src, 0, path + "." + key, shown(obj.at(key)), expected);
   return v;
 }
 

@@ -2,6 +2,7 @@
 
 #include "integrity/gnss/parse_error.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -14,6 +15,10 @@ namespace {
 constexpr double kSemicircle_rad = M_PI;
 /// MAAST numbers Galileo almanac entries from 75 (PRN = ID − 74).
 constexpr int kMaastGalileoIdOffset = 74;
+/// Largest almanac ID: MAAST's Galileo 75 … 110 plus margin; PRNs are then checked to 1 … 99.
+constexpr int kMaxAlmanacId = 173;
+/// GPS weeks beyond this (year 2171) are taken as corrupt input.
+constexpr int kMaxWeek = 10000;
 
 SatId assignSat(int id, bool header_says_galileo, AlmanacSystem system) {
   SatId sat;
@@ -73,9 +78,11 @@ std::vector<AlmanacRecord> parseYuma(const std::string& text, const std::string&
     AlmanacRecord r;
     r.source_line = static_cast<int>(i + 1);
     double v[kFields];
+    int line_of[kFields];
     for (int f = 0; f < kFields; ++f) {
       ++i;
       const int ln = static_cast<int>(i + 1);
+      line_of[f] = ln;
       if (i >= lines.size()) {
         throw ParseError(source, ln, kLabels[f], "", "the record to continue (file is truncated)");
       }
@@ -90,9 +97,9 @@ std::vector<AlmanacRecord> parseYuma(const std::string& text, const std::string&
       if (std::isnan(v[f])) throw ParseError(source, ln, kLabels[f], "", "a number");
     }
     ++i;
-    const int id = static_cast<int>(v[0]);
+    const int id = integerField(v[0], 1, kMaxAlmanacId, source, line_of[0], kLabels[0]);
     r.sat = assignSat(id, header_gal, system);
-    r.health = static_cast<int>(v[1]);
+    r.health = integerField(v[1], 0, 255, source, line_of[1], kLabels[1]);
     r.orbit.constellation = r.sat.constellation;
     r.orbit.e = v[2];
     r.orbit.toe.sow = v[3];
@@ -104,7 +111,7 @@ std::vector<AlmanacRecord> parseYuma(const std::string& text, const std::string&
     r.orbit.m0_rad = v[9];
     r.af0_s = v[10];
     r.af1_sps = v[11];
-    r.week_field = static_cast<int>(v[12]);
+    r.week_field = integerField(v[12], 0, kMaxWeek, source, line_of[12], kLabels[12]);
     r.orbit.toe.week = r.week_field;
     checkOrbit(r, source);
     out.push_back(r);
@@ -145,7 +152,11 @@ std::vector<AlmanacRecord> parseSem(const std::string& text, const std::string& 
   }
   // The rest of line 1 is a free title; the week is the first token on line 2.
   while (k < tok.size() && tok[k].line == 1) ++k;
+  const Token& week_tok = tok[std::min(k, tok.size() - 1)];
   const int week = integer("week");
+  if (week < 0 || week > kMaxWeek) {
+    throw ParseError(source, week_tok.line, "week", std::to_string(week), "a GPS week in [0, 10000]");
+  }
   const double toa = real("time of applicability");
   std::vector<AlmanacRecord> out;
   for (int n = 0; n < count; ++n) {
@@ -194,15 +205,12 @@ GpsTime resolveAlmanacEpoch(int week_field, double toa_s, const GpsTime& near) {
   int modulus = 0;
   if (week_field < 256) modulus = 256;
   else if (week_field < 1024) modulus = 1024;
-  GpsTime best{week_field, toa_s};
-  if (modulus == 0) return best;
-  double best_gap = std::abs(near - best);
-  for (int w = week_field; w < near.week + modulus; w += modulus) {
-    const GpsTime cand{w, toa_s};
-    const double gap = std::abs(near - cand);
-    if (gap < best_gap) { best = cand; best_gap = gap; }
-  }
-  return best;
+  if (modulus == 0) return GpsTime{week_field, toa_s};
+  // The rollover count that brings t_oa nearest to `near` (never before week_field itself).
+  const double rollovers = std::round((near.totalSeconds() - GpsTime{week_field, toa_s}.totalSeconds()) /
+                                      (modulus * kSecondsPerWeek));
+  const int k = static_cast<int>(std::clamp(rollovers, 0.0, 1e6));
+  return GpsTime{week_field + k * modulus, toa_s};
 }
 
 SatelliteState almanacState(const AlmanacRecord& rec, const GpsTime& t) {

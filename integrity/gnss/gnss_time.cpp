@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 
 namespace skylane::integrity {
 namespace {
@@ -101,17 +102,39 @@ CalendarTime utcFromGps(const GpsTime& t) {
 }
 
 std::optional<GpsTime> parseRfc3339(const std::string& text) {
-  // YYYY-MM-DDTHH:MM:SS[.frac](Z|±HH:MM)
-  int y = 0, mo = 0, d = 0, h = 0, mi = 0, consumed = 0;
-  double s = 0;
-  if (std::sscanf(text.c_str(), "%4d-%2d-%2d%*1[Tt ]%2d:%2d:%lf%n", &y, &mo, &d, &h, &mi, &s,
-                  &consumed) != 6) {
+  // YYYY-MM-DDTHH:MM:SS[.frac](Z|±HH:MM), every digit where RFC 3339 §5.6 puts it.
+  const auto digits = [&](std::size_t pos, std::size_t n, int& out) {
+    if (pos + n > text.size()) return false;
+    out = 0;
+    for (std::size_t i = pos; i < pos + n; ++i) {
+      if (!std::isdigit(static_cast<unsigned char>(text[i]))) return false;
+      out = out * 10 + (text[i] - '0');
+    }
+    return true;
+  };
+  int y = 0, mo = 0, d = 0, h = 0, mi = 0, si = 0;
+  if (text.size() < 20 || !digits(0, 4, y) || text[4] != '-' || !digits(5, 2, mo) || text[7] != '-' ||
+      !digits(8, 2, d) || (text[10] != 'T' && text[10] != 't' && text[10] != ' ') || !digits(11, 2, h) ||
+      text[13] != ':' || !digits(14, 2, mi) || text[16] != ':' || !digits(17, 2, si)) {
     return std::nullopt;
   }
-  if (mo < 1 || mo > 12 || d < 1 || d > 31 || h > 23 || mi > 59 || !(s >= 0.0 && s < 61.0)) {
-    return std::nullopt;
+  std::size_t pos = 19;
+  double s = si;
+  if (pos < text.size() && text[pos] == '.') {
+    double scale = 0.1;
+    std::size_t start = ++pos;
+    for (; pos < text.size() && std::isdigit(static_cast<unsigned char>(text[pos])); ++pos, scale /= 10) {
+      s += (text[pos] - '0') * scale;
+    }
+    if (pos == start) return std::nullopt;
   }
-  const std::string zone = text.substr(static_cast<std::size_t>(consumed));
+  static constexpr int kDaysInMonth[] = {31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  const bool leap_year = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+  if (y < 1980 || mo < 1 || mo > 12 || d < 1 || d > kDaysInMonth[mo - 1] || (mo == 2 && d == 29 && !leap_year) ||
+      h > 23 || mi > 59 || si > 59) {
+    return std::nullopt;  // 23:59:60 is not accepted: skylane cannot tell a real leap second apart
+  }
+  const std::string zone = text.substr(pos);
   int offset_min = 0;
   if (zone == "Z" || zone == "z") {
     offset_min = 0;
@@ -175,7 +198,7 @@ std::optional<double> parseDuration(const std::string& text) {
     total += v * unit;
     any = true;
   }
-  if (!(total > 0)) return std::nullopt;
+  if (!(total > 0) || !std::isfinite(total)) return std::nullopt;
   return total;
 }
 

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 
 namespace skylane::integrity {
 namespace {
@@ -32,6 +33,17 @@ std::string trim(const std::string& s) {
   if (b == std::string::npos) return {};
   const auto e = s.find_last_not_of(ws);
   return s.substr(b, e - b + 1);
+}
+
+int integerField(double value, int lo, int hi, const std::string& source, int line,
+                 const std::string& field_name) {
+  if (!(value >= lo && value <= hi) || value != std::floor(value)) {
+    std::ostringstream v;
+    v << value;
+    throw ParseError(source, line, field_name, v.str(),
+                     "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  }
+  return static_cast<int>(value);
 }
 
 std::vector<std::string> splitLines(const std::string& text) {

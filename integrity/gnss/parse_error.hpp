@@ -34,6 +34,11 @@ class ParseError : public std::runtime_error {
 [[nodiscard]] int parseInt(const std::string& text, const std::string& source, int line,
                            const std::string& field, int blank_value = 0);
 
+/// \brief An integer-valued real (RINEX and YUMA write integers as reals) in [lo, hi]; throws
+/// ParseError naming the field when it is fractional or out of range.
+[[nodiscard]] int integerField(double value, int lo, int hi, const std::string& source, int line,
+                               const std::string& field);
+
 /// \brief Substring that tolerates short lines (returns what exists, possibly empty).
 [[nodiscard]] std::string field(const std::string& line, std::size_t pos, std::size_t len);
 

@@ -31,7 +31,7 @@ const char* const kOrbitFields[7][4] = {
     {"transmission time", "fit interval", "spare", "spare"}};
 
 void checkCalendar(const CalendarTime& c, const std::string& src, int ln) {
-  if (c.month < 1 || c.month > 12 || c.day < 1 || c.day > 31 || c.hour < 0 || c.hour > 24 ||
+  if (c.year < 1980 || c.year > 2200 || c.month < 1 || c.month > 12 || c.day < 1 || c.day > 31 || c.hour < 0 || c.hour > 24 ||
       c.minute < 0 || c.minute > 59 || !(c.second >= 0 && c.second < 61)) {
     throw ParseError(src, ln, "epoch", std::to_string(c.year) + "-" + std::to_string(c.month) + "-" +
                                            std::to_string(c.day),
@@ -66,7 +66,7 @@ void fillEphemeris(BroadcastEphemeris& e, const std::array<std::array<double, 4>
                    const std::string& src, int ln) {
   KeplerOrbit& k = e.orbit;
   k.constellation = e.sat.constellation;
-  e.iode = static_cast<int>(o[0][0]);
+  e.iode = integerField(o[0][0], 0, 1023, src, ln + 1, "IODE/IODnav");
   k.crs = o[0][1];
   k.delta_n_radps = o[0][2];
   k.m0_rad = o[0][3];
@@ -83,13 +83,13 @@ void fillEphemeris(BroadcastEphemeris& e, const std::array<std::array<double, 4>
   k.omega_rad = o[3][2];
   k.omega_dot_radps = o[3][3];
   k.idot_radps = o[4][0];
-  k.toe.week = static_cast<int>(o[4][2]);
+  k.toe.week = integerField(o[4][2], 0, 10000, src, ln + 5, "week");
   e.accuracy_m = o[5][0];
-  e.health = static_cast<int>(o[5][1]);
+  e.health = integerField(o[5][1], 0, 65535, src, ln + 6, "SV health");
   e.tgd_s = o[5][2];
   if (e.sat.constellation == Constellation::kGalileo) {
     e.bgd_e5b_s = o[5][3];
-    e.data_sources = static_cast<int>(o[4][1]);
+    e.data_sources = integerField(o[4][1], 0, 65535, src, ln + 5, "data sources");
   }
   if (e.sat.constellation == Constellation::kGps && o[6][1] > 0) e.fit_interval_h = o[6][1];
   if (!(k.e >= 0 && k.e < 1)) throw ParseError(src, ln + 2, "e", std::to_string(k.e), "an eccentricity in [0, 1)");
@@ -99,15 +99,9 @@ void fillEphemeris(BroadcastEphemeris& e, const std::array<std::array<double, 4>
   if (!(k.toe.sow >= 0 && k.toe.sow <= kSecondsPerWeek)) {
     throw ParseError(src, ln + 3, "Toe", std::to_string(k.toe.sow), "seconds of week in [0, 604800]");
   }
-  if (k.toe.week < 0 || k.toe.week > 10000) {
-    throw ParseError(src, ln + 5, "week", std::to_string(k.toe.week), "a GPS week number in [0, 10000]");
-  }
-  // The week field may be modulo 1024 in old files: put toe within half a week of toc.
-  while (k.toe - e.toc > kSecondsPerWeek / 2 + 1) k.toe.week -= 1;
-  while (e.toc - k.toe > kSecondsPerWeek / 2 + 1) k.toe.week += 1;
-  if (std::abs(k.toe - e.toc) > kSecondsPerWeek / 2 + 1) {
-    throw ParseError(src, ln + 5, "week", std::to_string(k.toe.week), "a week consistent with toc");
-  }
+  // The week field is modulo 1024 in some old files and toe may sit in the week before or after
+  // toc: toc (a full calendar date) decides, toe goes to the week that puts it nearest to toc.
+  k.toe.week = e.toc.week + static_cast<int>(std::round((e.toc.sow - k.toe.sow) / kSecondsPerWeek));
 }
 
 void parseHeaderIono(NavigationData& nav, const std::string& line, const std::string& lab,

@@ -68,7 +68,7 @@ std::optional<SatId> parseSatId(const std::string& text) {
   std::size_t digits = 0;
   for (; i < text.size() && std::isdigit(static_cast<unsigned char>(text[i])); ++i, ++digits) {
     prn = prn * 10 + (text[i] - '0');
-    if (digits > 3) return std::nullopt;
+    if (digits >= 2) return std::nullopt;  // PRNs have at most two digits (RINEX)
   }
   while (i < text.size() && text[i] == ' ') ++i;
   if (digits == 0 || i != text.size() || prn < 1) return std::nullopt;
