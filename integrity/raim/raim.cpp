@@ -64,6 +64,14 @@ RaimPl raimProtectionLevels(const Geometry& g, const RaimConfig& cfg) {
     const double w = 1.0 / (g.sigma_int[i] * g.sigma_int[i]);
     const double m_ii = w - w * w * g.G.row(i).dot(wls.P * g.G.row(i).transpose());
     if (!(m_ii > kMinResidualObservability * w)) {
+      // Not seen by the residuals. Harmless when it does not move the position either (the
+      // only satellite of its constellation just fixes that clock); otherwise undetectable.
+      const double effect = std::sqrt(w) * wls.S.col(i).head<3>().norm();
+      if (effect < kMinResidualObservability) {
+        out.hslope[i] = 0.0;
+        out.vslope[i] = 0.0;
+        continue;
+      }
       out.reason = "satellite " + g.sats[static_cast<std::size_t>(i)].str() +
                    " is not observable in the residuals: its fault cannot be detected";
       return out;

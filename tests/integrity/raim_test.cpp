@@ -171,6 +171,18 @@ TEST(RaimPl, RemovingASatelliteNeverShrinksTheFaultFreeSigma) {
   EXPECT_GT(checked, 100);
 }
 
+TEST(RaimPl, ALoneSatelliteOfAnotherConstellationChangesNothing) {
+  // It only fixes its own clock: the same PLs as without it (the redundancy is unchanged too).
+  const ErrorModel m;
+  const RaimPl gps = raimProtectionLevels(buildGeometry(typicalSky(), m, 9.0), RaimConfig{});
+  auto sky = typicalSky();
+  sky.push_back({{Constellation::kGalileo, 5}, {1.0, 0.6}});
+  const RaimPl mixed = raimProtectionLevels(buildGeometry(sky, m, 9.0), RaimConfig{});
+  ASSERT_TRUE(mixed.available) << mixed.reason;
+  EXPECT_NEAR(mixed.hpl_m, gps.hpl_m, 1e-9);
+  EXPECT_NEAR(mixed.vpl_m, gps.vpl_m, 1e-9);
+}
+
 TEST(RaimPl, BrownFormulaIsSlopeTimesPbias) {
   const Geometry g = buildGeometry(typicalSky(), ErrorModel{}, 9.0);
   RaimConfig cfg;
