@@ -54,6 +54,33 @@ TEST(SatellitePosition, MatchesRtklibForUsloOverAFullDay) {
   compareWithRtklib("rtklib/sat_positions_uslo.csv", "gnss/Uslo3610.06N");
 }
 
+TEST(SatellitePosition, MatchesRtklibForGpsAndGalileoFromRinex3) {
+  // Galileo uses its own μ (ICD Table 58) and the I/NAV record; the 1e-12 s clock tolerance
+  // tells I/NAV from F/NAV for E04 (their af0 differ by 0.116 ns).
+  const NavigationData nav = loadRinexNav(test::dataPath("rinex3/base_20240624_MN.rnx"));
+  std::ifstream in(test::dataPath("rtklib/sat_positions_rinex3.csv"));
+  std::string line;
+  std::getline(in, line);
+  int gal = 0, gps = 0;
+  while (std::getline(in, line)) {
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream ss(line);
+    char sys = 0;
+    int prn = 0, week = 0;
+    double tow = 0, tx = 0, x = 0, y = 0, z = 0, clk = 0;
+    ss >> sys >> prn >> week >> tow >> tx >> x >> y >> z >> clk;
+    const SatId sat{*constellationFromLetter(sys), prn};
+    const BroadcastEphemeris* eph = selectEphemeris(nav, sat, GpsTime{week, tow});
+    ASSERT_NE(eph, nullptr) << sat.str();
+    const SatelliteState s = satelliteState(*eph, GpsTime{week, tx});
+    EXPECT_TRUE(test::nearVec(s.p_ecef, Eigen::Vector3d(x, y, z), kPositionTol_m)) << sat.str() << " tow " << tow;
+    EXPECT_NEAR(s.clock_s, clk, kClockTol_s) << sat.str() << " tow " << tow;
+    (sat.constellation == Constellation::kGalileo ? gal : gps)++;
+  }
+  EXPECT_EQ(gal, 90);
+  EXPECT_EQ(gps, 120);
+}
+
 TEST(SatellitePosition, EarthRotationCorrectionTurnsAboutZ) {
   const Eigen::Vector3d p(26560e3, 0, 1000.0);
   const double tau = 0.075;

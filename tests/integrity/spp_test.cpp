@@ -134,8 +134,10 @@ TEST(Spp, Rinex3GpsPlusGalileoWithTwoReceiverClocks) {
     EXPECT_TRUE(has_gal);
     EXPECT_GE(e.used.size(), 12u);
     const Eigen::Vector3d d = f.ecefToEnu(e.p_ecef);
+    // RTKLIB's GPS+Galileo SPP on these files is 2.3 m H, 1.6 m V from the header position
+    // (tests/data/rtklib/spp_summary_rinex3.txt), a near-constant ionospheric bias.
     EXPECT_LT(std::hypot(d.x(), d.y()), 3.0);
-    EXPECT_LT(std::abs(d.z()), 5.0);
+    EXPECT_LT(std::abs(d.z()), 3.0);
     EXPECT_TRUE(e.pl.available);
     // Galileo orbits, clocks and the second receiver clock are consistent with GPS: nothing is
     // excluded and the residual test passes.

@@ -53,13 +53,22 @@ def header_xyz(obsfile):
 
 
 def count_epochs(obsfile, step=None):
-    """Number of RINEX epochs; with step (s), only epochs whose time of day
+    """Number of RINEX (2 or 3) epochs; with step (s), only epochs whose time of day
     (rounded to 1 s) is a multiple of step (what rnx2rtkp -ti step processes)."""
     n, in_hdr = 0, True
     with open(obsfile, errors='replace') as f:
         for line in f:
             if in_hdr:
                 in_hdr = 'END OF HEADER' not in line
+                continue
+            # RINEX 3 epoch line: '> yyyy mm dd hh mm ss.sssssss  f nn...'
+            if line.startswith('> ') and len(line) > 31 and line[31] in '0123456':
+                if step:
+                    tod = int(line[13:15]) * 3600 + int(line[16:18]) * 60 + float(line[18:29])
+                    if round(tod) % step:
+                        continue
+                if line[31] in '01':          # epoch flags 0/1 carry observations
+                    n += 1
                 continue
             # RINEX 2 epoch line: ' yy mm dd hh mm ss.sssssss  f nn...'
             if (len(line) > 32 and line[0] == ' ' and line[3] == ' ' and line[26] == ' '
