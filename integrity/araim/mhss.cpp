@@ -1,0 +1,213 @@
+#include "integrity/araim/mhss.hpp"
+
+#include "integrity/stats.hpp"
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+
+namespace skylane::integrity {
+namespace {
+
+/// Reciprocal condition below which a subset's normal matrix is singular (mode unmonitorable).
+constexpr double kMinRcond = 1e-12;
+
+/// Q̃(x): the normal tail, 1 for negative arguments (conservative when PL < T + b).
+double modifiedTail(double x) { return x < 0.0 ? 1.0 : normalTail(x); }
+
+struct AllInView {
+  Eigen::MatrixXd A;  ///< Gᵀ W (m × n)
+  Eigen::MatrixXd N;  ///< Gᵀ W G
+};
+
+/// Subset solution from the all-in-view normal matrix down-dated by the removed satellites
+/// (N_k = N − Σ_{i∈B} w_i g_i g_iᵀ; TAES §III-B), with the clocks of emptied constellations
+/// dropped. Returns false when the mode cannot be monitored.
+bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<int>& removed, SubsetSolution& out) {
+  const int n = g.numSats(), m = g.numStates();
+  std::vector<bool> keep(static_cast<std::size_t>(n), true);
+  for (int i : removed) keep[static_cast<std::size_t>(i)] = false;
+  std::vector<int> cols = {0, 1, 2};
+  for (int c = 3; c < m; ++c) {
+    for (int i = 0; i < n; ++i) {
+      if (keep[static_cast<std::size_t>(i)] && g.G(i, c) != 0.0) {
+        cols.push_back(c);
+        break;
+      }
+    }
+  }
+  const int kept = n - static_cast<int>(removed.size());
+  const int mk = static_cast<int>(cols.size());
+  if (kept < mk) return false;  // the subset cannot fix position and its clocks (Stanford: N ≥ unknowns)
+  Eigen::MatrixXd Nk = aiv.N;
+  for (int i : removed) {
+    const double w = 1.0 / (g.sigma_int[i] * g.sigma_int[i]);
+    Nk.noalias() -= w * g.G.row(i).transpose() * g.G.row(i);  // rank-one down-date
+  }
+  Eigen::MatrixXd Nr(mk, mk);
+  for (int a = 0; a < mk; ++a) {
+    for (int b = 0; b < mk; ++b) Nr(a, b) = Nk(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(Nr);
+  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > kMinRcond)) return false;
+  const Eigen::MatrixXd X = ldlt.solve(Eigen::MatrixXd::Identity(mk, 3));  // columns q of N_k⁻¹
+  out.S = Eigen::MatrixXd::Zero(3, n);
+  for (int i = 0; i < n; ++i) {
+    if (!keep[static_cast<std::size_t>(i)]) continue;
+    for (int q = 0; q < 3; ++q) {
+      double s = 0.0;
+      for (int a = 0; a < mk; ++a) s += X(a, q) * aiv.A(cols[static_cast<std::size_t>(a)], i);
+      out.S(q, i) = s;
+    }
+  }
+  for (int q = 0; q < 3; ++q) out.sigma[q] = std::sqrt(X(q, q));
+  return std::isfinite(out.sigma[0]) && std::isfinite(out.sigma[2]);
+}
+
+}  // namespace
+
+double integrityRisk(const std::vector<RiskTerm>& terms, double pl) {
+  double r = 0.0;
+  for (const RiskTerm& t : terms) r += t.prior * modifiedTail((pl - t.threshold - t.bias) / t.sigma);
+  return r;
+}
+
+double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, double tol, double* equal_allocation) {
+  const double n1 = static_cast<double>(terms.size());
+  double low = -1e300, high = -1e300;
+  for (const RiskTerm& t : terms) {
+    if (t.prior > budget) low = std::max(low, t.threshold + t.bias + normalTailInverse(budget / t.prior) * t.sigma);
+    const double share = budget / (n1 * t.prior);
+    const double k = share < 0.5 ? normalTailInverse(share) : 0.0;
+    high = std::max(high, t.threshold + t.bias + k * t.sigma);
+  }
+  if (equal_allocation) *equal_allocation = high;
+  low = std::min(low, high);
+  // ADD Appendix B: at `low` the largest single term already uses the whole budget; at `high`
+  // every term uses at most budget/(N+1). The risk decreases with PL in between.
+  while (high - low > tol) {
+    const double mid = 0.5 * (low + high);
+    (integrityRisk(terms, mid) > budget ? low : high) = mid;
+  }
+  return high;
+}
+
+AraimResult araimProtectionLevels(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg) {
+  AraimResult out;
+  const Requirements& req = cfg.requirements;
+  const int n = g.numSats(), m = g.numStates();
+  if (n < m + 1) {
+    out.reason = "too few satellites: " + std::to_string(n) + " in view, ARAIM needs at least " + std::to_string(m + 1) +
+                 " for " + std::to_string(m) + " unknowns (3 + one clock per constellation)";
+    return out;
+  }
+  for (Constellation c : g.clocks) {
+    const auto count = std::count_if(g.sats.begin(), g.sats.end(), [&](const SatId& s) { return s.constellation == c; });
+    if (count == 1) {
+      out.reason = std::string("constellation ") + constellationName(c) +
+                   " has a single satellite: it only fixes its own clock and cannot be checked";
+      return out;
+    }
+  }
+  AllInView aiv;
+  const Eigen::VectorXd w = g.sigma_int.array().square().inverse();
+  aiv.A = g.G.transpose() * w.asDiagonal();
+  aiv.N = aiv.A * g.G;
+  SubsetSolution all;
+  if (!subsetSolution(g, aiv, {}, all)) {
+    out.reason = "singular geometry: the satellites do not fix position and clocks";
+    return out;
+  }
+  out.S0 = all.S;
+  const Eigen::VectorXd c_acc = g.sigma_acc.array().square();
+  for (int q = 0; q < 3; ++q) {
+    out.sigma0[q] = all.sigma[q];
+    out.bias0[q] = out.S0.row(q).cwiseAbs().dot(g.bnom);  // b_q^(0) = Σ|S_q,i| b_nom,i
+  }
+  out.sigma_acc_v_m = std::sqrt(out.S0.row(2).cwiseAbs2().dot(c_acc));
+
+  // Fault modes from the ISM.
+  std::vector<Constellation> cons;
+  std::vector<double> p_sat;
+  for (const SatId& s : g.sats) {
+    cons.push_back(s.constellation);
+    p_sat.push_back(model.of(s.constellation).psat);
+  }
+  std::vector<double> p_const(kNumConstellations);
+  for (Constellation c : kAllConstellations) p_const[static_cast<std::size_t>(c)] = model.of(c).pconst;
+  const FaultModeSet fm = determineFaultModes(cons, p_sat, p_const, req.p_thres, cfg.rule);
+  out.n_fault_max = fm.n_fault_max;
+  out.p_not_monitored = fm.p_not_monitored;
+  for (const FaultMode& mode : fm.modes) {
+    SubsetSolution s;
+    s.removed = mode.removed;
+    s.prior = mode.prior;
+    if (!subsetSolution(g, aiv, mode.removed, s)) {
+      out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
+      continue;
+    }
+    const Eigen::MatrixXd dS = s.S - out.S0;
+    for (int q = 0; q < 3; ++q) {
+      s.sigma_ss[q] = std::sqrt(dS.row(q).cwiseAbs2().dot(c_acc));  // ADD Eq. 21 (C_acc)
+      s.bias[q] = s.S.row(q).cwiseAbs().dot(g.bnom);
+      s.sigma_acc[q] = std::sqrt(s.S.row(q).cwiseAbs2().dot(c_acc));
+    }
+    out.subsets.push_back(std::move(s));
+  }
+  out.fault_modes = static_cast<int>(out.subsets.size());
+  const double nfm = std::max(1, out.fault_modes);
+  out.k_fa_h = normalTailInverse(req.pfa_hor / (4.0 * nfm));   // ADD Eq. 26
+  out.k_fa_v = normalTailInverse(req.pfa_vert / (2.0 * nfm));  // ADD Eq. 27
+  for (SubsetSolution& s : out.subsets) {
+    s.threshold = {out.k_fa_h * s.sigma_ss[0], out.k_fa_h * s.sigma_ss[1], out.k_fa_v * s.sigma_ss[2]};
+  }
+
+  // Risk budgets (ADD Eq. 31–32): the unmonitored probability is taken off the top.
+  const double scale = 1.0 - out.p_not_monitored / (req.phmi_vert + req.phmi_hor);
+  if (!(scale > 0.0)) {
+    out.reason = "the unmonitored fault probability " + std::to_string(out.p_not_monitored) +
+                 " exceeds the integrity budget";
+    return out;
+  }
+  const double budget_v = req.phmi_vert * scale;
+  const double budget_h = 0.5 * req.phmi_hor * scale;  // per horizontal axis
+  std::array<double, 3> pl{}, pl_eq{};
+  for (int q = 0; q < 3; ++q) {
+    std::vector<RiskTerm> terms;
+    terms.reserve(out.subsets.size() + 1);
+    terms.push_back({2.0, 0.0, out.bias0[q], out.sigma0[q]});
+    for (const SubsetSolution& s : out.subsets) terms.push_back({s.prior, s.threshold[q], s.bias[q], s.sigma[q]});
+    pl[q] = solveProtectionLevel(terms, q == 2 ? budget_v : budget_h, req.tol_pl_m, &pl_eq[q]);
+  }
+  out.hpl_axis_m = {pl[0], pl[1]};
+  out.hpl_m = std::hypot(pl[0], pl[1]);
+  out.vpl_m = pl[2];
+  out.hpl_equal_allocation_m = std::hypot(pl_eq[0], pl_eq[1]);
+  out.vpl_equal_allocation_m = pl_eq[2];
+  // EMT (ADD Eq. 35): the largest vertical threshold among modes with prior ≥ P_EMT.
+  for (const SubsetSolution& s : out.subsets) {
+    if (s.prior >= req.p_emt) out.emt_m = std::max(out.emt_m, s.threshold[2]);
+  }
+  out.pl_computed = std::isfinite(out.hpl_m) && std::isfinite(out.vpl_m);
+  if (!out.pl_computed) {
+    out.reason = "protection level is not finite";
+    return out;
+  }
+  if (cfg.horizontal_only) {
+    out.available = out.hpl_m <= req.hal_m;
+    if (!out.available) out.reason = "HPL exceeds HAL";
+  } else {
+    out.available = out.vpl_m <= req.val_m && out.hpl_m <= req.hal_m && out.emt_m <= req.emt_m &&
+                    out.sigma_acc_v_m <= req.sigma_acc_m;
+    if (!out.available) {
+      out.reason = out.vpl_m > req.val_m     ? "VPL exceeds VAL"
+                   : out.hpl_m > req.hal_m   ? "HPL exceeds HAL"
+                   : out.emt_m > req.emt_m   ? "EMT exceeds its limit"
+                                             : "sigma_acc exceeds its limit";
+    }
+  }
+  return out;
+}
+
+}  // namespace skylane::integrity

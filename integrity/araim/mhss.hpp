@@ -1,0 +1,83 @@
+#pragma once
+/// \file
+/// \brief ARAIM multiple-hypothesis solution separation (MHSS): subset solutions, thresholds,
+/// the optimised protection level of seed 003, the equal-allocation bound, EMT, σ_acc and
+/// availability.
+///
+/// References: WG-C ARAIM Technical Subgroup, "Reference Airborne Algorithm Description Document"
+/// v3.0 (2017) — ADD; J. Blanch et al., "Baseline Advanced RAIM User Algorithm and Possible
+/// Improvements", IEEE TAES 51(1) 713–732, 2015 — TAES; seed 003 (ARAIM PL optimisation patent):
+/// the PL is the root of the integrity-risk equation over all monitored subsets, which is the
+/// optimal allocation of PHMI among them and never larger than the equal-allocation bound.
+///
+/// Symbol table (ADD → skylane): σ_q^(k) → sigma[q], σ_ss,q^(k) → sigma_ss[q], b_q^(k) → bias[q],
+/// T_k,q → threshold[q], p_fault,k → prior, K_fa,q → k_fa_h / k_fa_v, P_not_monitored →
+/// p_not_monitored; axes q = 0 east, 1 north, 2 up (the ADD's 1, 2, 3).
+
+#include "integrity/araim/fault_modes.hpp"
+#include "integrity/geometry_file.hpp"
+#include "integrity/raim/wls.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace skylane::integrity {
+
+/// \brief ARAIM settings.
+struct AraimConfig {
+  Requirements requirements;
+  FaultModeRule rule = FaultModeRule::kJointEvents;
+  bool horizontal_only = false;  ///< availability from HPL ≤ HAL alone (H-ARAIM)
+};
+
+/// \brief One monitored fault mode with its subset solution.
+struct SubsetSolution {
+  std::vector<int> removed;  ///< indices into the geometry's satellites
+  double prior = 0.0;
+  std::array<double, 3> sigma{};      ///< σ_q^(k) [m], integrity covariance
+  std::array<double, 3> sigma_ss{};   ///< σ_ss,q^(k) [m], accuracy covariance (C_acc)
+  std::array<double, 3> bias{};       ///< b_q^(k) [m]
+  std::array<double, 3> threshold{};  ///< T_k,q [m]
+  std::array<double, 3> sigma_acc{};  ///< σ_q,acc^(k) [m]
+  Eigen::MatrixXd S;                  ///< rows 0..2 of S^(k) (3 × n), zero columns for removed satellites
+};
+
+/// \brief ARAIM protection levels and everything behind them.
+struct AraimResult {
+  bool pl_computed = false;  ///< false: too few satellites, degenerate geometry, risk budget exhausted
+  bool available = false;    ///< against VAL/HAL/EMT/σ_acc (or HAL alone in horizontal-only mode)
+  std::string reason;
+  double hpl_m = 0, vpl_m = 0;
+  double hpl_equal_allocation_m = 0, vpl_equal_allocation_m = 0;
+  std::array<double, 2> hpl_axis_m{};  ///< east, north
+  double emt_m = 0;
+  double sigma_acc_v_m = 0;  ///< √(S⁰ C_acc S⁰ᵀ)_UU
+  int fault_modes = 0;       ///< monitored (and monitorable) fault modes, fault-free excluded
+  int n_fault_max = 0;
+  double p_not_monitored = 0;
+  double k_fa_h = 0, k_fa_v = 0;
+  std::array<double, 3> sigma0{}, bias0{};
+  Eigen::MatrixXd S0;  ///< rows 0..2 of the all-in-view S
+  std::vector<SubsetSolution> subsets;
+};
+
+/// \brief Integrity-risk terms of one axis: p·Q̃((PL − T − b)/σ) each; the fault-free term has
+/// p = 2, T = 0 (ADD Eq. 31–32).
+struct RiskTerm {
+  double prior = 0, threshold = 0, bias = 0, sigma = 1;
+};
+
+/// \brief Total integrity risk Σ p·Q̃((PL − T − b)/σ) at PL, with Q̃(x) = 1 for x < 0 (ADD Eq. 7–8).
+[[nodiscard]] double integrityRisk(const std::vector<RiskTerm>& terms, double pl);
+
+/// \brief Solves integrityRisk(PL) = budget by bisection between the ADD's bounds (Appendix B),
+/// stopping when the bracket is ≤ tol; returns the upper end (conservative by ≤ tol).
+/// `equal_allocation` receives the initial upper bound max_j(T_j + b_j + Q⁻¹(budget/((N+1)p_j))σ_j).
+[[nodiscard]] double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, double tol,
+                                          double* equal_allocation = nullptr);
+
+/// \brief ARAIM MHSS protection levels for a geometry (σ_int, σ_acc, b_nom set) under an ISM.
+[[nodiscard]] AraimResult araimProtectionLevels(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg);
+
+}  // namespace skylane::integrity

@@ -1,0 +1,194 @@
+// ARAIM MHSS against the published worked examples and the properties seed 003 and the ADD
+// promise. Example geometry: Blanch et al., ION GNSS 2012, Appendix J = WG-C ARAIM ADD v3.0,
+// Appendix D (5 GPS + 5 Galileo satellites, C_int/C_acc as printed there).
+#include "integrity/araim/mhss.hpp"
+
+#include "integrity/gnss/almanac.hpp"
+#include "integrity/gnss/orbit_source.hpp"
+#include "integrity/stats.hpp"
+#include "tests/test_util.hpp"
+
+#include <random>
+
+namespace skylane::integrity {
+namespace {
+
+/// Published values are printed to 0.1 m; the solver returns the upper end of a 0.05 m bracket.
+constexpr double kPublishedTol_m = 0.1;
+
+Geometry addExampleGeometry() {
+  const double rows[10][5] = {{0.0225, 0.9951, -0.0966, 1, 0},   {0.6750, -0.6900, -0.2612, 1, 0},
+                              {0.0723, -0.6601, -0.7477, 1, 0},  {-0.9398, 0.2553, -0.2269, 1, 0},
+                              {-0.5907, -0.7539, -0.2877, 1, 0}, {-0.3236, -0.0354, -0.9455, 0, 1},
+                              {-0.6748, 0.4356, -0.5957, 0, 1},  {0.0938, -0.7004, -0.7075, 0, 1},
+                              {0.5571, 0.3088, -0.7709, 0, 1},   {0.6622, 0.6958, -0.2780, 0, 1}};
+  const double c_int[10] = {3.8865, 1.4377, 0.8604, 1.6383, 1.3229, 0.8434, 0.8963, 0.8669, 0.8573, 1.3616};
+  Geometry g;
+  g.G.resize(10, 5);
+  g.sigma_int.resize(10);
+  g.sigma_acc.resize(10);
+  g.bnom = Eigen::VectorXd::Constant(10, 0.5);
+  g.clocks = {Constellation::kGps, Constellation::kGalileo};
+  for (int i = 0; i < 10; ++i) {
+    for (int j = 0; j < 5; ++j) g.G(i, j) = rows[i][j];
+    g.sigma_int[i] = std::sqrt(c_int[i]);
+    g.sigma_acc[i] = std::sqrt(c_int[i] - (0.75 * 0.75 - 0.5 * 0.5));  // σ_URA 0.75 → σ_URE 0.5
+    g.sats.push_back({i < 5 ? Constellation::kGps : Constellation::kGalileo, i % 5 + 1});
+    g.elevation_rad.push_back(0.5);
+  }
+  return g;
+}
+
+ErrorModel ismWith(double psat, double pconst) {
+  ErrorModel m;
+  for (Constellation c : kAllConstellations) {
+    m.of(c).psat = psat;
+    m.of(c).pconst = pconst;
+  }
+  return m;
+}
+
+TEST(AraimFaultModes, TenSatellitesTwoConstellationsGive57UnderThe2012Rule) {
+  std::vector<Constellation> cons(10, Constellation::kGps);
+  for (int i = 5; i < 10; ++i) cons[static_cast<std::size_t>(i)] = Constellation::kGalileo;
+  const std::vector<double> psat(10, 1e-4), pconst(kNumConstellations, 1e-4);
+  const FaultModeSet s2012 = determineFaultModes(cons, psat, pconst, 4e-8, FaultModeRule::kBlanch2012);
+  ASSERT_EQ(s2012.modes.size(), 57u);  // 10 singles + 45 pairs + 2 constellations
+  EXPECT_EQ(std::count_if(s2012.modes.begin(), s2012.modes.end(), [](const FaultMode& m) { return m.removed.size() == 5; }), 2);
+  EXPECT_NEAR(s2012.p_not_monitored, 1.01e-8, 0.01e-8);
+  // The ADD's joint-event rule also monitors "one constellation + a satellite of the other"
+  // (10 more) and merges "constellation + own satellite" into the constellation mode.
+  const FaultModeSet joint = determineFaultModes(cons, psat, pconst, 4e-8, FaultModeRule::kJointEvents);
+  EXPECT_EQ(joint.n_fault_max, 2);
+  EXPECT_EQ(joint.modes.size(), 68u);  // 67 monitorable + "both constellations out"
+}
+
+TEST(AraimFaultModes, PriorsAreProductsOfEventProbabilities) {
+  const std::vector<Constellation> cons(4, Constellation::kGps);
+  const FaultModeSet s = determineFaultModes(cons, std::vector<double>(4, 1e-3), std::vector<double>(kNumConstellations, 0.0), 1e-7);
+  ASSERT_EQ(s.n_fault_max, 2);
+  const double p_nf = std::pow(1 - 1e-3, 4);
+  EXPECT_NEAR(s.modes.front().prior, p_nf * 1e-3 / (1 - 1e-3), 1e-18);
+  EXPECT_NEAR(s.modes.back().prior, p_nf * std::pow(1e-3 / (1 - 1e-3), 2), 1e-21);
+  // P(≥3 of 4 at 1e-3) = 4·1e-9·0.999 + 1e-12.
+  EXPECT_NEAR(s.p_not_monitored, 4e-9 * 0.999 + 1e-12, 1e-15);
+}
+
+TEST(AraimPl, ReproducesBlanch2012AppendixJ) {
+  AraimConfig cfg;
+  cfg.rule = FaultModeRule::kBlanch2012;
+  cfg.requirements.p_thres = 4e-8;
+  const AraimResult r = araimProtectionLevels(addExampleGeometry(), ismWith(1e-4, 1e-4), cfg);
+  ASSERT_TRUE(r.pl_computed) << r.reason;
+  EXPECT_EQ(r.fault_modes, 57);
+  EXPECT_NEAR(r.k_fa_v, 5.3953, 1e-4);
+  EXPECT_NEAR(r.vpl_m, 19.7, kPublishedTol_m);
+  EXPECT_NEAR(r.hpl_m, 14.9, kPublishedTol_m);
+  EXPECT_NEAR(r.sigma_acc_v_m, 1.47, 0.005);
+  EXPECT_NEAR(r.sigma0[2], 1.7792, 1e-3);
+  EXPECT_NEAR(r.bias0[2], 2.4079, 1e-3);
+}
+
+TEST(AraimPl, ReproducesAddV3AppendixD) {
+  AraimConfig cfg;  // joint rule, P_THRES 8e-8
+  const AraimResult r = araimProtectionLevels(addExampleGeometry(), ismWith(1e-5, 1e-4), cfg);
+  ASSERT_TRUE(r.pl_computed) << r.reason;
+  EXPECT_EQ(r.n_fault_max, 1);
+  EXPECT_EQ(r.fault_modes, 12);  // 10 satellites + 2 constellations
+  EXPECT_NEAR(r.k_fa_v, 5.1083, 1e-4);
+  EXPECT_NEAR(r.vpl_m, 19.2, kPublishedTol_m);
+  EXPECT_NEAR(r.hpl_m, 14.5, kPublishedTol_m);
+  EXPECT_NEAR(r.emt_m, 7.8, kPublishedTol_m);
+  EXPECT_NEAR(r.sigma_acc_v_m, 1.47, 0.005);
+  // The GPS-out subset of the ADD's table: σ_3 2.5760, σ_ss,3 1.5307, b_3 2.8935.
+  const auto gps_out = std::find_if(r.subsets.begin(), r.subsets.end(),
+                                    [](const SubsetSolution& s) { return s.removed == std::vector<int>{0, 1, 2, 3, 4}; });
+  ASSERT_NE(gps_out, r.subsets.end());
+  EXPECT_NEAR(gps_out->sigma[2], 2.5760, 1e-3);
+  EXPECT_NEAR(gps_out->sigma_ss[2], 1.5307, 1e-3);
+  EXPECT_NEAR(gps_out->bias[2], 2.8935, 1e-3);
+  EXPECT_TRUE(r.available);
+}
+
+/// GPS + Galileo geometries from the shared almanacs at random places and times.
+std::vector<Geometry> randomAlmanacGeometries(int count, unsigned seed) {
+  OrbitSource orbits;
+  orbits.addAlmanac(loadAlmanac(test::dataPath("gnss/alm_gps_ed259.txt")));
+  orbits.addAlmanac(loadAlmanac(test::dataPath("gnss/alm_gal_ed259.txt")));
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> lat(-80, 80), lon(-180, 180), t(0, 86400);
+  std::vector<Geometry> out;
+  while (static_cast<int>(out.size()) < count) {
+    const Eigen::Vector3d p = maps::geodeticToEcef({maps::deg2rad(lat(rng)), maps::deg2rad(lon(rng)), 0});
+    std::vector<SatLook> looks;
+    for (const auto& v : orbits.visible(p, GpsTime{1930, t(rng)}, maps::deg2rad(5))) looks.push_back({v.sat, v.look});
+    out.push_back(buildGeometry(looks, ErrorModel{}, 9.0));
+  }
+  return out;
+}
+
+TEST(AraimPl, SolvedLevelSatisfiesTheRiskEquationAndBeatsEqualAllocation) {
+  const AraimConfig cfg;
+  const ErrorModel m;
+  int computed = 0;
+  for (const Geometry& g : randomAlmanacGeometries(60, 3)) {
+    const AraimResult r = araimProtectionLevels(g, m, cfg);
+    if (!r.pl_computed) continue;
+    ++computed;
+    // Optimised (seed 003) ≤ equal allocation.
+    EXPECT_LE(r.vpl_m, r.vpl_equal_allocation_m + 1e-9);
+    EXPECT_LE(r.hpl_m, r.hpl_equal_allocation_m + 1e-9);
+    // The risk equation: at VPL the risk is within budget, TOL_PL lower it is not.
+    std::vector<RiskTerm> terms{{2.0, 0.0, r.bias0[2], r.sigma0[2]}};
+    for (const auto& s : r.subsets) terms.push_back({s.prior, s.threshold[2], s.bias[2], s.sigma[2]});
+    const double budget = cfg.requirements.phmi_vert *
+                          (1 - r.p_not_monitored / (cfg.requirements.phmi_vert + cfg.requirements.phmi_hor));
+    EXPECT_LE(integrityRisk(terms, r.vpl_m), budget * (1 + 1e-12));
+    EXPECT_GT(integrityRisk(terms, r.vpl_m - cfg.requirements.tol_pl_m - 1e-9), budget);
+  }
+  EXPECT_GE(computed, 55);
+}
+
+TEST(AraimPl, RemovingASatelliteNeverShrinksTheFaultFreeSigma) {
+  for (const Geometry& g : randomAlmanacGeometries(10, 5)) {
+    const AraimResult all = araimProtectionLevels(g, ErrorModel{}, AraimConfig{});
+    if (!all.pl_computed) continue;
+    for (int i = 0; i < g.numSats(); ++i) {
+      const AraimResult sub = araimProtectionLevels(g.without(i), ErrorModel{}, AraimConfig{});
+      if (!sub.pl_computed) continue;
+      for (int q = 0; q < 3; ++q) EXPECT_GE(sub.sigma0[q], all.sigma0[q] * (1 - 1e-12));
+    }
+  }
+}
+
+TEST(AraimPl, DegenerateGeometriesAreNotAvailable) {
+  // Fewer than 4 + constellations satellites.
+  Geometry g = addExampleGeometry();
+  const AraimResult r5 = araimProtectionLevels(g.without(9).without(8).without(7).without(6).without(5), ErrorModel{}, AraimConfig{});
+  EXPECT_TRUE(r5.pl_computed);  // 5 GPS satellites, one clock: 5 ≥ 4 + 1
+  Geometry four = addExampleGeometry();
+  for (int k = 0; k < 6; ++k) four = four.without(four.numSats() - 1);
+  const AraimResult r4 = araimProtectionLevels(four, ErrorModel{}, AraimConfig{});
+  EXPECT_FALSE(r4.pl_computed);
+  EXPECT_NE(r4.reason.find("too few satellites"), std::string::npos) << r4.reason;
+  // A constellation with one satellite.
+  Geometry one_gal = addExampleGeometry();
+  for (int k = 0; k < 4; ++k) one_gal = one_gal.without(one_gal.numSats() - 1);
+  const AraimResult r1 = araimProtectionLevels(one_gal, ErrorModel{}, AraimConfig{});
+  EXPECT_FALSE(r1.pl_computed);
+  EXPECT_NE(r1.reason.find("single satellite"), std::string::npos) << r1.reason;
+  EXPECT_FALSE(std::isnan(r1.vpl_m));
+}
+
+TEST(AraimPl, SolverBracketsAreTheAddBounds) {
+  // One fault-free term: PL = b + Q⁻¹(budget/2)·σ exactly (within the tolerance, from above).
+  const std::vector<RiskTerm> terms{{2.0, 0.0, 1.0, 2.0}};
+  double eq = 0;
+  const double pl = solveProtectionLevel(terms, 1e-7, 1e-6, &eq);
+  EXPECT_NEAR(pl, 1.0 + normalTailInverse(0.5e-7) * 2.0, 1e-6);
+  EXPECT_GE(pl, 1.0 + normalTailInverse(0.5e-7) * 2.0);
+  EXPECT_NEAR(eq, pl, 1e-6);  // a single term: equal allocation is exact
+}
+
+}  // namespace
+}  // namespace skylane::integrity
