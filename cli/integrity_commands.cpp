@@ -96,21 +96,68 @@ void writeText(const std::string& path, const std::string& text, const char* opt
   f << text;
 }
 
+json triple(const std::array<double, 3>& v) { return json::array({r4(v[0]), r4(v[1]), r4(v[2])}); }
+
+json araimJson(const integrity::AraimResult& r, bool verbose, const std::vector<integrity::SatId>& sats) {
+  json j;
+  j["method"] = "araim";
+  j["available"] = r.available;
+  j["pl_computed"] = r.pl_computed;
+  if (!r.reason.empty()) j["reason"] = r.reason;
+  const bool ok = r.pl_computed;
+  j["hpl_m"] = ok ? r4(r.hpl_m) : json(nullptr);
+  j["vpl_m"] = ok ? r4(r.vpl_m) : json(nullptr);
+  j["hpl_equal_allocation_m"] = ok ? r4(r.hpl_equal_allocation_m) : json(nullptr);
+  j["vpl_equal_allocation_m"] = ok ? r4(r.vpl_equal_allocation_m) : json(nullptr);
+  j["emt_m"] = ok ? r4(r.emt_m) : json(nullptr);
+  j["sigma_acc_m"] = ok ? r4(r.sigma_acc_v_m) : json(nullptr);
+  j["fault_modes"] = r.fault_modes;
+  j["satellites"] = sats.size();
+  if (verbose && ok) {
+    j["n_fault_max"] = r.n_fault_max;
+    j["p_not_monitored"] = r.p_not_monitored;
+    j["k_fa_h"] = r4(r.k_fa_h);
+    j["k_fa_v"] = r4(r.k_fa_v);
+    j["hpl_axis_m"] = {r4(r.hpl_axis_m[0]), r4(r.hpl_axis_m[1])};
+    j["fault_free"] = {{"sigma_m", triple(r.sigma0)}, {"bias_m", triple(r.bias0)}};
+    json subsets = json::array();
+    for (const auto& s : r.subsets) {
+      json removed = json::array();
+      for (int i : s.removed) removed.push_back(sats[static_cast<std::size_t>(i)].str());
+      subsets.push_back({{"removed", removed},
+                         {"prior", s.prior},
+                         {"sigma_m", triple(s.sigma)},
+                         {"sigma_ss_m", triple(s.sigma_ss)},
+                         {"bias_m", triple(s.bias)},
+                         {"threshold_m", triple(s.threshold)}});
+    }
+    j["subsets"] = subsets;
+  }
+  return j;
+}
+
+integrity::IntegrityMethod parseMethod(const std::string& m) {
+  if (m == "araim") return integrity::IntegrityMethod::kAraim;
+  if (m == "raim") return integrity::IntegrityMethod::kRaim;
+  throw ParseError("--method", 0, "--method", m, "araim or raim");
+}
+
 // ---------------------------------------------------------------------------
 struct PlOptions {
   std::string geometry;
-  std::string method = "raim";
+  std::string method = "araim";
   bool verbose = false;
 };
 
 void runPl(const PlOptions& o) {
-  if (o.method != "raim") {
-    throw ParseError("--method", 0, "--method", o.method, "\"raim\" (ARAIM arrives with issue 3)");
-  }
+  const integrity::IntegrityMethod method = parseMethod(o.method);
   const integrity::GeometryInput in = integrity::loadGeometryFile(o.geometry);
   const integrity::Geometry g = integrity::buildGeometry(in.satellites, in.model, in.tau_vert_m);
-  const integrity::RaimPl pl = integrity::raimProtectionLevels(g, in.raim);
-  std::cout << plJson(pl, in.requirements, o.verbose, g.sats).dump(2) << "\n";
+  if (method == integrity::IntegrityMethod::kAraim) {
+    std::cout << araimJson(integrity::araimProtectionLevels(g, in.model, in.araim), o.verbose, g.sats).dump(2) << "\n";
+  } else {
+    std::cout << plJson(integrity::raimProtectionLevels(g, in.raim), in.requirements, o.verbose, g.sats).dump(2) << "\n";
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -127,12 +174,12 @@ struct PredictOptions {
   std::string plot;
   std::string ism;
   std::string user_model = "dual_frequency";
-  std::string method = "raim";
+  std::string method = "araim";
   bool progress = false;
 };
 
 void runPredict(const PredictOptions& o) {
-  if (o.method != "raim") throw ParseError("--method", 0, "--method", o.method, "\"raim\" (ARAIM arrives with issue 3)");
+  const integrity::IntegrityMethod method = parseMethod(o.method);
   integrity::PredictRequest req;
   if (!(o.lat_deg >= -90 && o.lat_deg <= 90)) throw ParseError("--lat", 0, "--lat", std::to_string(o.lat_deg), "a latitude in [-90, 90] degrees");
   if (!(o.lon_deg >= -180 && o.lon_deg <= 360)) throw ParseError("--lon", 0, "--lon", std::to_string(o.lon_deg), "a longitude in degrees");
@@ -170,26 +217,42 @@ void runPredict(const PredictOptions& o) {
               << "positions are extrapolated (use an almanac of the flight's week for real predictions)\n";
   }
   Progress bar("predict", o.progress);
-  const auto samples = integrity::predictRaim(orbits, req, std::ref(bar));
+  const auto samples = integrity::predictIntegrity(orbits, req, method, std::ref(bar));
+  const integrity::Requirements& limits = req.araim.requirements;
 
   const auto out_file = openOutput(o.output);
   std::ostream& out = out_file ? *out_file : std::cout;
-  if (o.format == "csv") out << "time_utc,gps_week,gps_sow,satellites,hdop,vdop,hpl_m,vpl_m,available\n";
+  if (o.format == "csv") {
+    out << "time_utc,gps_week,gps_sow,satellites,hdop,vdop,hpl_m,vpl_m,available,emt_m,sigma_acc_m,fault_modes\n";
+  }
   for (const auto& s : samples) {
     if (o.format == "csv") {
-      char buf[256];
-      std::snprintf(buf, sizeof buf, "%s,%d,%.1f,%zu,%.3f,%.3f,%.3f,%.3f,%d\n", integrity::formatRfc3339(s.t).c_str(),
-                    s.t.week, s.t.sow, s.sats.size(), s.dops.hdop, s.dops.vdop, s.pl.available ? s.pl.hpl_m : NAN,
-                    s.pl.available ? s.pl.vpl_m : NAN, s.available ? 1 : 0);
+      const bool ok = s.pl.pl_computed, ar = method == integrity::IntegrityMethod::kAraim;
+      char buf[320];
+      std::snprintf(buf, sizeof buf, "%s,%d,%.1f,%zu,%.3f,%.3f,%.3f,%.3f,%d,%.3f,%.3f,%d\n",
+                    integrity::formatRfc3339(s.t).c_str(), s.t.week, s.t.sow, s.sats.size(), s.dops.hdop, s.dops.vdop,
+                    ok ? s.pl.hpl_m : NAN, ok ? s.pl.vpl_m : NAN, s.pl.available ? 1 : 0, ok && ar ? s.pl.emt_m : NAN,
+                    ok && ar ? s.pl.sigma_acc_m : NAN, s.pl.fault_modes);
       out << buf;
     } else {
       std::vector<integrity::SatId> ids;
       for (const auto& l : s.sats) ids.push_back(l.sat);
-      json j = plJson(s.pl, req.requirements, false, ids);
+      const bool ok = s.pl.pl_computed;
+      json j;
       j["time"] = integrity::formatRfc3339(s.t);
+      j["method"] = o.method;
+      j["available"] = s.pl.available;
+      j["pl_computed"] = ok;
+      if (!s.pl.reason.empty()) j["reason"] = s.pl.reason;
+      j["hpl_m"] = ok ? r4(s.pl.hpl_m) : json(nullptr);
+      j["vpl_m"] = ok ? r4(s.pl.vpl_m) : json(nullptr);
+      if (method == integrity::IntegrityMethod::kAraim) {
+        j["emt_m"] = ok ? r4(s.pl.emt_m) : json(nullptr);
+        j["sigma_acc_m"] = ok ? r4(s.pl.sigma_acc_m) : json(nullptr);
+        j["fault_modes"] = s.pl.fault_modes;
+      }
       j["hdop"] = r4(s.dops.hdop);
       j["vdop"] = r4(s.dops.vdop);
-      j["available"] = s.available;
       j["satellites"] = satList(ids);
       out << j.dump() << "\n";
     }
@@ -198,15 +261,15 @@ void runPredict(const PredictOptions& o) {
     std::vector<double> x, hpl, vpl, hal, val, nsat;
     for (const auto& s : samples) {
       x.push_back(s.t - req.start);
-      hpl.push_back(s.pl.available ? s.pl.hpl_m : NAN);
-      vpl.push_back(s.pl.available ? s.pl.vpl_m : NAN);
-      hal.push_back(req.requirements.hal_m);
-      val.push_back(req.requirements.val_m);
+      hpl.push_back(s.pl.pl_computed ? s.pl.hpl_m : NAN);
+      vpl.push_back(s.pl.pl_computed ? s.pl.vpl_m : NAN);
+      hal.push_back(limits.hal_m);
+      val.push_back(limits.val_m);
       nsat.push_back(static_cast<double>(s.sats.size()));
     }
     char title[200];
-    std::snprintf(title, sizeof title, "RAIM protection levels at %.4f°, %.4f°, %.0f m from %s", o.lat_deg, o.lon_deg,
-                  o.alt_m, integrity::formatRfc3339(req.start).c_str());
+    std::snprintf(title, sizeof title, "%s protection levels at %.4f°, %.4f°, %.0f m from %s", method == integrity::IntegrityMethod::kAraim ? "ARAIM" : "RAIM",
+                  o.lat_deg, o.lon_deg, o.alt_m, integrity::formatRfc3339(req.start).c_str());
     const std::string svg = renderTimeSeriesSvg(
         title, "time since start",
         x,
@@ -289,12 +352,12 @@ void addIntegrityCommands(CLI::App& app) {
   auto pl = std::make_shared<PlOptions>();
   CLI::App* c = integ->add_subcommand("pl", "protection levels for one geometry file (JSON)");
   c->add_option("--geometry", pl->geometry, "geometry JSON: satellites (id, az_deg, el_deg), ism, requirements")->required();
-  c->add_option("--method", pl->method, "integrity method (raim)");
+  c->add_option("--method", pl->method, "integrity method: araim (default) or raim");
   c->add_flag("--verbose", pl->verbose, "per-satellite slopes and thresholds");
   c->callback([pl] { runPl(*pl); });
 
   auto pr = std::make_shared<PredictOptions>();
-  c = integ->add_subcommand("predict", "RAIM protection levels over time at one place");
+  c = integ->add_subcommand("predict", "protection levels over time at one place (ARAIM or RAIM)");
   c->add_option("--almanac", pr->almanacs, "YUMA or SEM almanac (repeatable)");
   c->add_option("--nav", pr->navs, "RINEX navigation file (repeatable)");
   c->add_option("--lat", pr->lat_deg, "latitude [deg]")->required();
@@ -309,7 +372,7 @@ void addIntegrityCommands(CLI::App& app) {
   c->add_option("--plot", pr->plot, "write an SVG plot of HPL/VPL and satellites in view");
   c->add_option("--ism", pr->ism, "JSON file with an ism object overriding the defaults");
   c->add_option("--user-model", pr->user_model, "dual_frequency or single_frequency");
-  c->add_option("--method", pr->method, "integrity method (raim)");
+  c->add_option("--method", pr->method, "integrity method: araim (default) or raim");
   c->add_flag("--progress", pr->progress, "show a progress bar even when stderr is not a terminal");
   c->callback([pr] { runPredict(*pr); });
 

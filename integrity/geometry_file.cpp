@@ -86,7 +86,8 @@ void parseIsm(const json& ism, ErrorModel& model, const std::string& src, const 
 GeometryInput parseGeometry(const json& doc, const std::string& src) {
   GeometryInput in;
   if (!doc.is_object()) throw ParseError(src, 0, "(document)", shown(doc), "a JSON object with a \"satellites\" array");
-  requireKeys(doc, {"satellites", "ism", "user_error_model", "requirements", "raim", "position", "iono_tau_vert_m"}, src, "");
+  requireKeys(doc, {"satellites", "ism", "user_error_model", "requirements", "raim", "araim", "position", "iono_tau_vert_m"},
+              src, "");
   const auto sats = doc.find("satellites");
   if (sats == doc.end() || !sats->is_array()) {
     throw ParseError(src, 0, "satellites", sats == doc.end() ? "" : shown(*sats), "an array of {id, az_deg, el_deg}");
@@ -162,6 +163,21 @@ GeometryInput parseGeometry(const json& doc, const std::string& src) {
       if (*f == "pbias_plus_noise") in.raim.formula = RaimPlFormula::kSlopePbiasPlusNoise;
       else if (*f == "brown") in.raim.formula = RaimPlFormula::kSlopePbias;
       else throw ParseError(src, 0, "raim.formula", shown(*f), "\"pbias_plus_noise\" or \"brown\"");
+    }
+  }
+  in.araim.requirements = in.requirements;
+  if (const auto it = doc.find("araim"); it != doc.end()) {
+    const json& a = *it;
+    if (!a.is_object()) throw ParseError(src, 0, "araim", shown(a), "an object");
+    requireKeys(a, {"fault_mode_rule", "horizontal_only"}, src, "araim");
+    if (const auto f = a.find("fault_mode_rule"); f != a.end()) {
+      if (*f == "joint_events") in.araim.rule = FaultModeRule::kJointEvents;
+      else if (*f == "blanch2012") in.araim.rule = FaultModeRule::kBlanch2012;
+      else throw ParseError(src, 0, "araim.fault_mode_rule", shown(*f), "\"joint_events\" or \"blanch2012\"");
+    }
+    if (const auto h = a.find("horizontal_only"); h != a.end()) {
+      if (!h->is_boolean()) throw ParseError(src, 0, "araim.horizontal_only", shown(*h), "true or false");
+      in.araim.horizontal_only = h->get<bool>();
     }
   }
   if (const auto it = doc.find("position"); it != doc.end()) {

@@ -11,12 +11,15 @@
 ///                  "p_thres":8e-8,"p_emt":1e-5,"tol_pl_m":0.05,"val_m":35,"hal_m":40,
 ///                  "emt_m":15,"sigma_acc_m":1.87},
 ///  "raim":{"pfa":1e-6,"pmd":1e-3,"formula":"pbias_plus_noise"|"brown"},
+///  "araim":{"fault_mode_rule":"joint_events"|"blanch2012","horizontal_only":false},
 ///  "position":{"lat_deg":…,"lon_deg":…,"h_m":…},   // optional: single-frequency τ_vert
 ///  "iono_tau_vert_m": 9}                               // optional override
 /// ```
 /// Every field but `satellites` is optional; defaults are the ARAIM ADD's LPV-200 values.
 
+#include "integrity/araim/mhss.hpp"
 #include "integrity/raim/raim.hpp"
+#include "integrity/requirements.hpp"
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -25,20 +28,6 @@
 
 namespace skylane::integrity {
 
-/// \brief Integrity requirements (ARAIM ADD v3.1 Table 3 defaults, LPV-200).
-struct Requirements {
-  double phmi_vert = 9.8e-8;
-  double phmi_hor = 2e-9;
-  double pfa_vert = 3.9e-6;
-  double pfa_hor = 9e-8;
-  double p_thres = 8e-8;
-  double p_emt = 1e-5;
-  double tol_pl_m = 5e-2;
-  double val_m = 35.0;
-  double hal_m = 40.0;
-  double emt_m = 15.0;
-  double sigma_acc_m = 1.87;
-};
 
 /// \brief A parsed geometry file.
 struct GeometryInput {
@@ -46,6 +35,7 @@ struct GeometryInput {
   ErrorModel model;
   Requirements requirements;
   RaimConfig raim;
+  AraimConfig araim;  ///< requirements copied from `requirements`
   std::optional<maps::Geodetic> position;
   double tau_vert_m = 9.0;  ///< resolved single-frequency ionospheric bound
 };

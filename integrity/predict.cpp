@@ -22,8 +22,32 @@ Dops computeDops(const Geometry& g) {
   return d;
 }
 
-std::vector<PredictSample> predictRaim(const OrbitSource& orbits, const PredictRequest& req,
-                                       const std::function<void(std::size_t, std::size_t)>& progress) {
+PlSummary summarize(const RaimPl& pl, const Requirements& req) {
+  PlSummary s;
+  s.pl_computed = pl.available;
+  s.reason = pl.reason;
+  s.hpl_m = pl.hpl_m;
+  s.vpl_m = pl.vpl_m;
+  s.available = pl.available && pl.hpl_m <= req.hal_m && pl.vpl_m <= req.val_m;
+  if (pl.available && !s.available) s.reason = pl.hpl_m > req.hal_m ? "HPL exceeds HAL" : "VPL exceeds VAL";
+  return s;
+}
+
+PlSummary summarize(const AraimResult& r) {
+  PlSummary s;
+  s.pl_computed = r.pl_computed;
+  s.available = r.available;
+  s.reason = r.reason;
+  s.hpl_m = r.hpl_m;
+  s.vpl_m = r.vpl_m;
+  s.emt_m = r.emt_m;
+  s.sigma_acc_m = r.sigma_acc_v_m;
+  s.fault_modes = r.fault_modes;
+  return s;
+}
+
+std::vector<PredictSample> predictIntegrity(const OrbitSource& orbits, const PredictRequest& req, IntegrityMethod method,
+                                            const std::function<void(std::size_t, std::size_t)>& progress) {
   const Eigen::Vector3d p_user = maps::geodeticToEcef(req.place);
   const double tau = req.model.iono_tau_vert_m.value_or(ionoTauVert_m(geomagneticLatitude(req.place)));
   const auto n = static_cast<std::size_t>(std::floor(req.duration_s / req.step_s + 1e-9)) + 1;
@@ -35,8 +59,8 @@ std::vector<PredictSample> predictRaim(const OrbitSource& orbits, const PredictR
     for (const VisibleSatellite& v : orbits.visible(p_user, s.t, req.mask_rad)) s.sats.push_back({v.sat, v.look});
     const Geometry g = buildGeometry(s.sats, req.model, tau);
     s.dops = computeDops(g);
-    s.pl = raimProtectionLevels(g, req.raim);
-    s.available = s.pl.available && s.pl.hpl_m <= req.requirements.hal_m && s.pl.vpl_m <= req.requirements.val_m;
+    s.pl = method == IntegrityMethod::kAraim ? summarize(araimProtectionLevels(g, req.model, req.araim))
+                                             : summarize(raimProtectionLevels(g, req.raim), req.araim.requirements);
     out.push_back(std::move(s));
     if (progress && (k % 16 == 0 || k + 1 == n)) progress(k + 1, n);
   }

@@ -4,6 +4,7 @@
 
 #include "integrity/geometry_file.hpp"
 #include "integrity/gnss/orbit_source.hpp"
+#include "integrity/araim/mhss.hpp"
 #include "integrity/raim/raim.hpp"
 
 #include <functional>
@@ -20,8 +21,26 @@ struct PredictRequest {
   double mask_rad = 5.0 * M_PI / 180.0;
   ErrorModel model;
   RaimConfig raim;
-  Requirements requirements;
+  AraimConfig araim;  ///< its requirements are the ones used for availability
 };
+
+/// \brief Which integrity algorithm forms the protection levels.
+enum class IntegrityMethod { kRaim, kAraim };
+
+/// \brief Method-neutral outcome of one epoch.
+struct PlSummary {
+  bool pl_computed = false;
+  bool available = false;
+  std::string reason;
+  double hpl_m = 0, vpl_m = 0;
+  double emt_m = 0, sigma_acc_m = 0;  ///< ARAIM only
+  int fault_modes = 0;                ///< ARAIM only
+};
+
+/// \brief Summary of a RAIM result against HAL/VAL.
+[[nodiscard]] PlSummary summarize(const RaimPl& pl, const Requirements& req);
+/// \brief Summary of an ARAIM result.
+[[nodiscard]] PlSummary summarize(const AraimResult& r);
 
 /// \brief Dilutions of precision of an unweighted geometry (∞ when singular).
 struct Dops {
@@ -33,15 +52,15 @@ struct PredictSample {
   GpsTime t;
   std::vector<SatLook> sats;
   Dops dops;
-  RaimPl pl;
-  bool available = false;  ///< PL computed and within HAL/VAL
+  PlSummary pl;
 };
 
 /// \brief DOPs of the geometry's G (unit weights).
 [[nodiscard]] Dops computeDops(const Geometry& g);
 
-/// \brief RAIM PLs at every step from start to start + duration (inclusive).
-[[nodiscard]] std::vector<PredictSample> predictRaim(const OrbitSource& orbits, const PredictRequest& req,
-                                                     const std::function<void(std::size_t, std::size_t)>& progress = {});
+/// \brief PLs at every step from start to start + duration (inclusive).
+[[nodiscard]] std::vector<PredictSample> predictIntegrity(const OrbitSource& orbits, const PredictRequest& req,
+                                                          IntegrityMethod method,
+                                                          const std::function<void(std::size_t, std::size_t)>& progress = {});
 
 }  // namespace skylane::integrity

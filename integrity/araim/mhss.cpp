@@ -10,15 +10,19 @@
 namespace skylane::integrity {
 namespace {
 
-/// Reciprocal condition below which a subset's normal matrix is singular (mode unmonitorable).
-constexpr double kMinRcond = 1e-12;
+/// Smallest/largest LDLᵀ pivot ratio below which a subset's normal matrix is singular (mode
+/// unmonitorable): far above round-off (1e-16) so the subset covariance is still meaningful.
+constexpr double kMinPivotRatio = 1e-12;
+/// 3 position states + at most one clock per constellation.
+constexpr int kMaxStates = 3 + kNumConstellations;
+using StateMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxStates, kMaxStates>;
 
 /// Q̃(x): the normal tail, 1 for negative arguments (conservative when PL < T + b).
 double modifiedTail(double x) { return x < 0.0 ? 1.0 : normalTail(x); }
 
 struct AllInView {
   Eigen::MatrixXd A;  ///< Gᵀ W (m × n)
-  Eigen::MatrixXd N;  ///< Gᵀ W G
+  StateMatrix N;      ///< Gᵀ W G
 };
 
 /// Subset solution from the all-in-view normal matrix down-dated by the removed satellites
@@ -28,7 +32,9 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
   const int n = g.numSats(), m = g.numStates();
   std::vector<bool> keep(static_cast<std::size_t>(n), true);
   for (int i : removed) keep[static_cast<std::size_t>(i)] = false;
+  if (m > kMaxStates) return false;
   std::vector<int> cols = {0, 1, 2};
+  cols.reserve(static_cast<std::size_t>(m));
   for (int c = 3; c < m; ++c) {
     for (int i = 0; i < n; ++i) {
       if (keep[static_cast<std::size_t>(i)] && g.G(i, c) != 0.0) {
@@ -40,18 +46,22 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
   const int kept = n - static_cast<int>(removed.size());
   const int mk = static_cast<int>(cols.size());
   if (kept < mk) return false;  // the subset cannot fix position and its clocks (Stanford: N ≥ unknowns)
-  Eigen::MatrixXd Nk = aiv.N;
+  StateMatrix Nk = aiv.N;
   for (int i : removed) {
     const double w = 1.0 / (g.sigma_int[i] * g.sigma_int[i]);
-    Nk.noalias() -= w * g.G.row(i).transpose() * g.G.row(i);  // rank-one down-date
+    for (int a = 0; a < m; ++a) {  // rank-one down-date N_k = N − w g gᵀ
+      for (int b = 0; b < m; ++b) Nk(a, b) -= w * g.G(i, a) * g.G(i, b);
+    }
   }
-  Eigen::MatrixXd Nr(mk, mk);
+  StateMatrix Nr(mk, mk);
   for (int a = 0; a < mk; ++a) {
     for (int b = 0; b < mk; ++b) Nr(a, b) = Nk(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
   }
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(Nr);
-  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > kMinRcond)) return false;
-  const Eigen::MatrixXd X = ldlt.solve(Eigen::MatrixXd::Identity(mk, 3));  // columns q of N_k⁻¹
+  const Eigen::LDLT<StateMatrix> ldlt(Nr);
+  const auto d = ldlt.vectorD();
+  if (ldlt.info() != Eigen::Success || !(d.minCoeff() > kMinPivotRatio * d.maxCoeff())) return false;
+  const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxStates, 3> X =
+      ldlt.solve(Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxStates, 3>::Identity(mk, 3));  // columns q of N_k⁻¹
   out.S = Eigen::MatrixXd::Zero(3, n);
   for (int i = 0; i < n; ++i) {
     if (!keep[static_cast<std::size_t>(i)]) continue;

@@ -15,8 +15,8 @@
 /// p_not_monitored; axes q = 0 east, 1 north, 2 up (the ADD's 1, 2, 3).
 
 #include "integrity/araim/fault_modes.hpp"
-#include "integrity/geometry_file.hpp"
 #include "integrity/raim/wls.hpp"
+#include "integrity/requirements.hpp"
 
 #include <array>
 #include <string>

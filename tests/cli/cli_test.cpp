@@ -49,10 +49,24 @@ TEST(Cli, PlPrintsProtectionLevelsAsJson) {
   EXPECT_EQ(j["dof"].get<int>(), 3);
 }
 
+TEST(Cli, PlDefaultsToAraimWithItsFields) {
+  const RunResult r = run("integrity pl --verbose --geometry " + std::string(SKYLANE_TEST_DATA) + "/../../examples/predict/geometry.json");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["method"], "araim");
+  for (const char* key : {"hpl_m", "vpl_m", "emt_m", "sigma_acc_m", "fault_modes", "hpl_equal_allocation_m",
+                          "vpl_equal_allocation_m", "available", "subsets"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_EQ(j["fault_modes"].get<int>(), 14);  // 12 satellites + GPS out + Galileo out (P_sat 1e-5)
+  EXPECT_EQ(j["subsets"].size(), 14u);
+  EXPECT_LE(j["vpl_m"].get<double>(), j["vpl_equal_allocation_m"].get<double>());
+}
+
 TEST(Cli, PlWithTooFewSatellitesSaysNotAvailable) {
   const std::string geo = writeTemp("geo3.json", R"({"satellites":[{"id":"G01","az_deg":0,"el_deg":88},
     {"id":"G05","az_deg":30,"el_deg":35},{"id":"G08","az_deg":95,"el_deg":20}]})");
-  const RunResult r = run("integrity pl --geometry " + geo);
+  const RunResult r = run("integrity pl --method raim --geometry " + geo);
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_FALSE(j["available"].get<bool>());
@@ -83,15 +97,33 @@ TEST(Cli, BadInputExitsTwoWithOneLineNamingTheProblem) {
 
 TEST(Cli, PredictWritesCsvAndSvg) {
   const std::string svg = ::testing::TempDir() + "/predict.svg";
-  const RunResult r = run("integrity predict --almanac " + test::dataPath("gnss/alm01jan2020.txt") +
+  const RunResult r = run("integrity predict --method raim --almanac " + test::dataPath("gnss/alm01jan2020.txt") +
                           " --lat 35.13 --lon 139.62 --start 2020-01-01T00:00:00Z --duration 2h --step 30m --plot " + svg);
   ASSERT_EQ(r.status, 0) << r.out;
-  EXPECT_EQ(r.out.rfind("time_utc,gps_week,gps_sow,satellites,hdop,vdop,hpl_m,vpl_m,available\n", 0), 0u) << r.out;
+  EXPECT_EQ(r.out.rfind("time_utc,gps_week,gps_sow,satellites,hdop,vdop,hpl_m,vpl_m,available,emt_m,sigma_acc_m,fault_modes\n", 0), 0u) << r.out;
   EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 6);  // header + 5 epochs
   std::ifstream f(svg);
   std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("<svg"), std::string::npos);
   EXPECT_NE(text.find("HPL"), std::string::npos);
+}
+
+TEST(Cli, PredictAraimWithGpsAndGalileoAlmanacs) {
+  const RunResult r = run("integrity predict --almanac " + test::dataPath("gnss/alm_gps_ed259.txt") + " --almanac " +
+                          test::dataPath("gnss/alm_gal_ed259.txt") +
+                          " --lat 48.1 --lon 11.6 --start 2017-01-01T00:00:00Z --duration 1h --step 20m --format jsonl");
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::istringstream in(r.out);
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    const auto j = nlohmann::json::parse(line);
+    EXPECT_EQ(j["method"], "araim");
+    EXPECT_TRUE(j["available"].get<bool>()) << line;
+    EXPECT_GE(j["satellites"].size(), 14u);
+    ++n;
+  }
+  EXPECT_EQ(n, 4);
 }
 
 TEST(Cli, SppPrintsOneJsonLinePerEpoch) {

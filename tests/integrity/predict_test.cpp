@@ -13,13 +13,13 @@ TEST(Predict, MopsConstellationGivesRaimEverywhereOverADayInJapan) {
   req.start = *parseRfc3339("2020-01-01T00:00:00Z");
   req.duration_s = 86400;
   req.step_s = 900;
-  const auto s = predictRaim(orbits, req);
+  const auto s = predictIntegrity(orbits, req, IntegrityMethod::kRaim);
   ASSERT_EQ(s.size(), 97u);
   for (const auto& p : s) {
     // The 24-satellite DO-229 constellation shows 6 … 12 satellites above 5° at mid latitudes.
     EXPECT_GE(p.sats.size(), 6u);
     EXPECT_LE(p.sats.size(), 12u);
-    EXPECT_TRUE(p.pl.available) << formatRfc3339(p.t) << ": " << p.pl.reason;
+    EXPECT_TRUE(p.pl.pl_computed) << formatRfc3339(p.t) << ": " << p.pl.reason;
     EXPECT_GT(p.dops.hdop, 0.5);
     EXPECT_LT(p.dops.hdop, 10);
   }
