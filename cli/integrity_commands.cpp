@@ -290,6 +290,7 @@ struct SppOptions {
   std::vector<std::string> inject;
   bool progress = false;
   bool no_galileo = false;
+  std::string method = "raim";
 };
 
 void runSpp(const SppOptions& o) {
@@ -301,6 +302,7 @@ void runSpp(const SppOptions& o) {
   else if (o.iono == "klobuchar") cfg.iono = integrity::IonoMode::kKlobuchar;
   else throw ParseError("--iono", 0, "--iono", o.iono, "auto, iono_free or klobuchar");
   cfg.use_galileo = !o.no_galileo;
+  cfg.method = parseMethod(o.method);
   for (const std::string& inj : o.inject) {  // "G05:50"
     const auto colon = inj.find(':');
     const auto sat = integrity::parseSatId(inj.substr(0, colon));
@@ -334,9 +336,16 @@ void runSpp(const SppOptions& o) {
       j["fault_detected"] = e.fault_detected;
       j["test_statistic"] = r4(e.test_statistic);
       j["threshold"] = r4(e.threshold);
-      j["hpl_m"] = e.pl.available ? r4(e.pl.hpl_m) : json(nullptr);
-      j["vpl_m"] = e.pl.available ? r4(e.pl.vpl_m) : json(nullptr);
-      j["pl_available"] = e.pl.available;
+      j["method"] = o.method;
+      j["hpl_m"] = e.pl.pl_computed ? r4(e.pl.hpl_m) : json(nullptr);
+      j["vpl_m"] = e.pl.pl_computed ? r4(e.pl.vpl_m) : json(nullptr);
+      j["pl_computed"] = e.pl.pl_computed;
+      j["available"] = e.pl.available;
+      if (o.method == "araim" && e.pl.pl_computed) {
+        j["emt_m"] = r4(e.pl.emt_m);
+        j["sigma_acc_m"] = r4(e.pl.sigma_acc_m);
+        j["fault_modes"] = e.pl.fault_modes;
+      }
     }
     if (!e.note.empty()) j["note"] = e.note;
     out << j.dump() << "\n";
@@ -385,6 +394,7 @@ void addIntegrityCommands(CLI::App& app) {
   c->add_option("--output,-o", sp->output, "output JSON-lines file (default stdout)");
   c->add_option("--inject", sp->inject, "fault injection SAT:BIAS_M (e.g. G05:50), repeatable");
   c->add_flag("--no-galileo", sp->no_galileo, "use GPS only");
+  c->add_option("--method", sp->method, "raim (default: chi-square + w-test) or araim (solution separation)");
   c->add_flag("--progress", sp->progress, "show a progress bar even when stderr is not a terminal");
   c->callback([sp] { runSpp(*sp); });
 }

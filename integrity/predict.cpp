@@ -22,30 +22,6 @@ Dops computeDops(const Geometry& g) {
   return d;
 }
 
-PlSummary summarize(const RaimPl& pl, const Requirements& req) {
-  PlSummary s;
-  s.pl_computed = pl.available;
-  s.reason = pl.reason;
-  s.hpl_m = pl.hpl_m;
-  s.vpl_m = pl.vpl_m;
-  s.available = pl.available && pl.hpl_m <= req.hal_m && pl.vpl_m <= req.val_m;
-  if (pl.available && !s.available) s.reason = pl.hpl_m > req.hal_m ? "HPL exceeds HAL" : "VPL exceeds VAL";
-  return s;
-}
-
-PlSummary summarize(const AraimResult& r) {
-  PlSummary s;
-  s.pl_computed = r.pl_computed;
-  s.available = r.available;
-  s.reason = r.reason;
-  s.hpl_m = r.hpl_m;
-  s.vpl_m = r.vpl_m;
-  s.emt_m = r.emt_m;
-  s.sigma_acc_m = r.sigma_acc_v_m;
-  s.fault_modes = r.fault_modes;
-  return s;
-}
-
 std::vector<PredictSample> predictIntegrity(const OrbitSource& orbits, const PredictRequest& req, IntegrityMethod method,
                                             const std::function<void(std::size_t, std::size_t)>& progress) {
   const Eigen::Vector3d p_user = maps::geodeticToEcef(req.place);

@@ -5,6 +5,7 @@
 #include "integrity/geometry_file.hpp"
 #include "integrity/gnss/orbit_source.hpp"
 #include "integrity/araim/mhss.hpp"
+#include "integrity/pl_summary.hpp"
 #include "integrity/raim/raim.hpp"
 
 #include <functional>
@@ -24,23 +25,7 @@ struct PredictRequest {
   AraimConfig araim;  ///< its requirements are the ones used for availability
 };
 
-/// \brief Which integrity algorithm forms the protection levels.
-enum class IntegrityMethod { kRaim, kAraim };
 
-/// \brief Method-neutral outcome of one epoch.
-struct PlSummary {
-  bool pl_computed = false;
-  bool available = false;
-  std::string reason;
-  double hpl_m = 0, vpl_m = 0;
-  double emt_m = 0, sigma_acc_m = 0;  ///< ARAIM only
-  int fault_modes = 0;                ///< ARAIM only
-};
-
-/// \brief Summary of a RAIM result against HAL/VAL.
-[[nodiscard]] PlSummary summarize(const RaimPl& pl, const Requirements& req);
-/// \brief Summary of an ARAIM result.
-[[nodiscard]] PlSummary summarize(const AraimResult& r);
 
 /// \brief Dilutions of precision of an unweighted geometry (∞ when singular).
 struct Dops {

@@ -1,5 +1,6 @@
 #include "integrity/raim/spp.hpp"
 
+#include "integrity/araim/fde.hpp"
 #include "integrity/gnss/atmosphere.hpp"
 
 #include <Eigen/Cholesky>
@@ -115,8 +116,16 @@ SppEpoch solveSppEpoch(const ObservationEpoch& ep, const ObservationData& obs, c
     return out;
   }
 
-  // Phase B: weighted, corrected, masked, with RAIM FDE at each linearisation point.
-  RaimFdeResult fde;
+  // Phase B: weighted, corrected, masked, with FDE at each linearisation point.
+  struct Outcome {
+    bool ok = false;
+    Eigen::VectorXd dx;
+    Geometry final_geometry;
+    std::vector<int> excluded;
+    bool fault_detected = false;
+    double statistic = 0, threshold = 0;
+    PlSummary pl;
+  } fde;
   std::vector<const Measurement*> in_view;
   for (int it = 0; it < kMaxIterations; ++it) {
     const maps::Geodetic user = maps::ecefToGeodetic(x);
@@ -145,8 +154,17 @@ SppEpoch solveSppEpoch(const ObservationEpoch& ep, const ObservationData& obs, c
     model.setUserModel(any_single ? UserErrorModel::kSingleFrequency : UserErrorModel::kDualFrequency);
     const Geometry g = buildGeometry(looks, model, tau);
     const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(prefit.data(), static_cast<Eigen::Index>(prefit.size()));
-    fde = raimFde(g, y, cfg.raim);
-    if (!fde.solution_ok) {
+    if (cfg.method == IntegrityMethod::kAraim) {
+      ErrorModel araim_model = cfg.model;  // the ISM priors; σ's come from `g`
+      const AraimFdeResult r = araimFde(g, y, araim_model, cfg.araim);
+      fde = {r.solution_ok, r.dx, r.final_geometry, r.excluded, r.fault_detected, r.max_test_ratio, 1.0, summarize(r.pl)};
+    } else {
+      const RaimFdeResult r = raimFde(g, y, cfg.raim);
+      fde = {r.solution_ok, r.dx, r.final_geometry, r.excluded, r.fault_detected, r.test_statistic, r.threshold,
+             summarize(r.pl, cfg.araim.requirements)};
+      if (r.fault_detected && !r.fault_excluded) fde.pl.reason = r.pl.reason;
+    }
+    if (!fde.ok) {
       out.note += fde.pl.reason;
       return out;
     }
@@ -166,10 +184,10 @@ SppEpoch solveSppEpoch(const ObservationEpoch& ep, const ObservationData& obs, c
   out.used = fde.final_geometry.sats;
   for (int idx : fde.excluded) out.excluded.push_back(in_view[static_cast<std::size_t>(idx)]->sat);
   out.fault_detected = fde.fault_detected;
-  out.test_statistic = fde.test_statistic;
+  out.test_statistic = fde.statistic;
   out.threshold = fde.threshold;
   out.pl = fde.pl;
-  if (!out.pl.available) out.note += out.pl.reason;
+  if (!out.pl.pl_computed) out.note += out.pl.reason;
   return out;
 }
 

@@ -10,6 +10,7 @@
 
 #include "integrity/gnss/rinex_nav.hpp"
 #include "integrity/gnss/rinex_obs.hpp"
+#include "integrity/pl_summary.hpp"
 #include "integrity/raim/raim.hpp"
 
 #include "maps/geodesy.hpp"
@@ -33,7 +34,9 @@ enum class IonoMode {
 struct SppConfig {
   double elevation_mask_rad = 15.0 * M_PI / 180.0;
   IonoMode iono = IonoMode::kAuto;
+  IntegrityMethod method = IntegrityMethod::kRaim;
   RaimConfig raim;
+  AraimConfig araim;  ///< used with IntegrityMethod::kAraim (solution-separation FDE)
   ErrorModel model;
   bool use_galileo = true;
   /// \brief Test hook / what-if: add this bias [m] to a satellite's pseudorange (fault injection).
@@ -53,9 +56,9 @@ struct SppEpoch {
   std::vector<SatId> used;
   std::vector<SatId> excluded;
   bool fault_detected = false;
-  double test_statistic = 0.0;
-  double threshold = 0.0;
-  RaimPl pl;
+  double test_statistic = 0.0;  ///< RAIM: √WSSE; ARAIM: max |Δx|/T over subsets and axes
+  double threshold = 0.0;       ///< RAIM: T_d; ARAIM: 1
+  PlSummary pl;
 };
 
 /// \brief Solves every epoch of `obs` with `nav`. `progress(done, total)` is called now and then.

@@ -78,7 +78,7 @@ TEST(Spp, ProtectionLevelsBoundTheActualErrorAtEveryEpoch) {
     const maps::LocalFrame f(maps::ecefToGeodetic(*obs.approx_position_ecef));
     for (const auto& e : solveSpp(obs, nav, cfg)) {
       ASSERT_TRUE(e.solved);
-      ASSERT_TRUE(e.pl.available) << e.note;
+      ASSERT_TRUE(e.pl.pl_computed) << e.note;
       const Eigen::Vector3d d = f.ecefToEnu(e.p_ecef);
       EXPECT_LT(std::hypot(d.x(), d.y()), e.pl.hpl_m);
       EXPECT_LT(std::abs(d.z()), e.pl.vpl_m);
@@ -138,7 +138,7 @@ TEST(Spp, Rinex3GpsPlusGalileoWithTwoReceiverClocks) {
     // (tests/data/rtklib/spp_summary_rinex3.txt), a near-constant ionospheric bias.
     EXPECT_LT(std::hypot(d.x(), d.y()), 3.0);
     EXPECT_LT(std::abs(d.z()), 3.0);
-    EXPECT_TRUE(e.pl.available);
+    EXPECT_TRUE(e.pl.pl_computed);
     // Galileo orbits, clocks and the second receiver clock are consistent with GPS: nothing is
     // excluded and the residual test passes.
     EXPECT_TRUE(e.excluded.empty());
@@ -153,8 +153,39 @@ TEST(Spp, EpochWithTooFewSatellitesIsReportedNotCrashed) {
   obs.epochs[0].sats.resize(3);
   const auto sol = solveSpp(obs, nav, SppConfig{});
   ASSERT_EQ(sol.size(), 1u);
-  EXPECT_FALSE(sol[0].pl.available);
+  EXPECT_FALSE(sol[0].pl.pl_computed);
   EXPECT_FALSE(sol[0].note.empty());
+}
+
+}  // namespace
+}  // namespace skylane::integrity
+
+namespace skylane::integrity {
+namespace {
+
+TEST(SppAraim, SolutionSeparationDetectsAndExcludesAFiftyMetreBias) {
+  const ObservationData obs = loadRinexObs(test::dataPath("rinex3/base_20240624_MO.rnx"));
+  const NavigationData nav = loadRinexNav(test::dataPath("rinex3/base_20240624_MN.rnx"));
+  SppConfig cfg;
+  cfg.method = IntegrityMethod::kAraim;
+  const auto clean = solveSpp(obs, nav, cfg);
+  for (const auto& e : clean) {
+    ASSERT_TRUE(e.solved) << e.note;
+    EXPECT_TRUE(e.pl.pl_computed) << e.note;
+    EXPECT_FALSE(e.fault_detected) << formatRfc3339(e.t) << " ratio " << e.test_statistic;
+    EXPECT_GT(e.pl.fault_modes, 10);
+  }
+  const SatId e11{Constellation::kGalileo, 11};
+  cfg.injected_bias_m[e11] = 50.0;
+  const maps::LocalFrame f(maps::ecefToGeodetic(*obs.approx_position_ecef));
+  for (const auto& e : solveSpp(obs, nav, cfg)) {
+    ASSERT_TRUE(e.solved);
+    EXPECT_TRUE(e.fault_detected) << formatRfc3339(e.t);
+    EXPECT_EQ(e.excluded, std::vector<SatId>{e11}) << formatRfc3339(e.t);
+    EXPECT_LE(e.test_statistic, 1.0);
+    const Eigen::Vector3d d = f.ecefToEnu(e.p_ecef);
+    EXPECT_LT(std::hypot(d.x(), d.y()), 3.0);
+  }
 }
 
 }  // namespace

@@ -1,0 +1,101 @@
+#include "integrity/araim/fde.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace skylane::integrity {
+namespace {
+
+Eigen::VectorXd subVector(const Eigen::VectorXd& y, const std::vector<int>& removed) {
+  Eigen::VectorXd out(y.size() - static_cast<Eigen::Index>(removed.size()));
+  for (Eigen::Index i = 0, j = 0; i < y.size(); ++i) {
+    if (!std::binary_search(removed.begin(), removed.end(), static_cast<int>(i))) out[j++] = y[i];
+  }
+  return out;
+}
+
+Geometry subGeometry(const Geometry& g, const std::vector<int>& removed) {
+  Geometry out = g;
+  for (auto it = removed.rbegin(); it != removed.rend(); ++it) out = out.without(*it);  // highest index first
+  return out;
+}
+
+struct Fit {
+  bool ok = false;
+  Eigen::VectorXd dx;
+  double wsse = 0.0;
+};
+
+Fit fit(const Geometry& g, const Eigen::VectorXd& y) {
+  Fit f;
+  const WlsSolution w = solveWls(g.G, g.sigma_int);
+  if (!w.ok) return f;
+  f.ok = true;
+  f.dx = w.S * y;
+  const Eigen::VectorXd r = y - g.G * f.dx;
+  f.wsse = r.cwiseQuotient(g.sigma_int).squaredNorm();
+  return f;
+}
+
+}  // namespace
+
+double solutionSeparationRatio(const AraimResult& r, const Eigen::VectorXd& y) {
+  const Eigen::Vector3d x0 = r.S0 * y;
+  double worst = 0.0;
+  for (const SubsetSolution& s : r.subsets) {
+    const Eigen::Vector3d xk = s.S * y;
+    for (int q = 0; q < 3; ++q) {
+      const double t = s.threshold[q];
+      const double sep = std::abs(xk[q] - x0[q]);
+      worst = std::max(worst, t > 0 ? sep / t : (sep > 0 ? std::numeric_limits<double>::infinity() : 0.0));
+    }
+  }
+  return worst;
+}
+
+AraimFdeResult araimFde(const Geometry& g, const Eigen::VectorXd& y, const ErrorModel& model, const AraimConfig& cfg) {
+  AraimFdeResult out;
+  out.pl = araimProtectionLevels(g, model, cfg);
+  const Fit all = fit(g, y);
+  if (!all.ok) {
+    out.pl.pl_computed = out.pl.available = false;
+    if (out.pl.reason.empty()) out.pl.reason = "singular geometry";
+    return out;
+  }
+  out.solution_ok = true;
+  out.dx = all.dx;
+  out.final_geometry = g;
+  if (!out.pl.pl_computed) return out;  // nothing to test against; the reason says why
+  out.max_test_ratio = solutionSeparationRatio(out.pl, y);
+  if (out.max_test_ratio <= 1.0) return out;
+  out.fault_detected = true;
+
+  // Exclusion: candidates are the monitored modes, fewest satellites first.
+  double best_wsse = std::numeric_limits<double>::infinity();
+  std::size_t best_size = std::numeric_limits<std::size_t>::max();
+  for (const SubsetSolution& cand : out.pl.subsets) {
+    if (cand.removed.size() > best_size) break;  // a smaller valid exclusion was found already
+    const Geometry gk = subGeometry(g, cand.removed);
+    const Eigen::VectorXd yk = subVector(y, cand.removed);
+    const AraimResult rk = araimProtectionLevels(gk, model, cfg);
+    if (!rk.pl_computed || solutionSeparationRatio(rk, yk) > 1.0) continue;
+    const Fit fk = fit(gk, yk);
+    if (!fk.ok || fk.wsse >= best_wsse) continue;
+    best_wsse = fk.wsse;
+    best_size = cand.removed.size();
+    out.excluded = cand.removed;
+    out.dx = fk.dx;
+    out.final_geometry = gk;
+    out.max_test_ratio = solutionSeparationRatio(rk, yk);
+    out.pl = rk;
+    out.fault_excluded = true;
+  }
+  if (!out.fault_excluded) {
+    out.pl.available = false;
+    out.pl.reason = "fault detected and not excluded";
+  }
+  return out;
+}
+
+}  // namespace skylane::integrity
