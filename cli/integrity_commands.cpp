@@ -1,6 +1,7 @@
 #include "cli/integrity_commands.hpp"
 
 #include "cli/svg_plot.hpp"
+#include "integrity/availability.hpp"
 #include "integrity/geometry_file.hpp"
 #include "integrity/gnss/almanac.hpp"
 #include "integrity/gnss/parse_error.hpp"
@@ -12,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <unistd.h>
@@ -37,6 +39,9 @@ class Progress {
   Progress(std::string what, bool force) : what_(std::move(what)), on_(force || isatty(STDERR_FILENO)) {}
   void operator()(std::size_t done, std::size_t total) {
     if (!on_ || total == 0) return;
+    const int permille = static_cast<int>(1000 * done / total);
+    if (permille == last_permille_ && done != total) return;  // redraw only when it moves
+    last_permille_ = permille;
     const int width = 30;
     const int filled = static_cast<int>(width * done / total);
     std::fprintf(stderr, "\r%s [%.*s%*s] %zu/%zu", what_.c_str(), filled, "##############################",
@@ -48,6 +53,7 @@ class Progress {
  private:
   std::string what_;
   bool on_;
+  int last_permille_ = -1;
 };
 
 json plJson(const integrity::RaimPl& pl, const integrity::Requirements& req, bool verbose,
@@ -352,6 +358,87 @@ void runSpp(const SppOptions& o) {
   }
 }
 
+// ---------------------------------------------------------------------------
+struct AvailabilityOptions {
+  std::vector<std::string> almanacs;
+  std::vector<std::string> navs;
+  double grid_deg = 5.0;
+  std::string start = "2017-01-01T00:00:00Z";
+  std::string duration = "24h";
+  std::string step = "10m";
+  double mask_deg = 5.0;
+  double alt_m = 0.0;
+  std::string method = "araim";
+  std::string ism;
+  std::string output;
+  std::string map;
+  int threads = 0;
+  bool horizontal_only = false;
+  bool progress = false;
+};
+
+void runAvailability(const AvailabilityOptions& o) {
+  integrity::AvailabilityRequest req;
+  req.method = parseMethod(o.method);
+  if (!(o.grid_deg >= 0.5 && o.grid_deg <= 30)) {
+    throw ParseError("--grid-deg", 0, "--grid-deg", std::to_string(o.grid_deg), "a grid step in [0.5, 30] degrees");
+  }
+  req.grid_deg = o.grid_deg;
+  const auto start = integrity::parseRfc3339(o.start);
+  if (!start) throw ParseError("--start", 0, "--start", o.start, "an RFC 3339 UTC time such as 2017-01-01T00:00:00Z");
+  req.start = *start;
+  const auto dur = integrity::parseDuration(o.duration);
+  if (!dur) throw ParseError("--duration", 0, "--duration", o.duration, "a duration such as 24h");
+  const auto step = integrity::parseDuration(o.step);
+  if (!step) throw ParseError("--step", 0, "--step", o.step, "a duration such as 10m");
+  if (*dur / *step > 1e5) throw ParseError("--step", 0, "--step", o.step, "at most 100000 epochs in --duration");
+  req.duration_s = *dur;
+  req.step_s = *step;
+  if (!(o.mask_deg >= 0 && o.mask_deg < 90)) throw ParseError("--mask-deg", 0, "--mask-deg", std::to_string(o.mask_deg), "an elevation mask in [0, 90) degrees");
+  req.mask_rad = maps::deg2rad(o.mask_deg);
+  req.user_h_m = o.alt_m;
+  if (o.threads < 0 || o.threads > 256) throw ParseError("--threads", 0, "--threads", std::to_string(o.threads), "0 (all cores) to 256");
+  req.threads = o.threads;
+  req.araim.horizontal_only = o.horizontal_only;
+  if (!o.ism.empty()) {
+    const std::string text = integrity::readTextFile(o.ism);
+    json doc;
+    try { doc = json::parse(text); } catch (const json::parse_error& e) { throw ParseError(o.ism, 0, "(JSON syntax)", e.what(), "valid JSON"); }
+    integrity::parseIsm(doc.contains("ism") ? doc["ism"] : doc, req.model, o.ism, "ism");
+  }
+  integrity::OrbitSource orbits;
+  for (const auto& a : o.almanacs) orbits.addAlmanac(integrity::loadAlmanac(a));
+  for (const auto& n : o.navs) orbits.addNavigation(integrity::loadRinexNav(n));
+  if (orbits.empty()) throw ParseError("--almanac", 0, "--almanac/--nav", "", "at least one almanac or navigation file");
+  Progress bar("availability", o.progress);
+  const integrity::AvailabilityMap map = integrity::computeAvailability(orbits, req, std::ref(bar));
+
+  const auto out_file = openOutput(o.output);
+  std::ostream& out = out_file ? *out_file : std::cout;
+  out << "lat_deg,lon_deg,epochs,available_epochs,availability_pct,max_hpl_m,max_vpl_m\n";
+  std::vector<MapCell> cells;
+  for (const auto& c : map.cells) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%.2f,%.2f,%d,%d,%.3f,%.3f,%.3f\n", c.lat_deg, c.lon_deg, c.epochs, c.available,
+                  c.percent(), c.max_hpl_m, c.max_vpl_m);
+    out << buf;
+    cells.push_back({c.lat_deg, c.lon_deg, c.percent()});
+  }
+  const double cov = map.coveragePercent(99.5);
+  std::cerr << "skylane: " << map.user_epochs << " user-epochs; " << std::fixed << std::setprecision(2) << cov
+            << " % of the Earth's area has >= 99.5 % availability\n";
+  if (!o.map.empty()) {
+    char title[200];
+    std::snprintf(title, sizeof title, "%s availability%s, %s + %s, mask %.0f°, step %s", o.method == "araim" ? "ARAIM" : "RAIM",
+                  o.horizontal_only ? " (horizontal)" : " (LPV-200)", integrity::formatRfc3339(req.start).c_str(),
+                  o.duration.c_str(), o.mask_deg, o.step.c_str());
+    char footer[200];
+    std::snprintf(footer, sizeof footer, "%.1f° grid, %zu user-epochs; %.2f %% of the area has ≥ 99.5 %% availability",
+                  o.grid_deg, map.user_epochs, cov);
+    writeText(o.map, renderAvailabilityMapSvg(title, cells, o.grid_deg, footer), "--map");
+  }
+}
+
 }  // namespace
 
 void addIntegrityCommands(CLI::App& app) {
@@ -384,6 +471,25 @@ void addIntegrityCommands(CLI::App& app) {
   c->add_option("--method", pr->method, "integrity method: araim (default) or raim");
   c->add_flag("--progress", pr->progress, "show a progress bar even when stderr is not a terminal");
   c->callback([pr] { runPredict(*pr); });
+
+  auto av = std::make_shared<AvailabilityOptions>();
+  c = integ->add_subcommand("availability", "worldwide availability map (percent of available epochs per grid point)");
+  c->add_option("--almanac", av->almanacs, "YUMA or SEM almanac (repeatable)");
+  c->add_option("--nav", av->navs, "RINEX navigation file (repeatable)");
+  c->add_option("--grid-deg", av->grid_deg, "grid step [deg] (cells centred on the grid)");
+  c->add_option("--start", av->start, "start, RFC 3339 UTC");
+  c->add_option("--duration", av->duration, "duration (24h)");
+  c->add_option("--step", av->step, "time step (10m)");
+  c->add_option("--mask-deg", av->mask_deg, "elevation mask [deg]");
+  c->add_option("--alt", av->alt_m, "user ellipsoidal height [m]");
+  c->add_option("--method", av->method, "araim (default) or raim");
+  c->add_option("--ism", av->ism, "JSON file with an ism object overriding the defaults");
+  c->add_option("--output,-o", av->output, "CSV output (default stdout)");
+  c->add_option("--map", av->map, "write an SVG world map with a colour scale");
+  c->add_option("--threads", av->threads, "worker threads (0 = all cores)");
+  c->add_flag("--horizontal-only", av->horizontal_only, "availability from HPL <= HAL only (H-ARAIM)");
+  c->add_flag("--progress", av->progress, "show a progress bar even when stderr is not a terminal");
+  c->callback([av] { runAvailability(*av); });
 
   auto sp = std::make_shared<SppOptions>();
   c = integ->add_subcommand("spp", "single-point positioning with RAIM FDE and protection levels per epoch");

@@ -110,4 +110,63 @@ std::string renderTimeSeriesSvg(const std::string& title, const std::string& x_l
   return s.str();
 }
 
+namespace {
+
+struct Bin {
+  double min_pct;
+  const char* colour;
+  const char* label;
+};
+constexpr Bin kBins[] = {{100.0, "#1a9850", "100 %"},   {99.9, "#66bd63", "≥ 99.9 %"}, {99.5, "#a6d96a", "≥ 99.5 %"},
+                         {99.0, "#d9ef8b", "≥ 99 %"},   {95.0, "#fee08b", "≥ 95 %"},   {90.0, "#fdae61", "≥ 90 %"},
+                         {50.0, "#f46d43", "≥ 50 %"},   {-1.0, "#d73027", "< 50 %"}};
+
+const char* binColour(double pct) {
+  for (const Bin& b : kBins) {
+    if (pct >= b.min_pct - 1e-9) return b.colour;
+  }
+  return kBins[7].colour;
+}
+
+}  // namespace
+
+std::string renderAvailabilityMapSvg(const std::string& title, const std::vector<MapCell>& cells, double cell_deg,
+                                     const std::string& footer) {
+  const double scale = 2.5;  // px per degree
+  const double left = 50, top = 40, w = 360 * scale, h = 180 * scale, legend_w = 130;
+  std::ostringstream s;
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << left + w + legend_w + 20 << "\" height=\"" << top + h + 60
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  s << "<text x=\"" << left + w / 2 << "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">" << escape(title) << "</text>\n";
+  for (const MapCell& c : cells) {
+    const double x = left + (c.lon_deg - cell_deg / 2 + 180) * scale;
+    const double y = top + (90 - c.lat_deg - cell_deg / 2) * scale;
+    s << "<rect x=\"" << fmt(x) << "\" y=\"" << fmt(y) << "\" width=\"" << fmt(cell_deg * scale + 0.3) << "\" height=\""
+      << fmt(cell_deg * scale + 0.3) << "\" fill=\"" << binColour(c.value) << "\"/>\n";
+  }
+  for (int lon = -180; lon <= 180; lon += 30) {
+    const double x = left + (lon + 180) * scale;
+    s << "<line x1=\"" << x << "\" x2=\"" << x << "\" y1=\"" << top << "\" y2=\"" << top + h
+      << "\" stroke=\"#333\" stroke-opacity=\"0.25\"/><text x=\"" << x << "\" y=\"" << top + h + 15
+      << "\" text-anchor=\"middle\">" << lon << "°</text>\n";
+  }
+  for (int lat = -90; lat <= 90; lat += 30) {
+    const double y = top + (90 - lat) * scale;
+    s << "<line x1=\"" << left << "\" x2=\"" << left + w << "\" y1=\"" << y << "\" y2=\"" << y
+      << "\" stroke=\"#333\" stroke-opacity=\"0.25\"/><text x=\"" << left - 6 << "\" y=\"" << y + 4
+      << "\" text-anchor=\"end\">" << lat << "°</text>\n";
+  }
+  s << "<rect x=\"" << left << "\" y=\"" << top << "\" width=\"" << w << "\" height=\"" << h
+    << "\" fill=\"none\" stroke=\"#222\"/>\n";
+  double ly = top + 10;
+  s << "<text x=\"" << left + w + 15 << "\" y=\"" << ly << "\">availability</text>\n";
+  for (const Bin& b : kBins) {
+    ly += 22;
+    s << "<rect x=\"" << left + w + 15 << "\" y=\"" << ly - 12 << "\" width=\"24\" height=\"16\" fill=\"" << b.colour
+      << "\" stroke=\"#444\"/><text x=\"" << left + w + 46 << "\" y=\"" << ly << "\">" << escape(b.label) << "</text>\n";
+  }
+  s << "<text x=\"" << left << "\" y=\"" << top + h + 40 << "\">" << escape(footer) << "</text>\n</svg>\n";
+  return s.str();
+}
+
 }  // namespace skylane::cli

@@ -27,4 +27,14 @@ struct Panel {
 [[nodiscard]] std::string renderTimeSeriesSvg(const std::string& title, const std::string& x_label,
                                               const std::vector<double>& x_s, const std::vector<Panel>& panels);
 
+/// \brief One grid cell of a world map: centre and value (percent available).
+struct MapCell {
+  double lat_deg = 0, lon_deg = 0, value = 0;
+};
+
+/// \brief Equirectangular world map of grid cells coloured by availability in MAAST's bins
+/// (100, ≥ 99.9, ≥ 99.5, ≥ 99, ≥ 95, ≥ 90, ≥ 50, < 50 %), with graticule and colour scale.
+[[nodiscard]] std::string renderAvailabilityMapSvg(const std::string& title, const std::vector<MapCell>& cells,
+                                                   double cell_deg, const std::string& footer);
+
 }  // namespace skylane::cli

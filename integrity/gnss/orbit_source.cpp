@@ -57,6 +57,27 @@ std::vector<VisibleSatellite> OrbitSource::visible(const Eigen::Vector3d& p_user
   return out;
 }
 
+std::vector<std::pair<SatId, Eigen::Vector3d>> OrbitSource::positionsForAllUsers(const GpsTime& t) const {
+  constexpr double kNominalFlight_s = 0.075;
+  std::vector<std::pair<SatId, Eigen::Vector3d>> out;
+  std::set<SatId> done, nav_sats;
+  const GpsTime t_tx = t.plus(-kNominalFlight_s);
+  for (const BroadcastEphemeris& e : nav_.ephemerides) nav_sats.insert(e.sat);
+  for (const SatId& sat : nav_sats) {
+    const BroadcastEphemeris* eph = selectEphemeris(nav_, sat, t);
+    if (!eph) continue;
+    done.insert(sat);
+    out.emplace_back(sat, earthRotationCorrection(satelliteState(*eph, t_tx).p_ecef, kNominalFlight_s));
+  }
+  for (const AlmanacRecord& a : almanac_) {
+    if (a.health != 0 || done.count(a.sat)) continue;
+    done.insert(a.sat);
+    out.emplace_back(a.sat, earthRotationCorrection(almanacState(a, t_tx).p_ecef, kNominalFlight_s));
+  }
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  return out;
+}
+
 double OrbitSource::almanacAge_s(const GpsTime& t) const {
   double age = 0.0;
   for (const AlmanacRecord& a : almanac_) {
