@@ -14,6 +14,9 @@ EX=examples/predict
 ./build/skylane integrity pl --geometry "$EX/geometry.json" --verbose > examples/out/pl.json
 ./build/skylane integrity spp --obs tests/data/gnss/30400920.05o --nav tests/data/gnss/30400920.05n \
   --output examples/out/spp_3040.jsonl
+./build/skylane integrity availability --almanac tests/data/gnss/alm_gps_ed259.txt \
+  --almanac tests/data/gnss/alm_gal_ed259.txt --grid-deg 5 --duration 24h --step 10m \
+  --output examples/out/availability.csv --map examples/out/availability.svg
 echo "--- one geometry (examples/out/pl.json):"
 head -12 examples/out/pl.json
 echo "--- prediction (examples/out/predict.csv, plot examples/out/predict.svg):"
