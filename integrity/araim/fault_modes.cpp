@@ -29,7 +29,7 @@ void enumerate(const std::vector<Event>& events, int r, double p_nf, std::map<st
   const int n = static_cast<int>(events.size());
   std::vector<int> pick;
   // Iterative combination walk: pick holds increasing event indices.
-  std::function<void(int, double)> rec = [&](int start, double u_prod) {
+  std::function<void(int, double, double)> rec = [&](int start, double u_prod, double p_prod) {
     if (!pick.empty()) {
       std::vector<int> removed;
       for (int e : pick) removed.insert(removed.end(), events[e].removes.begin(), events[e].removes.end());
@@ -41,17 +41,18 @@ void enumerate(const std::vector<Event>& events, int r, double p_nf, std::map<st
         m.events = static_cast<int>(pick.size());
       }
       m.prior += p_nf * u_prod;  // ∏_{e∈E} p_e ∏_{e∉E} (1 − p_e)
+      m.event_prior += p_prod;
       m.events = std::min(m.events, static_cast<int>(pick.size()));
     }
     if (static_cast<int>(pick.size()) == r) return;
     for (int e = start; e < n; ++e) {
       if (!(events[e].p > 0.0)) continue;
       pick.push_back(e);
-      rec(e + 1, u_prod * events[e].p / (1.0 - events[e].p));
+      rec(e + 1, u_prod * events[e].p / (1.0 - events[e].p), p_prod * events[e].p);
       pick.pop_back();
     }
   };
-  rec(0, 1.0);
+  rec(0, 1.0, 1.0);
 }
 
 double noFault(const std::vector<Event>& events) {
@@ -119,8 +120,12 @@ FaultModeSet determineFaultModes(const std::vector<Constellation>& sats, const s
     enumerate(const_events, n_const, noFault(const_events), cmodes);
     for (auto& [k, m] : cmodes) {
       FaultMode& dst = modes[k];
-      if (dst.removed.empty()) dst = m;
-      else dst.prior += m.prior;
+      if (dst.removed.empty()) {
+        dst = m;
+      } else {
+        dst.prior += m.prior;
+        dst.event_prior += m.event_prior;
+      }
     }
   }
   for (auto& [k, m] : modes) out.modes.push_back(m);

@@ -31,7 +31,8 @@ enum class FaultModeRule {
 /// \brief One fault mode: the satellites it removes and its prior probability.
 struct FaultMode {
   std::vector<int> removed;  ///< indices into the satellite list, ascending
-  double prior = 0.0;
+  double prior = 0.0;        ///< P(exactly these events): ∏ p_e · ∏_{others} (1 − p_e), summed over merges
+  double event_prior = 0.0;  ///< ∏ p_e of its events (summed over merges): the ISM's nominal rate
   int events = 0;            ///< number of events (smallest over merged combinations)
 };
 

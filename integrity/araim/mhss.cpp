@@ -153,6 +153,7 @@ AraimResult araimProtectionLevels(const Geometry& g, const ErrorModel& model, co
     SubsetSolution s;
     s.removed = mode.removed;
     s.prior = mode.prior;
+    s.event_prior = mode.event_prior;
     if (!subsetSolution(g, aiv, mode.removed, s)) {
       out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
       continue;
@@ -195,9 +196,11 @@ AraimResult araimProtectionLevels(const Geometry& g, const ErrorModel& model, co
   out.vpl_m = pl[2];
   out.hpl_equal_allocation_m = std::hypot(pl_eq[0], pl_eq[1]);
   out.vpl_equal_allocation_m = pl_eq[2];
-  // EMT (ADD Eq. 35): the largest vertical threshold among modes with prior ≥ P_EMT.
+  // EMT (ADD Eq. 35): the largest vertical threshold among modes whose probability is at least
+  // P_EMT. The ISM rate ∏p_e is compared (a single-satellite mode at P_sat = P_EMT = 1e-5 counts;
+  // its exclusive prior, 1e-5·∏(1 − p), is a hair below and would not).
   for (const SubsetSolution& s : out.subsets) {
-    if (s.prior >= req.p_emt) out.emt_m = std::max(out.emt_m, s.threshold[2]);
+    if (s.event_prior >= req.p_emt) out.emt_m = std::max(out.emt_m, s.threshold[2]);
   }
   out.pl_computed = std::isfinite(out.hpl_m) && std::isfinite(out.vpl_m);
   if (!out.pl_computed) {

@@ -35,6 +35,7 @@ struct AraimConfig {
 struct SubsetSolution {
   std::vector<int> removed;  ///< indices into the geometry's satellites
   double prior = 0.0;
+  double event_prior = 0.0;  ///< ∏ p_e of the mode's events (compared with P_EMT)
   std::array<double, 3> sigma{};      ///< σ_q^(k) [m], integrity covariance
   std::array<double, 3> sigma_ss{};   ///< σ_ss,q^(k) [m], accuracy covariance (C_acc)
   std::array<double, 3> bias{};       ///< b_q^(k) [m]

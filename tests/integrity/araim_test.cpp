@@ -99,6 +99,15 @@ TEST(AraimPl, ReproducesAddV3AppendixD) {
   EXPECT_NEAR(r.vpl_m, 19.2, kPublishedTol_m);
   EXPECT_NEAR(r.hpl_m, 14.5, kPublishedTol_m);
   EXPECT_NEAR(r.emt_m, 7.8, kPublishedTol_m);
+  // GPS alone: the single-satellite modes (P_sat = P_EMT = 1e-5) set the EMT.
+  Geometry gps = addExampleGeometry();
+  for (int k = 0; k < 5; ++k) gps = gps.without(gps.numSats() - 1);
+  const AraimResult rg = araimProtectionLevels(gps, ismWith(1e-5, 1e-8), cfg);  // GPS P_const
+  ASSERT_TRUE(rg.pl_computed) << rg.reason;
+  double max_t = 0;
+  for (const auto& s : rg.subsets) max_t = std::max(max_t, s.threshold[2]);
+  EXPECT_GT(rg.emt_m, 0.0);
+  EXPECT_DOUBLE_EQ(rg.emt_m, max_t);
   EXPECT_NEAR(r.sigma_acc_v_m, 1.47, 0.005);
   // The GPS-out subset of the ADD's table: σ_3 2.5760, σ_ss,3 1.5307, b_3 2.8935.
   const auto gps_out = std::find_if(r.subsets.begin(), r.subsets.end(),
