@@ -102,6 +102,27 @@ void writeText(const std::string& path, const std::string& text, const char* opt
   f << text;
 }
 
+/// Reads a JSON file holding an ISM (either {"ism":{…}} or the bare object) into `model`.
+void applyIsmFile(const std::string& path, integrity::ErrorModel& model) {
+  const std::string text = integrity::readTextFile(path);
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw ParseError(path, 0, "(JSON syntax)", e.what(), "valid JSON");
+  }
+  integrity::parseIsm(doc.contains("ism") ? doc["ism"] : doc, model, path, "ism");
+}
+
+/// Loads every almanac and navigation file given on the command line.
+integrity::OrbitSource loadOrbits(const std::vector<std::string>& almanacs, const std::vector<std::string>& navs) {
+  integrity::OrbitSource orbits;
+  for (const auto& a : almanacs) orbits.addAlmanac(integrity::loadAlmanac(a));
+  for (const auto& n : navs) orbits.addNavigation(integrity::loadRinexNav(n));
+  if (orbits.empty()) throw ParseError("--almanac", 0, "--almanac/--nav", "", "at least one almanac or navigation file");
+  return orbits;
+}
+
 json triple(const std::array<double, 3>& v) { return json::array({r4(v[0]), r4(v[1]), r4(v[2])}); }
 
 json araimJson(const integrity::AraimResult& r, bool verbose, const std::vector<integrity::SatId>& sats) {
@@ -205,18 +226,10 @@ void runPredict(const PredictOptions& o) {
   req.mask_rad = maps::deg2rad(o.mask_deg);
   if (o.user_model == "single_frequency") req.model.setUserModel(integrity::UserErrorModel::kSingleFrequency);
   else if (o.user_model != "dual_frequency") throw ParseError("--user-model", 0, "--user-model", o.user_model, "dual_frequency or single_frequency");
-  if (!o.ism.empty()) {
-    const std::string text = integrity::readTextFile(o.ism);
-    json doc;
-    try { doc = json::parse(text); } catch (const json::parse_error& e) { throw ParseError(o.ism, 0, "(JSON syntax)", e.what(), "valid JSON"); }
-    integrity::parseIsm(doc.contains("ism") ? doc["ism"] : doc, req.model, o.ism, "ism");
-  }
+  if (!o.ism.empty()) applyIsmFile(o.ism, req.model);
   if (o.format != "csv" && o.format != "jsonl") throw ParseError("--format", 0, "--format", o.format, "csv or jsonl");
 
-  integrity::OrbitSource orbits;
-  for (const auto& a : o.almanacs) orbits.addAlmanac(integrity::loadAlmanac(a));
-  for (const auto& n : o.navs) orbits.addNavigation(integrity::loadRinexNav(n));
-  if (orbits.empty()) throw ParseError("--almanac", 0, "--almanac/--nav", "", "at least one almanac or navigation file");
+  const integrity::OrbitSource orbits = loadOrbits(o.almanacs, o.navs);
   const double age = orbits.almanacAge_s(req.start);
   if (age > 4 * integrity::kSecondsPerWeek) {
     std::cerr << "skylane: warning: the almanac is " << std::lround(age / 86400) << " days from --start; "
@@ -400,16 +413,8 @@ void runAvailability(const AvailabilityOptions& o) {
   if (o.threads < 0 || o.threads > 256) throw ParseError("--threads", 0, "--threads", std::to_string(o.threads), "0 (all cores) to 256");
   req.threads = o.threads;
   req.araim.horizontal_only = o.horizontal_only;
-  if (!o.ism.empty()) {
-    const std::string text = integrity::readTextFile(o.ism);
-    json doc;
-    try { doc = json::parse(text); } catch (const json::parse_error& e) { throw ParseError(o.ism, 0, "(JSON syntax)", e.what(), "valid JSON"); }
-    integrity::parseIsm(doc.contains("ism") ? doc["ism"] : doc, req.model, o.ism, "ism");
-  }
-  integrity::OrbitSource orbits;
-  for (const auto& a : o.almanacs) orbits.addAlmanac(integrity::loadAlmanac(a));
-  for (const auto& n : o.navs) orbits.addNavigation(integrity::loadRinexNav(n));
-  if (orbits.empty()) throw ParseError("--almanac", 0, "--almanac/--nav", "", "at least one almanac or navigation file");
+  if (!o.ism.empty()) applyIsmFile(o.ism, req.model);
+  const integrity::OrbitSource orbits = loadOrbits(o.almanacs, o.navs);
   Progress bar("availability", o.progress);
   const integrity::AvailabilityMap map = integrity::computeAvailability(orbits, req, std::ref(bar));
 
