@@ -123,6 +123,37 @@ integrity::OrbitSource loadOrbits(const std::vector<std::string>& almanacs, cons
   return orbits;
 }
 
+/// A validated --start / --duration / --step triple.
+struct TimeWindow {
+  integrity::GpsTime start;
+  double duration_s = 0, step_s = 0;
+};
+
+TimeWindow parseTimeWindow(const std::string& start, const std::string& duration, const std::string& step,
+                           double max_epochs) {
+  TimeWindow w;
+  const auto t = integrity::parseRfc3339(start);
+  if (!t) throw ParseError("--start", 0, "--start", start, "an RFC 3339 UTC time such as 2026-11-23T14:00:00Z");
+  const auto d = integrity::parseDuration(duration);
+  if (!d) throw ParseError("--duration", 0, "--duration", duration, "a duration such as 24h, 90m, 3600s");
+  const auto s = integrity::parseDuration(step);
+  if (!s) throw ParseError("--step", 0, "--step", step, "a duration such as 10m or 30s");
+  if (*d / *s > max_epochs) {
+    throw ParseError("--step", 0, "--step", step, "at most " + std::to_string(static_cast<long>(max_epochs)) + " epochs in --duration");
+  }
+  w.start = *t;
+  w.duration_s = *d;
+  w.step_s = *s;
+  return w;
+}
+
+double parseMask(double mask_deg) {
+  if (!(mask_deg >= 0 && mask_deg < 90)) {
+    throw ParseError("--mask-deg", 0, "--mask-deg", std::to_string(mask_deg), "an elevation mask in [0, 90) degrees");
+  }
+  return maps::deg2rad(mask_deg);
+}
+
 json triple(const std::array<double, 3>& v) { return json::array({r4(v[0]), r4(v[1]), r4(v[2])}); }
 
 json araimJson(const integrity::AraimResult& r, bool verbose, const std::vector<integrity::SatId>& sats) {
@@ -212,18 +243,11 @@ void runPredict(const PredictOptions& o) {
   if (!(o.lon_deg >= -180 && o.lon_deg <= 360)) throw ParseError("--lon", 0, "--lon", std::to_string(o.lon_deg), "a longitude in degrees");
   if (!std::isfinite(o.alt_m)) throw ParseError("--alt", 0, "--alt", std::to_string(o.alt_m), "an ellipsoidal height in metres");
   req.place = {maps::deg2rad(o.lat_deg), maps::deg2rad(o.lon_deg), o.alt_m};
-  const auto start = integrity::parseRfc3339(o.start);
-  if (!start) throw ParseError("--start", 0, "--start", o.start, "an RFC 3339 UTC time such as 2026-11-23T14:00:00Z");
-  req.start = *start;
-  const auto dur = integrity::parseDuration(o.duration);
-  if (!dur) throw ParseError("--duration", 0, "--duration", o.duration, "a duration such as 24h, 90m, 3600s");
-  const auto step = integrity::parseDuration(o.step);
-  if (!step) throw ParseError("--step", 0, "--step", o.step, "a duration such as 10m or 30s");
-  if (*dur / *step > 1e6) throw ParseError("--step", 0, "--step", o.step, "at most a million epochs in --duration");
-  req.duration_s = *dur;
-  req.step_s = *step;
-  if (!(o.mask_deg >= 0 && o.mask_deg < 90)) throw ParseError("--mask-deg", 0, "--mask-deg", std::to_string(o.mask_deg), "an elevation mask in [0, 90) degrees");
-  req.mask_rad = maps::deg2rad(o.mask_deg);
+  const TimeWindow window = parseTimeWindow(o.start, o.duration, o.step, 1e6);
+  req.start = window.start;
+  req.duration_s = window.duration_s;
+  req.step_s = window.step_s;
+  req.mask_rad = parseMask(o.mask_deg);
   if (o.user_model == "single_frequency") req.model.setUserModel(integrity::UserErrorModel::kSingleFrequency);
   else if (o.user_model != "dual_frequency") throw ParseError("--user-model", 0, "--user-model", o.user_model, "dual_frequency or single_frequency");
   if (!o.ism.empty()) applyIsmFile(o.ism, req.model);
@@ -314,8 +338,7 @@ struct SppOptions {
 
 void runSpp(const SppOptions& o) {
   integrity::SppConfig cfg;
-  if (!(o.mask_deg >= 0 && o.mask_deg < 90)) throw ParseError("--mask-deg", 0, "--mask-deg", std::to_string(o.mask_deg), "an elevation mask in [0, 90) degrees");
-  cfg.elevation_mask_rad = maps::deg2rad(o.mask_deg);
+  cfg.elevation_mask_rad = parseMask(o.mask_deg);
   if (o.iono == "auto") cfg.iono = integrity::IonoMode::kAuto;
   else if (o.iono == "iono_free") cfg.iono = integrity::IonoMode::kIonoFree;
   else if (o.iono == "klobuchar") cfg.iono = integrity::IonoMode::kKlobuchar;
@@ -397,18 +420,12 @@ void runAvailability(const AvailabilityOptions& o) {
     throw ParseError("--grid-deg", 0, "--grid-deg", std::to_string(o.grid_deg), "a grid step in [0.5, 30] degrees");
   }
   req.grid_deg = o.grid_deg;
-  const auto start = integrity::parseRfc3339(o.start);
-  if (!start) throw ParseError("--start", 0, "--start", o.start, "an RFC 3339 UTC time such as 2017-01-01T00:00:00Z");
-  req.start = *start;
-  const auto dur = integrity::parseDuration(o.duration);
-  if (!dur) throw ParseError("--duration", 0, "--duration", o.duration, "a duration such as 24h");
-  const auto step = integrity::parseDuration(o.step);
-  if (!step) throw ParseError("--step", 0, "--step", o.step, "a duration such as 10m");
-  if (*dur / *step > 1e5) throw ParseError("--step", 0, "--step", o.step, "at most 100000 epochs in --duration");
-  req.duration_s = *dur;
-  req.step_s = *step;
-  if (!(o.mask_deg >= 0 && o.mask_deg < 90)) throw ParseError("--mask-deg", 0, "--mask-deg", std::to_string(o.mask_deg), "an elevation mask in [0, 90) degrees");
-  req.mask_rad = maps::deg2rad(o.mask_deg);
+  const TimeWindow window = parseTimeWindow(o.start, o.duration, o.step, 1e5);
+  req.start = window.start;
+  req.duration_s = window.duration_s;
+  req.step_s = window.step_s;
+  req.mask_rad = parseMask(o.mask_deg);
+  if (!std::isfinite(o.alt_m)) throw ParseError("--alt", 0, "--alt", std::to_string(o.alt_m), "an ellipsoidal height in metres");
   req.user_h_m = o.alt_m;
   if (o.threads < 0 || o.threads > 256) throw ParseError("--threads", 0, "--threads", std::to_string(o.threads), "0 (all cores) to 256");
   req.threads = o.threads;

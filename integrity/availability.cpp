@@ -66,9 +66,7 @@ AvailabilityMap computeAvailability(const OrbitSource& orbits, const Availabilit
           looks.push_back({sat, {az, el}});
         }
         const Geometry g = buildGeometry(looks, req.model, tau);
-        const PlSummary s = req.method == IntegrityMethod::kAraim
-                                ? summarize(araimProtectionLevels(g, req.model, req.araim))
-                                : summarize(raimProtectionLevels(g, req.raim), req.araim.requirements);
+        const PlSummary s = protectionLevels(g, req.method, req.model, req.raim, req.araim);
         ++cell.epochs;
         cell.available += s.available ? 1 : 0;
         if (s.pl_computed) {

@@ -26,4 +26,10 @@ PlSummary summarize(const AraimResult& r) {
   return s;
 }
 
+PlSummary protectionLevels(const Geometry& g, IntegrityMethod method, const ErrorModel& model, const RaimConfig& raim,
+                           const AraimConfig& araim) {
+  return method == IntegrityMethod::kAraim ? summarize(araimProtectionLevels(g, model, araim))
+                                           : summarize(raimProtectionLevels(g, raim), araim.requirements);
+}
+
 }  // namespace skylane::integrity

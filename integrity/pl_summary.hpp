@@ -28,4 +28,9 @@ struct PlSummary {
 /// \brief Summary of an ARAIM result.
 [[nodiscard]] PlSummary summarize(const AraimResult& r);
 
+/// \brief Protection levels of a geometry with the chosen method (availability from the ARAIM
+/// config's requirements for both methods).
+[[nodiscard]] PlSummary protectionLevels(const Geometry& g, IntegrityMethod method, const ErrorModel& model,
+                                         const RaimConfig& raim, const AraimConfig& araim);
+
 }  // namespace skylane::integrity

@@ -35,8 +35,7 @@ std::vector<PredictSample> predictIntegrity(const OrbitSource& orbits, const Pre
     for (const VisibleSatellite& v : orbits.visible(p_user, s.t, req.mask_rad)) s.sats.push_back({v.sat, v.look});
     const Geometry g = buildGeometry(s.sats, req.model, tau);
     s.dops = computeDops(g);
-    s.pl = method == IntegrityMethod::kAraim ? summarize(araimProtectionLevels(g, req.model, req.araim))
-                                             : summarize(raimProtectionLevels(g, req.raim), req.araim.requirements);
+    s.pl = protectionLevels(g, method, req.model, req.raim, req.araim);
     out.push_back(std::move(s));
     if (progress && (k % 16 == 0 || k + 1 == n)) progress(k + 1, n);
   }

@@ -71,6 +71,15 @@ long daysFromCivil(int y, int m, int d) {
   return era * 146097 + doe - 719468;
 }
 
+bool isValidCalendar(const CalendarTime& c) {
+  static constexpr int kDaysInMonth[] = {31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  if (c.year < 1980 || c.year > 2200 || c.month < 1 || c.month > 12) return false;
+  const bool leap = (c.year % 4 == 0 && c.year % 100 != 0) || c.year % 400 == 0;
+  const int days = c.month == 2 && !leap ? 28 : kDaysInMonth[c.month - 1];
+  return c.day >= 1 && c.day <= days && c.hour >= 0 && c.hour <= 23 && c.minute >= 0 && c.minute <= 59 &&
+         c.second >= 0 && c.second < 61;
+}
+
 GpsTime GpsTime::fromTotalSeconds(double t_s) {
   GpsTime t;
   t.week = static_cast<int>(std::floor(t_s / kSecondsPerWeek));

@@ -43,6 +43,10 @@ struct GpsTime {
   return (t1.week - t0.week) * kSecondsPerWeek + (t1.sow - t0.sow);
 }
 
+/// \brief True for a real calendar date-time in 1980 … 2200 (month lengths, leap years,
+/// seconds < 61 for leap seconds) — the rule every file parser applies to epochs.
+[[nodiscard]] bool isValidCalendar(const CalendarTime& c);
+
 /// \brief Calendar date-time read in the GPS time scale → GPS time.
 [[nodiscard]] GpsTime gpsFromCalendar(const CalendarTime& c);
 /// \brief GPS time → calendar date-time in the GPS time scale.

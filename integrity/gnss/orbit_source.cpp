@@ -10,8 +10,8 @@ namespace {
 /// Light-time iterations: 3 bring the transmit time to < 1 ns for any GNSS orbit.
 constexpr int kLightTimeIterations = 3;
 
-template <typename StateAt>
-VisibleSatellite locate(const SatId& sat, const Eigen::Vector3d& p_user, const GpsTime& t, StateAt state_at) {
+VisibleSatellite locate(const SatId& sat, const Eigen::Vector3d& p_user, const GpsTime& t,
+                        const OrbitSource::StateAt& state_at) {
   double tau = 0.075;  // ≈ 22 000 km / c
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
   for (int k = 0; k < kLightTimeIterations; ++k) {
@@ -34,25 +34,30 @@ void OrbitSource::addAlmanac(const std::vector<AlmanacRecord>& records) {
 
 void OrbitSource::addNavigation(const NavigationData& nav) { nav_.merge(nav); }
 
-std::vector<VisibleSatellite> OrbitSource::visible(const Eigen::Vector3d& p_user, const GpsTime& t,
-                                                   double mask_rad) const {
-  std::vector<VisibleSatellite> out;
-  std::set<SatId> done;
-  std::set<SatId> nav_sats;
+void OrbitSource::forEachUsable(const GpsTime& t,
+                                const std::function<void(const SatId&, const StateAt&)>& fn) const {
+  std::set<SatId> done, nav_sats;
   for (const BroadcastEphemeris& e : nav_.ephemerides) nav_sats.insert(e.sat);
   for (const SatId& sat : nav_sats) {
     const BroadcastEphemeris* eph = selectEphemeris(nav_, sat, t);
     if (!eph) continue;
     done.insert(sat);
-    const VisibleSatellite v = locate(sat, p_user, t, [&](const GpsTime& tt) { return satelliteState(*eph, tt); });
-    if (v.look.elevation_rad >= mask_rad) out.push_back(v);
+    fn(sat, [eph](const GpsTime& tt) { return satelliteState(*eph, tt); });
   }
   for (const AlmanacRecord& a : almanac_) {
     if (a.health != 0 || done.count(a.sat)) continue;
     done.insert(a.sat);
-    const VisibleSatellite v = locate(a.sat, p_user, t, [&](const GpsTime& tt) { return almanacState(a, tt); });
-    if (v.look.elevation_rad >= mask_rad) out.push_back(v);
+    fn(a.sat, [&a](const GpsTime& tt) { return almanacState(a, tt); });
   }
+}
+
+std::vector<VisibleSatellite> OrbitSource::visible(const Eigen::Vector3d& p_user, const GpsTime& t,
+                                                   double mask_rad) const {
+  std::vector<VisibleSatellite> out;
+  forEachUsable(t, [&](const SatId& sat, const StateAt& state_at) {
+    const VisibleSatellite v = locate(sat, p_user, t, state_at);
+    if (v.look.elevation_rad >= mask_rad) out.push_back(v);
+  });
   std::sort(out.begin(), out.end(), [](const VisibleSatellite& a, const VisibleSatellite& b) { return a.sat < b.sat; });
   return out;
 }
@@ -60,21 +65,11 @@ std::vector<VisibleSatellite> OrbitSource::visible(const Eigen::Vector3d& p_user
 std::vector<std::pair<SatId, Eigen::Vector3d>> OrbitSource::positionsForAllUsers(const GpsTime& t) const {
   constexpr double kNominalFlight_s = 0.075;
   std::vector<std::pair<SatId, Eigen::Vector3d>> out;
-  std::set<SatId> done, nav_sats;
   const GpsTime t_tx = t.plus(-kNominalFlight_s);
-  for (const BroadcastEphemeris& e : nav_.ephemerides) nav_sats.insert(e.sat);
-  for (const SatId& sat : nav_sats) {
-    const BroadcastEphemeris* eph = selectEphemeris(nav_, sat, t);
-    if (!eph) continue;
-    done.insert(sat);
-    out.emplace_back(sat, earthRotationCorrection(satelliteState(*eph, t_tx).p_ecef, kNominalFlight_s));
-  }
-  for (const AlmanacRecord& a : almanac_) {
-    if (a.health != 0 || done.count(a.sat)) continue;
-    done.insert(a.sat);
-    out.emplace_back(a.sat, earthRotationCorrection(almanacState(a, t_tx).p_ecef, kNominalFlight_s));
-  }
-  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  forEachUsable(t, [&](const SatId& sat, const StateAt& state_at) {
+    out.emplace_back(sat, earthRotationCorrection(state_at(t_tx).p_ecef, kNominalFlight_s));
+  });
+  std::sort(out.begin(), out.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
   return out;
 }
 

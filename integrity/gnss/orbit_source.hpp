@@ -7,6 +7,7 @@
 
 #include "maps/geodesy.hpp"
 
+#include <functional>
 #include <vector>
 
 namespace skylane::integrity {
@@ -22,6 +23,9 @@ struct VisibleSatellite {
 /// \brief A set of orbits: almanac records and/or broadcast ephemerides.
 class OrbitSource {
  public:
+  /// \brief A satellite's state as a function of GPS time.
+  using StateAt = std::function<SatelliteState(const GpsTime&)>;
+
   /// \brief Adds almanac records (unhealthy ones are kept and skipped at use).
   void addAlmanac(const std::vector<AlmanacRecord>& records);
   /// \brief Adds a navigation file's ephemerides.
@@ -43,6 +47,9 @@ class OrbitSource {
   [[nodiscard]] std::size_t size() const { return almanac_.size() + nav_.ephemerides.size(); }
 
  private:
+  /// Calls fn for every satellite usable at t: a valid broadcast ephemeris wins over the almanac.
+  void forEachUsable(const GpsTime& t, const std::function<void(const SatId&, const StateAt&)>& fn) const;
+
   std::vector<AlmanacRecord> almanac_;
   NavigationData nav_;
 };

@@ -31,8 +31,7 @@ const char* const kOrbitFields[7][4] = {
     {"transmission time", "fit interval", "spare", "spare"}};
 
 void checkCalendar(const CalendarTime& c, const std::string& src, int ln) {
-  if (c.year < 1980 || c.year > 2200 || c.month < 1 || c.month > 12 || c.day < 1 || c.day > 31 || c.hour < 0 || c.hour > 24 ||
-      c.minute < 0 || c.minute > 59 || !(c.second >= 0 && c.second < 61)) {
+  if (!isValidCalendar(c)) {
     throw ParseError(src, ln, "epoch", std::to_string(c.year) + "-" + std::to_string(c.month) + "-" +
                                            std::to_string(c.day),
                      "a valid calendar date and time of clock (toc)");

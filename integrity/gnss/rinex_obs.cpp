@@ -18,8 +18,7 @@ constexpr std::size_t kObsWidth = 16;
 std::string label(const std::string& line) { return rinexLabel(line); }
 
 void checkEpoch(const CalendarTime& c, const std::string& src, int ln) {
-  if (c.year < 1980 || c.year > 2200 || c.month < 1 || c.month > 12 || c.day < 1 || c.day > 31 || c.hour < 0 || c.hour > 23 ||
-      c.minute < 0 || c.minute > 59 || !(c.second >= 0 && c.second < 61)) {
+  if (!isValidCalendar(c)) {
     throw ParseError(src, ln, "epoch", std::to_string(c.year) + "-" + std::to_string(c.month) + "-" +
                                            std::to_string(c.day) + " " + std::to_string(c.hour) + ":" +
                                            std::to_string(c.minute),

@@ -14,6 +14,13 @@ namespace {
 /// checked by the residuals: its fault is undetectable and the slope infinite.
 constexpr double kMinResidualObservability = 1e-9;
 
+/// M_ii of the weighted residual projector M = W − W G P Gᵀ W: a bias b on satellite i adds
+/// b²·M_ii to the non-centrality of the test statistic.
+double residualProjectorDiagonal(const Geometry& g, const WlsSolution& wls, int i) {
+  const double w = 1.0 / (g.sigma_int[i] * g.sigma_int[i]);
+  return w - w * w * g.G.row(i).dot(wls.P * g.G.row(i).transpose());
+}
+
 double ellipseSemiMajor(double pee, double pnn, double pen) {
   const double half_sum = 0.5 * (pee + pnn);
   const double half_diff = 0.5 * (pee - pnn);
@@ -60,9 +67,8 @@ RaimPl raimProtectionLevels(const Geometry& g, const RaimConfig& cfg) {
   out.hslope.resize(n);
   out.vslope.resize(n);
   for (int i = 0; i < n; ++i) {
-    // M = W − W G P Gᵀ W: the weighted residual projector; λ_i = b² M_ii for a bias b on sat i.
     const double w = 1.0 / (g.sigma_int[i] * g.sigma_int[i]);
-    const double m_ii = w - w * w * g.G.row(i).dot(wls.P * g.G.row(i).transpose());
+    const double m_ii = residualProjectorDiagonal(g, wls, i);
     if (!(m_ii > kMinResidualObservability * w)) {
       // Not seen by the residuals. Harmless when it does not move the position either (the
       // only satellite of its constellation just fixes that clock); otherwise undetectable.
@@ -146,7 +152,7 @@ RaimFdeResult raimFde(const Geometry& g, const Eigen::VectorXd& prefit, const Ra
     int worst = -1;
     double worst_w = -1;
     for (int i = 0; i < n; ++i) {
-      const double m_ii = w[i] - w[i] * w[i] * cur.G.row(i).dot(wls.P * cur.G.row(i).transpose());
+      const double m_ii = residualProjectorDiagonal(cur, wls, i);
       if (!(m_ii > kMinResidualObservability * w[i])) continue;
       const double wi = std::abs(w[i] * r[i]) / std::sqrt(m_ii);
       if (wi > worst_w) { worst_w = wi; worst = i; }
