@@ -1,29 +1,17 @@
 #pragma once
 /// \file
-/// \brief The one error type for malformed external input (files, JSON, command-line values).
+/// \brief Text-field readers for the fixed-width GNSS formats (RINEX, YUMA, SEM); their errors are
+/// maps::ParseError.
 
-#include <stdexcept>
+#include "maps/parse_error.hpp"
+
 #include <string>
 #include <vector>
 
 namespace skylane::integrity {
 
-/// \brief Bad external input: names the source (file), the line (0 = not line-based), the
-/// field, the offending value and what was expected.
-class ParseError : public std::runtime_error {
- public:
-  ParseError(std::string source, int line, std::string field, std::string value,
-             std::string expected);
-
-  [[nodiscard]] const std::string& source() const { return source_; }
-  [[nodiscard]] int line() const { return line_; }
-  [[nodiscard]] const std::string& field() const { return field_; }
-
- private:
-  std::string source_;
-  int line_;
-  std::string field_;
-};
+/// \brief Bad external input (maps/parse_error.hpp).
+using maps::ParseError;
 
 /// \brief Parses a Fortran-style real ("1.23D-04", "  .5E+01", "-0.1") from a fixed-width
 /// field. Blank fields give `blank_value`. Throws ParseError naming the field otherwise.

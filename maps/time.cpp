@@ -1,4 +1,4 @@
-#include "integrity/gnss/gnss_time.hpp"
+#include "maps/time.hpp"
 
 #include <array>
 #include <cctype>
@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <string>
 
-namespace skylane::integrity {
+namespace skylane::maps {
 namespace {
 
 /// Days from 1970-01-01 to the GPS epoch 1980-01-06.
@@ -211,4 +211,4 @@ std::optional<double> parseDuration(const std::string& text) {
   return total;
 }
 
-}  // namespace skylane::integrity
+}  // namespace skylane::maps
