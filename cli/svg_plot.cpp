@@ -1,5 +1,7 @@
 #include "cli/svg_plot.hpp"
 
+#include "cli/coastlines.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -144,6 +146,14 @@ std::string renderAvailabilityMapSvg(const std::string& title, const std::vector
     s << "<rect x=\"" << fmt(x) << "\" y=\"" << fmt(y) << "\" width=\"" << fmt(cell_deg * scale + 0.3) << "\" height=\""
       << fmt(cell_deg * scale + 0.3) << "\" fill=\"" << binColour(c.value) << "\"/>\n";
   }
+  // Coastlines (GSHHG crude) drawn over the cells so that a reader can place them.
+  s << "<g fill=\"none\" stroke=\"#1b1b1b\" stroke-width=\"0.8\" stroke-opacity=\"0.8\">\n";
+  for (const Coastline& line : worldCoastlines()) {
+    s << "<polyline points=\"";
+    for (const auto& [lon, lat] : line) s << fmt(left + (lon + 180) * scale) << ',' << fmt(top + (90 - lat) * scale) << ' ';
+    s << "\"/>\n";
+  }
+  s << "</g>\n";
   for (int lon = -180; lon <= 180; lon += 30) {
     const double x = left + (lon + 180) * scale;
     s << "<line x1=\"" << x << "\" x2=\"" << x << "\" y1=\"" << top << "\" y2=\"" << top + h

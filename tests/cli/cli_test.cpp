@@ -138,5 +138,24 @@ TEST(Cli, SppPrintsOneJsonLinePerEpoch) {
   EXPECT_NEAR(first["lat_deg"].get<double>(), 35.13207, 1e-4);
 }
 
+TEST(Cli, AvailabilityMapHasCellsColourScaleAndCoastlines) {
+  // GIVEN a coarse 30° grid over 1 h (a seconds-long run)
+  const std::string svg = ::testing::TempDir() + "/availability.svg";
+  const RunResult r = run("integrity availability --almanac " + test::dataPath("gnss/alm01jan2020.txt") +
+                          " --grid-deg 30 --start 2020-01-01T00:00:00Z --duration 1h --step 30m --method raim --map " + svg);
+  ASSERT_EQ(r.status, 0) << r.out;
+  // THEN the CSV has one row per cell (12 × 6 = 72) and the map draws the cells, the bins' legend
+  // and the GSHHG coastlines (117 lines in the embedded crude set).
+  // (run() merges stderr, which adds the one-line area summary)
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1 + 72 + 1) << r.out;
+  EXPECT_NE(r.out.find("% of the Earth's area has >= 99.5 % availability"), std::string::npos) << r.out;
+  std::ifstream f(svg);
+  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  std::size_t polylines = 0;
+  for (std::size_t p = text.find("<polyline"); p != std::string::npos; p = text.find("<polyline", p + 1)) ++polylines;
+  EXPECT_EQ(polylines, 117u);
+  EXPECT_NE(text.find("availability"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace skylane
