@@ -7,6 +7,7 @@
 #include "integrity/gnss/parse_error.hpp"
 #include "integrity/predict.hpp"
 #include "integrity/raim/spp.hpp"
+#include "maps/text_file.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -104,13 +105,7 @@ void writeText(const std::string& path, const std::string& text, const char* opt
 
 /// Reads a JSON file holding an ISM (either {"ism":{…}} or the bare object) into `model`.
 void applyIsmFile(const std::string& path, integrity::ErrorModel& model) {
-  const std::string text = integrity::readTextFile(path);
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw ParseError(path, 0, "(JSON syntax)", e.what(), "valid JSON");
-  }
+  const json doc = maps::readJsonFile(path);
   integrity::parseIsm(doc.contains("ism") ? doc["ism"] : doc, model, path, "ism");
 }
 

@@ -1,5 +1,7 @@
 #include "integrity/geometry_file.hpp"
 
+#include "maps/text_file.hpp"
+
 #include "integrity/gnss/almanac.hpp"
 #include "integrity/gnss/atmosphere.hpp"
 #include "integrity/gnss/parse_error.hpp"
@@ -198,21 +200,6 @@ GeometryInput parseGeometry(const json& doc, const std::string& src) {
   return in;
 }
 
-GeometryInput loadGeometryFile(const std::string& path) {
-  const std::string text = readTextFile(path);
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::parse_error& e) {
-    // nlohmann reports a byte offset; turn it into a line number.
-    const std::size_t upto = std::min<std::size_t>(e.byte, text.size());
-    const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(upto), '\n'));
-    std::string what = e.what();
-    const auto colon = what.rfind(": ");
-    throw ParseError(path, line, "(JSON syntax)", colon == std::string::npos ? what : what.substr(colon + 2),
-                     "valid JSON (RFC 8259)");
-  }
-  return parseGeometry(doc, path);
-}
+GeometryInput loadGeometryFile(const std::string& path) { return parseGeometry(maps::readJsonFile(path), path); }
 
 }  // namespace skylane::integrity

@@ -48,14 +48,6 @@ void checkOrbit(const AlmanacRecord& r, const std::string& source) {
 
 }  // namespace
 
-std::string readTextFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ParseError(path, 0, "file", "", "a readable file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 std::vector<AlmanacRecord> parseYuma(const std::string& text, const std::string& source,
                                      AlmanacSystem system) {
   // Field order of a YUMA record (labels vary slightly between producers, values follow ':').

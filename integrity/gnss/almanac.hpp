@@ -4,6 +4,7 @@
 /// by the US Coast Guard Navigation Center and used by MAAST).
 
 #include "integrity/gnss/ephemeris.hpp"
+#include "maps/text_file.hpp"
 
 #include <string>
 #include <vector>
@@ -46,7 +47,7 @@ enum class AlmanacSystem {
 /// near t. Clock: af0 + af1·t_k + relativistic term.
 [[nodiscard]] SatelliteState almanacState(const AlmanacRecord& rec, const GpsTime& t);
 
-/// \brief Reads a whole file; throws ParseError naming the path when it cannot be read.
-[[nodiscard]] std::string readTextFile(const std::string& path);
+/// \brief Reads a whole file (maps/text_file.hpp).
+using maps::readTextFile;
 
 }  // namespace skylane::integrity

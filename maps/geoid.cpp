@@ -1,0 +1,219 @@
+#include "maps/geoid.hpp"
+
+#include "maps/geodesy.hpp"
+#include "maps/parse_error.hpp"
+
+#include <cpl_error.h>
+#include <gdal_priv.h>
+#include <ogr_spatialref.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+#ifndef SKYLANE_GEOID_GRID
+// CMake defines this for skylane_maps; the fallback is where Debian's proj-data installs it.
+#define SKYLANE_GEOID_GRID "/usr/share/proj/egm96_15.gtx"
+#endif
+
+namespace skylane::maps {
+namespace {
+
+/// What a grid file must be, in every ParseError this file raises.
+constexpr const char* kExpectedGrid =
+    "a geoid grid GDAL can read (EGM96 15': /usr/share/proj/egm96_15.gtx from Debian proj-data)";
+
+/// A grid spacing divides 360° when 360/step is this close to an integer (GDAL computes the
+/// GTX step from doubles in the header; 1e-6 columns is far below any real rounding).
+constexpr double kPeriodTol_cols = 1e-6;
+/// Slack when comparing a latitude with ±90° (degrees): rounding in the geotransform.
+constexpr double kPoleTol_deg = 1e-9;
+/// One degree is this many degrees of a geographic CRS's angular unit when that unit is the
+/// degree (to rounding); other angular units (grads, radians) are refused.
+constexpr double kDegreeUnitTol = 1e-9;
+
+void registerGdalOnce() {
+  static const bool registered = [] {
+    GDALAllRegister();
+    return true;
+  }();
+  (void)registered;
+}
+
+/// GDAL's last error message, or a fallback when GDAL left none.
+std::string gdalMessage(const char* fallback) {
+  const char* msg = CPLGetLastErrorMsg();
+  return (msg != nullptr && *msg != '\0') ? std::string(msg) : std::string(fallback);
+}
+
+void requireFinite(double lat_rad, double lon_rad, const char* what) {
+  if (!std::isfinite(lat_rad) || !std::isfinite(lon_rad) || std::abs(lat_rad) > M_PI / 2 + 1e-12) {
+    std::ostringstream msg;
+    msg << what << ": position (lat " << rad2deg(lat_rad) << " deg, lon " << rad2deg(lon_rad)
+        << " deg) is not finite or latitude is outside [-90, 90] deg";
+    throw std::invalid_argument(msg.str());
+  }
+}
+
+}  // namespace
+
+Geoid::Geoid(const std::string& grid_path) : path_(grid_path) {
+  registerGdalOnce();
+  // GDAL reports through a thread-local handler stack: keep its messages off stderr, they go
+  // into the ParseError instead.
+  CPLErrorHandlerPusher quiet(CPLQuietErrorHandler);
+  CPLErrorReset();
+  GDALDatasetUniquePtr ds(GDALDataset::Open(grid_path.c_str(),
+                                            GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR));
+  if (!ds) throw ParseError(path_, 0, "grid", "unreadable (" + gdalMessage("GDAL cannot open it") + ")", kExpectedGrid);
+  if (ds->GetRasterCount() < 1) throw ParseError(path_, 0, "grid", "no raster band", kExpectedGrid);
+
+  const OGRSpatialReference* srs = ds->GetSpatialRef();
+  if (srs != nullptr && !srs->IsEmpty()) {
+    const double unit_rad = srs->GetAngularUnits(nullptr);
+    if (!srs->IsGeographic() || std::abs(rad2deg(unit_rad) - 1.0) > kDegreeUnitTol) {
+      const char* name = srs->GetName();
+      throw ParseError(path_, 0, "grid.crs", name != nullptr ? name : "not geographic",
+                       std::string("a geographic CRS in degrees; ") + kExpectedGrid);
+    }
+  }
+
+  double gt[6] = {0, 1, 0, 0, 0, 1};
+  if (ds->GetGeoTransform(gt) != CE_None || gt[2] != 0.0 || gt[4] != 0.0 || !(gt[1] > 0.0) || gt[5] == 0.0) {
+    std::ostringstream v;
+    v << "geotransform (" << gt[0] << ", " << gt[1] << ", " << gt[2] << ", " << gt[3] << ", " << gt[4]
+      << ", " << gt[5] << ")";
+    throw ParseError(path_, 0, "grid.geotransform", v.str(),
+                     std::string("an axis-aligned geographic grid; ") + kExpectedGrid);
+  }
+  rows_ = ds->GetRasterYSize();
+  cols_ = ds->GetRasterXSize();
+  dlon_deg_ = gt[1];
+  dlat_deg_ = gt[5];
+  // GDAL pixel centres are the grid nodes (for GTX, GDAL shifts the origin by half a cell).
+  lon0_deg_ = gt[0] + 0.5 * gt[1];
+  lat0_deg_ = gt[3] + 0.5 * gt[5];
+
+  const double period = 360.0 / dlon_deg_;
+  period_cols_ = static_cast<int>(std::lround(period));
+  if (std::abs(period - period_cols_) > kPeriodTol_cols || cols_ < period_cols_) {
+    std::ostringstream v;
+    v << cols_ << " columns of " << dlon_deg_ << " deg";
+    throw ParseError(path_, 0, "grid.columns", v.str(),
+                     std::string("a global grid (360 deg of longitude); ") + kExpectedGrid);
+  }
+  const double lat_first = lat0_deg_;
+  const double lat_last = lat0_deg_ + (rows_ - 1) * dlat_deg_;
+  const double row_step = std::abs(dlat_deg_);
+  if (std::max(lat_first, lat_last) < 90.0 - row_step - kPoleTol_deg ||
+      std::min(lat_first, lat_last) > -90.0 + row_step + kPoleTol_deg) {
+    std::ostringstream v;
+    v << "rows from lat " << lat_first << " to " << lat_last << " deg";
+    throw ParseError(path_, 0, "grid.rows", v.str(),
+                     std::string("a global grid reaching to within one row of both poles; ") + kExpectedGrid);
+  }
+
+  GDALRasterBand* band = ds->GetRasterBand(1);
+  int has_nodata = 0;
+  const double nodata = band->GetNoDataValue(&has_nodata);
+  int has_scale = 0, has_offset = 0;
+  const double scale = band->GetScale(&has_scale);
+  const double offset = band->GetOffset(&has_offset);
+  std::vector<double> row(static_cast<std::size_t>(cols_));
+  n_m_.resize(static_cast<std::size_t>(rows_) * static_cast<std::size_t>(cols_));
+  for (int r = 0; r < rows_; ++r) {
+    if (band->RasterIO(GF_Read, 0, r, cols_, 1, row.data(), cols_, 1, GDT_Float64, 0, 0, nullptr) != CE_None) {
+      throw ParseError(path_, 0, "grid.band1", "unreadable row " + std::to_string(r) + " (" +
+                       gdalMessage("read error") + ")", kExpectedGrid);
+    }
+    for (int c = 0; c < cols_; ++c) {
+      const double raw = row[static_cast<std::size_t>(c)];
+      if (!std::isfinite(raw) || (has_nodata != 0 && raw == nodata)) {
+        std::ostringstream v;
+        v << "void (nodata) node at row " << r << ", column " << c;
+        throw ParseError(path_, 0, "grid.band1", v.str(), std::string("a void-free grid; ") + kExpectedGrid);
+      }
+      n_m_[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols_) + static_cast<std::size_t>(c)] =
+          static_cast<float>(raw * (has_scale != 0 ? scale : 1.0) + (has_offset != 0 ? offset : 0.0));
+    }
+  }
+}
+
+const Geoid& Geoid::egm96() {
+  // A function-local static is initialised once even under concurrent first calls (C++11
+  // [stmt.dcl]/4); if the constructor throws, the next call tries again.
+  static const Geoid geoid([] {
+    const char* env = std::getenv("SKYLANE_GEOID_GRID");
+    return (env != nullptr && *env != '\0') ? std::string(env) : std::string(SKYLANE_GEOID_GRID);
+  }());
+  return geoid;
+}
+
+double Geoid::wrappedColumn(double lon_deg) const {
+  double x = std::fmod((lon_deg - lon0_deg_) / dlon_deg_, static_cast<double>(period_cols_));
+  if (x < 0.0) x += period_cols_;
+  if (x >= period_cols_) x -= period_cols_;  // -tiny + period rounds up to period
+  return x;
+}
+
+double Geoid::clampedRow(double lat_deg) const {
+  return std::clamp((lat_deg - lat0_deg_) / dlat_deg_, 0.0, static_cast<double>(rows_ - 1));
+}
+
+double Geoid::undulation_m(double lat_rad, double lon_rad) const {
+  requireFinite(lat_rad, lon_rad, "Geoid::undulation_m");
+  const double x = wrappedColumn(rad2deg(lon_rad));
+  const double y = clampedRow(rad2deg(lat_rad));
+  const int c0 = std::min(static_cast<int>(x), period_cols_ - 1);
+  const int c1 = (c0 + 1) % period_cols_;
+  const int r0 = std::min(static_cast<int>(y), rows_ - 1);
+  const int r1 = std::min(r0 + 1, rows_ - 1);
+  const double fx = x - c0, fy = y - r0;
+  const double top = (1.0 - fx) * node_m(r0, c0) + fx * node_m(r0, c1);
+  const double bottom = (1.0 - fx) * node_m(r1, c0) + fx * node_m(r1, c1);
+  return (1.0 - fy) * top + fy * bottom;
+}
+
+double Geoid::ellipsoidalFromAmsl_m(double lat_rad, double lon_rad, double alt_amsl_m) const {
+  if (!std::isfinite(alt_amsl_m)) throw std::invalid_argument("Geoid::ellipsoidalFromAmsl_m: altitude AMSL is not finite");
+  return alt_amsl_m + undulation_m(lat_rad, lon_rad);
+}
+
+double Geoid::amslFromEllipsoidal_m(double lat_rad, double lon_rad, double h_ell_m) const {
+  if (!std::isfinite(h_ell_m)) throw std::invalid_argument("Geoid::amslFromEllipsoidal_m: ellipsoidal height is not finite");
+  return h_ell_m - undulation_m(lat_rad, lon_rad);
+}
+
+std::pair<double, double> Geoid::undulationRange_m(double lat_min_rad, double lat_max_rad,
+                                                   double lon_west_rad, double lon_east_rad) const {
+  if (!std::isfinite(lat_min_rad) || !std::isfinite(lat_max_rad) || !std::isfinite(lon_west_rad) ||
+      !std::isfinite(lon_east_rad) || lat_min_rad > lat_max_rad || lon_east_rad < lon_west_rad) {
+    std::ostringstream msg;
+    msg << "Geoid::undulationRange_m: box lat " << rad2deg(lat_min_rad) << ".." << rad2deg(lat_max_rad)
+        << " deg, lon " << rad2deg(lon_west_rad) << ".." << rad2deg(lon_east_rad)
+        << " deg is not finite or not ordered (min <= max, west <= east)";
+    throw std::invalid_argument(msg.str());
+  }
+  const double ya = clampedRow(rad2deg(std::clamp(lat_min_rad, -M_PI / 2, M_PI / 2)));
+  const double yb = clampedRow(rad2deg(std::clamp(lat_max_rad, -M_PI / 2, M_PI / 2)));
+  const int r_lo = static_cast<int>(std::floor(std::min(ya, yb)));
+  const int r_hi = std::min(static_cast<int>(std::ceil(std::max(ya, yb))), rows_ - 1);
+  // Columns: from the west edge's left node eastwards, span columns (whole circle at most).
+  const double span_cols = (rad2deg(lon_east_rad) - rad2deg(lon_west_rad)) / dlon_deg_;
+  const double x_west = wrappedColumn(rad2deg(lon_west_rad));
+  const int c_first = static_cast<int>(std::floor(x_west));
+  const int n_cols = std::min(static_cast<int>(std::ceil(x_west + span_cols)) - c_first + 1, period_cols_);
+  double lo = node_m(r_lo, c_first % period_cols_), hi = lo;
+  for (int r = r_lo; r <= r_hi; ++r) {
+    for (int k = 0; k < n_cols; ++k) {
+      const double n = node_m(r, (c_first + k) % period_cols_);
+      lo = std::min(lo, n);
+      hi = std::max(hi, n);
+    }
+  }
+  return {lo, hi};
+}
+
+}  // namespace skylane::maps

@@ -1,0 +1,344 @@
+#include "maps/terrain.hpp"
+
+#include "maps/geodesy.hpp"
+#include "maps/geoid.hpp"
+#include "maps/parse_error.hpp"
+
+#include <cpl_error.h>
+#include <gdal_priv.h>
+#include <ogr_spatialref.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+namespace skylane::maps {
+namespace {
+
+/// What a terrain file must be, in every ParseError this file raises.
+constexpr const char* kExpectedRaster =
+    "an elevation raster GDAL can read (GeoTIFF, ESRI ASCII grid .asc, SRTM .hgt) with a geotransform";
+
+/// Points per edge when a latitude/longitude box is traced into the raster's CRS (box of
+/// rangeAmsl_m) or the raster's footprint into WGS-84 (describe()). A box edge's image in a
+/// projected CRS bends by far less than a cell between samples this close (a 100 km edge in
+/// UTM: sagitta ~5 cm), and kProjectedPad_px covers the rest.
+constexpr int kEdgeSamples = 64;
+/// Pixels added around a box traced into a projected CRS, for the bending between samples.
+constexpr double kProjectedPad_px = 1.0;
+/// One degree is this many degrees of a geographic CRS's angular unit when that unit is the
+/// degree (to rounding); only then are longitudes wrapped by 360.
+constexpr double kDegreeUnitTol = 1e-9;
+
+void registerGdalOnce() {
+  static const bool registered = [] {
+    GDALAllRegister();
+    return true;
+  }();
+  (void)registered;
+}
+
+/// GDAL's last error message, or a fallback when GDAL left none.
+std::string gdalMessage(const char* fallback) {
+  const char* msg = CPLGetLastErrorMsg();
+  return (msg != nullptr && *msg != '\0') ? std::string(msg) : std::string(fallback);
+}
+
+void requireLatLon(double lat_rad, double lon_rad, const char* what) {
+  if (!std::isfinite(lat_rad) || !std::isfinite(lon_rad) || std::abs(lat_rad) > M_PI / 2 + 1e-12) {
+    std::ostringstream msg;
+    msg << what << ": position (lat " << rad2deg(lat_rad) << " deg, lon " << rad2deg(lon_rad)
+        << " deg) is not finite or latitude is outside [-90, 90] deg";
+    throw std::invalid_argument(msg.str());
+  }
+}
+
+/// x wrapped by whole turns into [centre − 180, centre + 180).
+double wrapDeg(double x_deg, double centre_deg) {
+  return x_deg - 360.0 * std::floor((x_deg - centre_deg + 180.0) / 360.0);
+}
+
+struct CtDeleter {
+  void operator()(OGRCoordinateTransformation* ct) const { OGRCoordinateTransformation::DestroyCT(ct); }
+};
+using CtPtr = std::unique_ptr<OGRCoordinateTransformation, CtDeleter>;
+
+/// WGS-84 geographic, longitude first (what skylane's radians become before GDAL sees them).
+OGRSpatialReference wgs84LonLat() {
+  OGRSpatialReference srs;
+  srs.SetWellKnownGeogCS("WGS84");
+  srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  return srs;
+}
+
+}  // namespace
+
+struct Terrain::Raster {
+  std::string path;
+  std::string driver;
+  std::string crs;            ///< CRS name, or the no-CRS assumption spelled out.
+  int cols = 0;
+  int rows = 0;
+  double inv_gt[6] = {0, 1, 0, 0, 0, 1};  ///< Raster CRS (x, y) → pixel (u, v), GDAL layout.
+  std::vector<float> z_m;     ///< Band 1, row-major; NaN marks a void.
+  bool identity = false;      ///< Raster CRS is WGS-84 lon/lat (or assumed so): no transformation.
+  bool wrap_lon = false;      ///< Geographic CRS in degrees: longitudes wrap by 360.
+  double lon_centre_deg = 0;  ///< Longitude of the raster's centre (wrap reference).
+  CtPtr to_raster;            ///< WGS-84 lon/lat → raster CRS (when not identity).
+  mutable std::mutex ct_mutex;
+  double lat_min_deg = 0, lat_max_deg = 0, lon_min_deg = 0, lon_max_deg = 0;  ///< WGS-84 footprint.
+
+  [[nodiscard]] float at(int r, int c) const {
+    return z_m[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)];
+  }
+
+  /// Pixel coordinates (u, v) of a WGS-84 point: u = 0 at the raster's left edge, u = cols at
+  /// its right edge, the centre of column i at u = i + 0.5 (GDAL convention). nullopt when the
+  /// transformation fails (point outside the CRS's domain).
+  [[nodiscard]] std::optional<std::pair<double, double>> toPixel(double lat_deg, double lon_deg) const {
+    double x = lon_deg, y = lat_deg;
+    if (!identity) {
+      const std::lock_guard<std::mutex> lock(ct_mutex);
+      if (!to_raster->Transform(1, &x, &y) || !std::isfinite(x) || !std::isfinite(y)) return std::nullopt;
+    }
+    if (wrap_lon) x = wrapDeg(x, lon_centre_deg);
+    return std::make_pair(inv_gt[0] + inv_gt[1] * x + inv_gt[2] * y, inv_gt[3] + inv_gt[4] * x + inv_gt[5] * y);
+  }
+
+  /// Bilinear between pixel centres; nullopt outside the footprint or next to a void.
+  [[nodiscard]] std::optional<double> interpolate(double u, double v) const {
+    if (!(u >= 0.0 && u <= cols && v >= 0.0 && v <= rows)) return std::nullopt;
+    const double s = std::clamp(u - 0.5, 0.0, static_cast<double>(cols - 1));
+    const double t = std::clamp(v - 0.5, 0.0, static_cast<double>(rows - 1));
+    const int c0 = std::min(static_cast<int>(s), cols - 1), c1 = std::min(c0 + 1, cols - 1);
+    const int r0 = std::min(static_cast<int>(t), rows - 1), r1 = std::min(r0 + 1, rows - 1);
+    const double z00 = at(r0, c0), z01 = at(r0, c1), z10 = at(r1, c0), z11 = at(r1, c1);
+    if (std::isnan(z00) || std::isnan(z01) || std::isnan(z10) || std::isnan(z11)) return std::nullopt;
+    const double fs = s - c0, ft = t - r0;
+    return (1.0 - ft) * ((1.0 - fs) * z00 + fs * z01) + ft * ((1.0 - fs) * z10 + fs * z11);
+  }
+};
+
+Terrain Terrain::flat(double alt_amsl_m) {
+  if (!std::isfinite(alt_amsl_m)) throw std::invalid_argument("Terrain::flat: altitude AMSL is not finite");
+  Terrain t;
+  t.flat_alt_amsl_m_ = alt_amsl_m;
+  return t;
+}
+
+Terrain Terrain::fromRaster(const std::string& path, HeightDatum datum) {
+  registerGdalOnce();
+  // GDAL reports through a thread-local handler stack: keep its messages off stderr, they go
+  // into the ParseError instead.
+  CPLErrorHandlerPusher quiet(CPLQuietErrorHandler);
+  CPLErrorReset();
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(),
+                                            GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR));
+  if (!ds) throw ParseError(path, 0, "raster", "unreadable (" + gdalMessage("GDAL cannot open it") + ")", kExpectedRaster);
+  if (ds->GetRasterCount() < 1) throw ParseError(path, 0, "raster", "no raster band", kExpectedRaster);
+
+  auto r = std::make_shared<Raster>();
+  r->path = path;
+  r->driver = ds->GetDriver() != nullptr ? ds->GetDriver()->GetDescription() : "?";
+  r->cols = ds->GetRasterXSize();
+  r->rows = ds->GetRasterYSize();
+  if (static_cast<long long>(r->cols) * r->rows > kMaxRasterCells) {
+    throw ParseError(path, 0, "raster.size", std::to_string(r->cols) + " x " + std::to_string(r->rows) + " cells",
+                     "at most " + std::to_string(kMaxRasterCells) + " cells (crop the DEM to the mission area)");
+  }
+
+  double gt[6] = {0, 1, 0, 0, 0, 1};
+  if (ds->GetGeoTransform(gt) != CE_None || GDALInvGeoTransform(gt, r->inv_gt) == FALSE) {
+    throw ParseError(path, 0, "raster.geotransform", "none or singular", kExpectedRaster);
+  }
+  const auto edgeX = [&](double u, double v) { return gt[0] + u * gt[1] + v * gt[2]; };
+  const auto edgeY = [&](double u, double v) { return gt[3] + u * gt[4] + v * gt[5]; };
+
+  // --- CRS: WGS-84 lon/lat → raster CRS ---------------------------------------------------
+  const OGRSpatialReference wgs84 = wgs84LonLat();
+  CtPtr to_wgs84;
+  const OGRSpatialReference* ds_srs = ds->GetSpatialRef();
+  if (ds_srs == nullptr || ds_srs->IsEmpty()) {
+    r->identity = true;
+    r->wrap_lon = true;
+    r->crs = "none (assumed WGS-84 lon/lat, degrees)";
+  } else {
+    OGRSpatialReference srs(*ds_srs);
+    srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    const char* name = srs.GetName();
+    r->crs = name != nullptr ? name : "unnamed";
+    r->wrap_lon = srs.IsGeographic() && std::abs(rad2deg(srs.GetAngularUnits(nullptr)) - 1.0) <= kDegreeUnitTol;
+    r->identity = srs.IsSame(&wgs84);
+    if (!r->identity) {
+      r->to_raster.reset(OGRCreateCoordinateTransformation(&wgs84, &srs));
+      to_wgs84.reset(OGRCreateCoordinateTransformation(&srs, &wgs84));
+      if (!r->to_raster || !to_wgs84) {
+        throw ParseError(path, 0, "raster.crs", r->crs + " (" + gdalMessage("no transformation from WGS-84") + ")",
+                         "a CRS PROJ can transform WGS-84 longitude/latitude into");
+      }
+    }
+  }
+  r->lon_centre_deg = edgeX(0.5 * r->cols, 0.5 * r->rows);
+
+  // --- WGS-84 footprint, traced along the raster's edges ----------------------------------
+  bool first = true;
+  for (int k = 0; k <= kEdgeSamples; ++k) {
+    const double f = static_cast<double>(k) / kEdgeSamples;
+    const double uv[4][2] = {{f * r->cols, 0.0}, {f * r->cols, 1.0 * r->rows}, {0.0, f * r->rows}, {1.0 * r->cols, f * r->rows}};
+    for (const auto& p : uv) {
+      double x = edgeX(p[0], p[1]), y = edgeY(p[0], p[1]);
+      if (to_wgs84 && (!to_wgs84->Transform(1, &x, &y) || !std::isfinite(x) || !std::isfinite(y))) continue;
+      if (first) {
+        r->lon_min_deg = r->lon_max_deg = x;
+        r->lat_min_deg = r->lat_max_deg = y;
+        first = false;
+      }
+      r->lon_min_deg = std::min(r->lon_min_deg, x);
+      r->lon_max_deg = std::max(r->lon_max_deg, x);
+      r->lat_min_deg = std::min(r->lat_min_deg, y);
+      r->lat_max_deg = std::max(r->lat_max_deg, y);
+    }
+  }
+  if (first) throw ParseError(path, 0, "raster.crs", r->crs, "a raster whose footprint maps to WGS-84 longitude/latitude");
+
+  // --- band 1, whole, voids as NaN -----------------------------------------------------------
+  GDALRasterBand* band = ds->GetRasterBand(1);
+  int has_nodata = 0, has_scale = 0, has_offset = 0;
+  const double nodata = band->GetNoDataValue(&has_nodata);
+  const double scale = band->GetScale(&has_scale);
+  const double offset = band->GetOffset(&has_offset);
+  std::vector<double> row(static_cast<std::size_t>(r->cols));
+  r->z_m.resize(static_cast<std::size_t>(r->cols) * static_cast<std::size_t>(r->rows));
+  for (int j = 0; j < r->rows; ++j) {
+    if (band->RasterIO(GF_Read, 0, j, r->cols, 1, row.data(), r->cols, 1, GDT_Float64, 0, 0, nullptr) != CE_None) {
+      throw ParseError(path, 0, "raster.band1", "unreadable row " + std::to_string(j) + " (" + gdalMessage("read error") + ")",
+                       kExpectedRaster);
+    }
+    float* out = r->z_m.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(r->cols);
+    for (int i = 0; i < r->cols; ++i) {
+      const double raw = row[static_cast<std::size_t>(i)];
+      const bool is_void = !std::isfinite(raw) || (has_nodata != 0 && raw == nodata);
+      out[i] = is_void ? std::numeric_limits<float>::quiet_NaN()
+                       : static_cast<float>(raw * (has_scale != 0 ? scale : 1.0) + (has_offset != 0 ? offset : 0.0));
+    }
+  }
+
+  Terrain t;
+  t.raster_ = std::move(r);
+  t.datum_ = datum;
+  return t;
+}
+
+std::optional<double> Terrain::altAmsl_m(double lat_rad, double lon_rad) const {
+  requireLatLon(lat_rad, lon_rad, "Terrain::altAmsl_m");
+  if (!raster_) return flat_alt_amsl_m_;
+  const auto uv = raster_->toPixel(rad2deg(lat_rad), rad2deg(lon_rad));
+  if (!uv) return std::nullopt;
+  const std::optional<double> z_m = raster_->interpolate(uv->first, uv->second);
+  if (!z_m || datum_ == HeightDatum::kAmslEgm96) return z_m;
+  return Geoid::egm96().amslFromEllipsoidal_m(lat_rad, lon_rad, *z_m);
+}
+
+std::optional<double> Terrain::heightEllipsoid_m(double lat_rad, double lon_rad) const {
+  requireLatLon(lat_rad, lon_rad, "Terrain::heightEllipsoid_m");
+  if (!raster_) return Geoid::egm96().ellipsoidalFromAmsl_m(lat_rad, lon_rad, flat_alt_amsl_m_);
+  const auto uv = raster_->toPixel(rad2deg(lat_rad), rad2deg(lon_rad));
+  if (!uv) return std::nullopt;
+  const std::optional<double> z_m = raster_->interpolate(uv->first, uv->second);
+  if (!z_m || datum_ == HeightDatum::kEllipsoid) return z_m;
+  return Geoid::egm96().ellipsoidalFromAmsl_m(lat_rad, lon_rad, *z_m);
+}
+
+std::optional<std::pair<double, double>> Terrain::rangeAmsl_m(
+    const std::vector<std::pair<double, double>>& ring_lat_lon_rad) const {
+  if (ring_lat_lon_rad.empty()) throw std::invalid_argument("Terrain::rangeAmsl_m: the ring has no vertex");
+  for (const auto& [lat_rad, lon_rad] : ring_lat_lon_rad) requireLatLon(lat_rad, lon_rad, "Terrain::rangeAmsl_m");
+  if (!raster_) return std::make_pair(flat_alt_amsl_m_, flat_alt_amsl_m_);
+
+  // --- bounding box in degrees; longitudes unwrapped along the ring -----------------------
+  double lat_min = 90.0, lat_max = -90.0, lat_sum = 0.0;
+  double lon_prev = rad2deg(ring_lat_lon_rad.front().second);
+  double west = lon_prev, east = lon_prev;
+  for (const auto& [lat_rad, lon_rad] : ring_lat_lon_rad) {
+    const double lat = rad2deg(lat_rad);
+    lat_min = std::min(lat_min, lat);
+    lat_max = std::max(lat_max, lat);
+    lat_sum += lat;
+    const double lon = wrapDeg(rad2deg(lon_rad), lon_prev);  // the shorter way round from the previous vertex
+    west = std::min(west, lon);
+    east = std::max(east, lon);
+    lon_prev = lon;
+  }
+  // Closing edge back to the first vertex: a ring around a pole comes back one turn off.
+  const double lon_first = rad2deg(ring_lat_lon_rad.front().second);
+  if (std::abs(wrapDeg(lon_first, lon_prev) - lon_first) > 180.0) {
+    west = -180.0;
+    east = 180.0;
+    if (lat_sum >= 0.0) lat_max = 90.0;
+    else lat_min = -90.0;
+  }
+
+  // --- the box traced into pixel coordinates ----------------------------------------------
+  double u_min = std::numeric_limits<double>::infinity(), u_max = -u_min, v_min = u_min, v_max = -u_min;
+  for (int k = 0; k <= kEdgeSamples; ++k) {
+    const double f = static_cast<double>(k) / kEdgeSamples;
+    const double lat_f = lat_min + f * (lat_max - lat_min), lon_f = west + f * (east - west);
+    const double pts[4][2] = {{lat_min, lon_f}, {lat_max, lon_f}, {lat_f, west}, {lat_f, east}};
+    for (const auto& p : pts) {
+      const auto uv = raster_->toPixel(p[0], p[1]);
+      if (!uv) return std::nullopt;  // part of the box has no image in the raster's CRS
+      u_min = std::min(u_min, uv->first);
+      u_max = std::max(u_max, uv->first);
+      v_min = std::min(v_min, uv->second);
+      v_max = std::max(v_max, uv->second);
+    }
+  }
+  const int cols = raster_->cols, rows = raster_->rows;
+  if (u_min < 0.0 || v_min < 0.0 || u_max > cols || v_max > rows) return std::nullopt;
+  if (!raster_->identity) {
+    u_min = std::max(0.0, u_min - kProjectedPad_px);
+    v_min = std::max(0.0, v_min - kProjectedPad_px);
+    u_max = std::min(static_cast<double>(cols), u_max + kProjectedPad_px);
+    v_max = std::min(static_cast<double>(rows), v_max + kProjectedPad_px);
+  }
+  // Columns the interpolation can use for u in [u_min, u_max]: floor(u − ½) and the next one.
+  const int c_lo = std::clamp(static_cast<int>(std::floor(u_min - 0.5)), 0, cols - 1);
+  const int c_hi = std::clamp(static_cast<int>(std::floor(u_max - 0.5)) + 1, 0, cols - 1);
+  const int r_lo = std::clamp(static_cast<int>(std::floor(v_min - 0.5)), 0, rows - 1);
+  const int r_hi = std::clamp(static_cast<int>(std::floor(v_max - 0.5)) + 1, 0, rows - 1);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (int j = r_lo; j <= r_hi; ++j) {
+    for (int i = c_lo; i <= c_hi; ++i) {
+      const double z = raster_->at(j, i);
+      if (std::isnan(z)) return std::nullopt;  // a void: the terrain there is unknown
+      lo = std::min(lo, z);
+      hi = std::max(hi, z);
+    }
+  }
+  if (datum_ == HeightDatum::kEllipsoid) {
+    const auto [n_lo, n_hi] = Geoid::egm96().undulationRange_m(deg2rad(lat_min), deg2rad(lat_max),
+                                                                 deg2rad(west), deg2rad(east));
+    return std::make_pair(lo - n_hi, hi - n_lo);
+  }
+  return std::make_pair(lo, hi);
+}
+
+std::string Terrain::describe() const {
+  std::ostringstream out;
+  if (!raster_) {
+    out << "flat terrain at " << flat_alt_amsl_m_ << " m above the EGM96 geoid";
+    return out.str();
+  }
+  const Raster& r = *raster_;
+  out.precision(6);
+  out << "raster '" << r.path << "' (" << r.driver << ", " << r.cols << " x " << r.rows << " cells, CRS "
+      << r.crs << ", lat " << r.lat_min_deg << ".." << r.lat_max_deg << " deg, lon " << r.lon_min_deg << ".."
+      << r.lon_max_deg << " deg, heights above the "
+      << (datum_ == HeightDatum::kAmslEgm96 ? "EGM96 geoid" : "WGS-84 ellipsoid") << ")";
+  return out.str();
+}
+
+}  // namespace skylane::maps
