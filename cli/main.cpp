@@ -2,6 +2,7 @@
 /// \brief The `skylane` command: parse, call, print; errors → one line on stderr, exit 2.
 
 #include "cli/integrity_commands.hpp"
+#include "cli/zones_commands.hpp"
 #include "integrity/gnss/parse_error.hpp"
 
 #include <CLI/CLI.hpp>
@@ -13,11 +14,14 @@ int main(int argc, char** argv) {
   CLI::App app{"skylane: airspace geofence and path-planning integrity planner for unmanned aircraft"};
   app.require_subcommand(1);
   skylane::cli::addIntegrityCommands(app);
+  skylane::cli::addZonesCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
+  } catch (const skylane::cli::ExitStatus& e) {
+    return e.status;
   } catch (const skylane::integrity::ParseError& e) {
     std::cerr << "skylane: error: " << e.what() << "\n";
     return 2;

@@ -157,5 +157,63 @@ TEST(Cli, AvailabilityMapHasCellsColourScaleAndCoastlines) {
   EXPECT_NE(text.find("availability"), std::string::npos);
 }
 
+TEST(Cli, ZonesValidateReportsEveryZoneAndExitsTwoWhenInvalid) {
+  const RunResult ok = run("zones validate " + test::dataPath("geozones/geo-awareness-che-1.json") + " " +
+                           test::dataPath("geozones/cis_source_sample_ed318.json"));
+  EXPECT_EQ(ok.status, 0) << ok.out;
+  EXPECT_NE(ok.out.find("features[2](Lausanne Airport): ok (3 volumes, PROHIBITED)"), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find("note: repeated vertex removed (lat 46.53194, lon 6.596603) [volume 1]"), std::string::npos);
+  const RunResult bad = run("zones validate " + test::dataPath("geozones/bowtie_ed269.json"));
+  EXPECT_EQ(bad.status, 2) << bad.out;
+  EXPECT_NE(bad.out.find("UASZoneList[0](BOWTIE): INVALID"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("error: self-intersecting ring: edge from vertex 0"), std::string::npos) << bad.out;
+  const RunResult fixed = run("zones validate --repair " + test::dataPath("geozones/bowtie_ed269.json"));
+  EXPECT_EQ(fixed.status, 0) << fixed.out;
+  EXPECT_NE(fixed.out.find("repaired: self-intersecting ring"), std::string::npos) << fixed.out;
+  const RunResult missing = run("zones at --lat 46 --lon 7 --h-ell 100 --time 2026-01-01T00:00:00Z /nonexistent.json");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.out.find("/nonexistent.json: field 'file'"), std::string::npos) << missing.out;
+}
+
+TEST(Cli, ZonesAtSaysWhichZonesApplyAndWhy) {
+  // Montreux concert area (prohibited SAT/SUN 17:00Z–24:00) and the wildlife preserve overlap here.
+  const std::string che = test::dataPath("geozones/geo-awareness-che-1.json");
+  const RunResult sat = run("zones at " + che + " --lat 46.430758 --lon 6.913146 --height-agl 50 --time 2022-06-18T18:00:00Z");
+  ASSERT_EQ(sat.status, 0) << sat.out;
+  const nlohmann::json j = nlohmann::json::parse(sat.out);
+  ASSERT_EQ(j["applies"].size(), 2u) << sat.out;
+  EXPECT_EQ(j["applies"][0]["zone"], "Montreux Concert Area");
+  EXPECT_EQ(j["applies"][0]["restriction"], "PROHIBITED");
+  EXPECT_EQ(j["applies"][1]["restriction"], "REQ_AUTHORISATION");
+  // 50 m AGL over flat terrain at 0 m AMSL = 50 m + N (EGM96 ≈ 49.76 m at Montreux) ellipsoidal.
+  EXPECT_NEAR(j["position"]["h_ell_m"].get<double>(), 99.76, 0.05);
+  // Monday: the concert area no longer applies, the preserve still does.
+  const RunResult mon = run("zones at " + che + " --lat 46.430758 --lon 6.913146 --height-agl 50 --time 2022-06-20T18:00:00Z");
+  const nlohmann::json m = nlohmann::json::parse(mon.out);
+  ASSERT_EQ(m["applies"].size(), 1u) << mon.out;
+  EXPECT_EQ(m["inside_outline_but_not_applying"][0]["why"], "inside the outline, between floor and ceiling; not active at this time");
+  // Above the 120 m AGL ceiling of the preserve.
+  const RunResult high = run("zones at " + che + " --lat 46.430758 --lon 6.913146 --height-agl 150 --time 2022-06-20T18:00:00Z");
+  EXPECT_EQ(nlohmann::json::parse(high.out)["applies"].size(), 0u) << high.out;
+}
+
+TEST(Cli, ZonesExportWritesGeoJsonWithBothHeightReferences) {
+  const std::string out = ::testing::TempDir() + "/zones.geojson";
+  const RunResult r = run("zones export " + test::dataPath("geozones/geo-awareness-che-1.json") + " " +
+                          test::dataPath("geozones/qgc_fence.plan") + " --to geojson -o " + out);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream f(out);
+  const nlohmann::json j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["type"], "FeatureCollection");
+  ASSERT_EQ(j["features"].size(), 10u + 3u);  // one feature per volume (CHE-1: 1+3+3+1+1+1)
+  const nlohmann::json& montreux = j["features"][0]["properties"];
+  EXPECT_EQ(montreux["upper"]["as_given"], "6259 M AMSL");
+  const double n = montreux["upper_resolved"]["h_ell_m"][0].get<double>() - 6259.0;
+  EXPECT_NEAR(n, 49.76, 0.05);  // EGM96 undulation at Montreux
+  EXPECT_EQ(montreux["upper_resolved"]["alt_amsl_m"][0], 6259.0);
+  // The polygon of Lausanne's second volume: the repeated vertex is gone, the ring closed again.
+  EXPECT_EQ(j["features"][5]["geometry"]["coordinates"][0].size(), 4u);
+}
+
 }  // namespace
 }  // namespace skylane

@@ -1,0 +1,318 @@
+#include "cli/zones_commands.hpp"
+
+#include "airspace/applicability.hpp"
+#include "airspace/loaders.hpp"
+#include "airspace/validation.hpp"
+#include "airspace/vertical.hpp"
+#include "airspace/zone_geometry.hpp"
+#include "maps/geodesy.hpp"
+#include "maps/geoid.hpp"
+#include "maps/parse_error.hpp"
+#include "maps/terrain.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+namespace skylane::cli {
+namespace {
+
+using nlohmann::json;
+using maps::ParseError;
+
+struct ValidateOptions {
+  std::vector<std::string> files;
+  std::string format = "auto";
+  bool repair = false;
+};
+
+struct AtOptions {
+  std::vector<std::string> files;
+  std::string format = "auto";
+  double lat_deg = NAN, lon_deg = NAN;
+  std::optional<double> alt_amsl_m, height_agl_m, h_ell_m;
+  std::string time;
+  std::string terrain;
+};
+
+struct ExportOptions {
+  std::vector<std::string> files;
+  std::string format = "auto";
+  std::string to = "geojson";
+  std::string output;
+  std::string terrain;
+  bool repair = false;
+};
+
+airspace::ZoneFormat zoneFormat(const std::string& text) {
+  const auto f = airspace::parseZoneFormat(text);
+  if (!f) throw ParseError("--format", 0, "--format", text, "auto, ed269, ed318, geojson or qgc");
+  return *f;
+}
+
+maps::Terrain loadTerrain(const std::string& path) {
+  return path.empty() ? maps::Terrain::flat(0.0) : maps::Terrain::fromRaster(path);
+}
+
+double r3(double v) { return std::round(v * 1e3) / 1e3; }
+json height(double v) { return std::isfinite(v) ? json(r3(v)) : json(nullptr); }
+
+json limitJson(const airspace::VerticalLimit& l) {
+  json j;
+  j["as_given"] = l.as_given;
+  j["reference"] = std::string(airspace::referenceName(l.reference));
+  j["value_m"] = l.unlimited ? json(nullptr) : json(r3(l.value_m));
+  j["unlimited"] = l.unlimited;
+  return j;
+}
+
+json applicabilityJson(const airspace::Zone& z) {
+  json list = json::array();
+  for (const airspace::Applicability& a : z.applicability) {
+    json j;
+    j["permanent"] = a.permanent;
+    if (a.start) j["start"] = maps::formatRfc3339(*a.start);
+    if (a.end) j["end"] = maps::formatRfc3339(*a.end);
+    json schedule = json::array();
+    for (const airspace::DailyPeriod& p : a.schedule) {
+      static const char* const kDays[] = {"MON", "TUE", "WED", "THU", "FRI", "SAT", "SUN"};
+      json days = json::array();
+      for (unsigned d = 0; d < 7; ++d) {
+        if (p.days & (1u << d)) days.push_back(kDays[d]);
+      }
+      schedule.push_back({{"day", days}, {"start_utc_s", p.start_s}, {"end_utc_s", p.end_s}});
+    }
+    if (!schedule.empty()) j["schedule"] = schedule;
+    list.push_back(j);
+  }
+  return list;
+}
+
+void runValidate(const ValidateOptions& o) {
+  bool all_ok = true;
+  for (const std::string& path : o.files) {
+    std::vector<airspace::Zone> zones;
+    try {
+      zones = airspace::readZoneFile(path, zoneFormat(o.format));
+    } catch (const ParseError& e) {
+      std::cout << path << ": INVALID: " << e.what() << "\n";
+      all_ok = false;
+      continue;
+    }
+    const airspace::ValidationReport report = airspace::validateZones(zones, o.repair);
+    for (std::size_t i = 0; i < zones.size(); ++i) {
+      std::string status = "ok";
+      for (const airspace::ZoneIssue& issue : report.issues) {
+        if (issue.zone != i || !issue.error) continue;
+        if (!issue.repaired) status = "INVALID";
+        else if (status == "ok") status = "repaired";
+      }
+      std::cout << airspace::describe(zones[i]) << ": " << status << " (" << zones[i].volumes.size() << " volume"
+                << (zones[i].volumes.size() == 1 ? "" : "s") << ", "
+                << airspace::restrictionName(zones[i].restriction) << ")\n";
+      for (const airspace::ZoneIssue& issue : report.issues) {
+        if (issue.zone != i) continue;
+        std::cout << "  " << (issue.error ? (issue.repaired ? "repaired: " : "error: ") : "note: ") << issue.what;
+        if (issue.volume >= 0) std::cout << " [volume " << issue.volume;
+        if (issue.vertex >= 0) std::cout << ", vertex " << issue.vertex;
+        if (issue.volume >= 0) std::cout << "]";
+        std::cout << "\n";
+      }
+    }
+    std::cout << path << ": " << zones.size() << " zone" << (zones.size() == 1 ? "" : "s") << ", "
+              << (report.ok() ? "valid" : "INVALID") << "\n";
+    all_ok = all_ok && report.ok();
+  }
+  if (!all_ok) throw ExitStatus(2);
+}
+
+void runAt(const AtOptions& o) {
+  if (!(std::abs(o.lat_deg) <= 90.0)) throw ParseError("--lat", 0, "--lat", std::to_string(o.lat_deg), "a latitude in [-90, 90]");
+  if (!(std::abs(o.lon_deg) <= 180.0)) throw ParseError("--lon", 0, "--lon", std::to_string(o.lon_deg), "a longitude in [-180, 180]");
+  const int given = (o.alt_amsl_m ? 1 : 0) + (o.height_agl_m ? 1 : 0) + (o.h_ell_m ? 1 : 0);
+  if (given != 1) throw ParseError("--alt-amsl", 0, "--alt-amsl|--height-agl|--h-ell", "", "exactly one height");
+  const auto t = maps::parseRfc3339(o.time);
+  if (!t) throw ParseError("--time", 0, "--time", o.time, "an RFC 3339 date-time such as 2026-11-23T14:00:00Z");
+  const maps::Terrain terrain = loadTerrain(o.terrain);
+  const maps::Geoid& geoid = maps::Geoid::egm96();
+  const airspace::VerticalModel model{terrain, geoid};
+  const airspace::LatLon p{maps::deg2rad(o.lat_deg), maps::deg2rad(o.lon_deg)};
+  double h_ell = 0.0;
+  if (o.h_ell_m) h_ell = *o.h_ell_m;
+  if (o.alt_amsl_m) h_ell = geoid.ellipsoidalFromAmsl_m(p.lat_rad, p.lon_rad, *o.alt_amsl_m);
+  if (o.height_agl_m) {
+    const auto ground = terrain.heightEllipsoid_m(p.lat_rad, p.lon_rad);
+    if (!ground) throw ParseError(o.terrain, 0, "--height-agl", std::to_string(*o.height_agl_m), "a point the terrain model covers");
+    h_ell = *ground + *o.height_agl_m;
+  }
+  json out;
+  out["position"] = {{"lat_deg", o.lat_deg}, {"lon_deg", o.lon_deg}, {"h_ell_m", r3(h_ell)},
+                     {"alt_amsl_m", r3(geoid.amslFromEllipsoidal_m(p.lat_rad, p.lon_rad, h_ell))}};
+  out["time"] = maps::formatRfc3339(*t);
+  out["terrain"] = terrain.describe();
+  json applies = json::array();
+  json nearby = json::array();
+  for (const std::string& path : o.files) {
+    for (const airspace::Zone& z : airspace::loadZones(path, zoneFormat(o.format))) {
+      const bool active = airspace::isActive(z, *t);
+      for (std::size_t vi = 0; vi < z.volumes.size(); ++vi) {
+        const airspace::Volume& v = z.volumes[vi];
+        const airspace::Side side = airspace::horizontalSide(v.outline, p);
+        const bool inside_h = side != airspace::Side::kOutside;
+        if (!inside_h) continue;
+        const auto floor = airspace::limitHeightEllipsoid_m(v.lower, false, p, model);
+        const auto ceiling = airspace::limitHeightEllipsoid_m(v.upper, true, p, model);
+        json j;
+        j["zone"] = z.identifier;
+        j["name"] = z.name;
+        j["file"] = z.source;
+        j["volume"] = vi;
+        j["restriction"] = std::string(airspace::restrictionName(z.restriction));
+        if (z.keep_in) j["keep_in"] = true;
+        j["message"] = z.message;
+        j["active"] = active;
+        j["horizontal"] = side == airspace::Side::kInside ? "inside" : "on the boundary";
+        j["floor"] = limitJson(v.lower);
+        j["ceiling"] = limitJson(v.upper);
+        j["floor_h_ell_m"] = floor ? height(*floor) : json("unknown terrain");
+        j["ceiling_h_ell_m"] = ceiling ? height(*ceiling) : json("unknown terrain");
+        const bool unknown = !floor || !ceiling;
+        const bool inside_v = !unknown && h_ell >= *floor && h_ell <= *ceiling;
+        std::string why = std::string(j["horizontal"].get<std::string>()) + " the outline";
+        if (unknown) {
+          why += "; the vertical limits need terrain that is not known here (counted as applying, on the safe side)";
+        } else if (inside_v) {
+          why += ", between floor and ceiling";
+        } else {
+          why += h_ell < *floor ? ", below the floor" : ", above the ceiling";
+        }
+        why += active ? "; active at this time" : "; not active at this time";
+        j["why"] = why;
+        const bool applies_here = (inside_v || unknown) && active;
+        j["applies"] = applies_here;
+        (applies_here ? applies : nearby).push_back(j);
+      }
+    }
+  }
+  out["applies"] = applies;
+  out["inside_outline_but_not_applying"] = nearby;
+  std::cout << out.dump(2) << "\n";
+}
+
+/// Ellipsoidal and AMSL range of a limit over the outline's vertices (or the circle's centre
+/// and four rim points): exact for WGS84 and AMSL limits up to the geoid's variation, a
+/// sample of the terrain for AGL limits.
+json resolvedRange(const airspace::VerticalLimit& l, bool ceiling, const airspace::Outline& o,
+                   const airspace::VerticalModel& model) {
+  std::vector<airspace::LatLon> pts = o.ring;
+  if (o.kind == airspace::Outline::Kind::kCircle) pts.push_back(o.centre);
+  double lo_ell = INFINITY, hi_ell = -INFINITY, lo_amsl = INFINITY, hi_amsl = -INFINITY;
+  for (const airspace::LatLon& p : pts) {
+    const auto h = airspace::limitHeightEllipsoid_m(l, ceiling, p, model);
+    if (!h) return json("unknown terrain");
+    const double amsl = std::isfinite(*h) ? model.geoid.amslFromEllipsoidal_m(p.lat_rad, p.lon_rad, *h) : *h;
+    lo_ell = std::min(lo_ell, *h);
+    hi_ell = std::max(hi_ell, *h);
+    lo_amsl = std::min(lo_amsl, amsl);
+    hi_amsl = std::max(hi_amsl, amsl);
+  }
+  return {{"h_ell_m", {height(lo_ell), height(hi_ell)}}, {"alt_amsl_m", {height(lo_amsl), height(hi_amsl)}}};
+}
+
+json positionJson(const airspace::LatLon& p) {
+  return json::array({std::round(maps::rad2deg(p.lon_rad) * 1e9) / 1e9, std::round(maps::rad2deg(p.lat_rad) * 1e9) / 1e9});
+}
+
+void runExport(const ExportOptions& o) {
+  if (o.to != "geojson") throw ParseError("--to", 0, "--to", o.to, "geojson");
+  const maps::Terrain terrain = loadTerrain(o.terrain);
+  const airspace::VerticalModel model{terrain, maps::Geoid::egm96()};
+  json features = json::array();
+  for (const std::string& path : o.files) {
+    for (const airspace::Zone& z : airspace::loadZones(path, zoneFormat(o.format), o.repair)) {
+      for (std::size_t vi = 0; vi < z.volumes.size(); ++vi) {
+        const airspace::Volume& v = z.volumes[vi];
+        json geometry;
+        json props;
+        if (v.outline.kind == airspace::Outline::Kind::kPolygon) {
+          json ring = json::array();
+          for (const airspace::LatLon& p : v.outline.ring) ring.push_back(positionJson(p));
+          ring.push_back(positionJson(v.outline.ring.front()));
+          geometry = {{"type", "Polygon"}, {"coordinates", json::array({ring})}};
+        } else {
+          geometry = {{"type", "Point"}, {"coordinates", positionJson(v.outline.centre)}};
+          props["radius_m"] = v.outline.radius_m;
+        }
+        props["identifier"] = z.identifier;
+        props["name"] = z.name;
+        props["restriction"] = std::string(airspace::restrictionName(z.restriction));
+        props["keep_in"] = z.keep_in;
+        props["reason"] = z.reasons;
+        props["message"] = z.message;
+        props["volume"] = vi;
+        props["source"] = z.source;
+        props["feature"] = z.feature;
+        props["lower"] = limitJson(v.lower);
+        props["upper"] = limitJson(v.upper);
+        props["lower_resolved"] = resolvedRange(v.lower, false, v.outline, model);
+        props["upper_resolved"] = resolvedRange(v.upper, true, v.outline, model);
+        props["applicability"] = applicabilityJson(z);
+        if (!z.notes.empty()) props["notes"] = z.notes;
+        features.push_back({{"type", "Feature"}, {"geometry", geometry}, {"properties", props}});
+      }
+    }
+  }
+  const json out = {{"type", "FeatureCollection"},
+                    {"name", "skylane normalised zones"},
+                    {"terrain", terrain.describe()},
+                    {"features", features}};
+  if (o.output.empty()) {
+    std::cout << out.dump(1) << "\n";
+  } else {
+    std::ofstream f(o.output);
+    if (!f) throw ParseError(o.output, 0, "--output", o.output, "a writable file");
+    f << out.dump(1) << "\n";
+  }
+}
+
+}  // namespace
+
+void addZonesCommands(CLI::App& app) {
+  CLI::App* zones = app.add_subcommand("zones", "airspace zones: validate, query, export (ED-269, ED-318, GeoJSON, QGC)");
+  zones->require_subcommand(1);
+
+  auto va = std::make_shared<ValidateOptions>();
+  CLI::App* c = zones->add_subcommand("validate", "check zone files; exit 0 when valid, 2 when not");
+  c->add_option("files", va->files, "zone files")->required();
+  c->add_option("--format", va->format, "auto (default), ed269, ed318, geojson or qgc");
+  c->add_flag("--repair", va->repair, "fix what can be fixed on the safe side, and report it");
+  c->callback([va] { runValidate(*va); });
+
+  auto at = std::make_shared<AtOptions>();
+  c = zones->add_subcommand("at", "the zones that apply at a point and time, and why");
+  c->add_option("files", at->files, "zone files")->required();
+  c->add_option("--format", at->format, "auto (default), ed269, ed318, geojson or qgc");
+  c->add_option("--lat", at->lat_deg, "latitude [deg]")->required();
+  c->add_option("--lon", at->lon_deg, "longitude [deg]")->required();
+  c->add_option("--alt-amsl", at->alt_amsl_m, "altitude above mean sea level (EGM96) [m]");
+  c->add_option("--height-agl", at->height_agl_m, "height above ground [m]");
+  c->add_option("--h-ell", at->h_ell_m, "WGS-84 ellipsoidal height [m]");
+  c->add_option("--time", at->time, "RFC 3339 time")->required();
+  c->add_option("--terrain", at->terrain, "terrain raster (GeoTIFF, ESRI ASCII, SRTM HGT); default flat at 0 m AMSL");
+  c->callback([at] { runAt(*at); });
+
+  auto ex = std::make_shared<ExportOptions>();
+  c = zones->add_subcommand("export", "the normalised zones as GeoJSON (ellipsoidal and AMSL limits)");
+  c->add_option("files", ex->files, "zone files")->required();
+  c->add_option("--format", ex->format, "auto (default), ed269, ed318, geojson or qgc");
+  c->add_option("--to", ex->to, "output format: geojson");
+  c->add_option("--output,-o", ex->output, "output file (default stdout)");
+  c->add_option("--terrain", ex->terrain, "terrain raster for AGL limits; default flat at 0 m AMSL");
+  c->add_flag("--repair", ex->repair, "repair what can be repaired before export");
+  c->callback([ex] { runExport(*ex); });
+}
+
+}  // namespace skylane::cli
