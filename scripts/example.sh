@@ -17,6 +17,10 @@ EX=examples/predict
 ./build/skylane integrity availability --almanac tests/data/gnss/alm_gps_ed259.txt \
   --almanac tests/data/gnss/alm_gal_ed259.txt --grid-deg 5 --duration 24h --step 10m \
   --output examples/out/availability.csv --map examples/out/availability.svg
+./build/skylane zones validate examples/zones/geo-awareness-che-1.json > examples/out/zones_validate.txt
+./build/skylane zones at examples/zones/geo-awareness-che-1.json --lat 46.430758 --lon 6.913146 \
+  --height-agl 50 --time 2022-06-18T18:00:00Z > examples/out/zones_at.json
+./build/skylane zones export examples/zones/geo-awareness-che-1.json --to geojson -o examples/out/zones.geojson
 echo "--- one geometry (examples/out/pl.json):"
 head -12 examples/out/pl.json
 echo "--- prediction (examples/out/predict.csv, plot examples/out/predict.svg):"
@@ -24,3 +28,6 @@ head -4 examples/out/predict.csv
 awk -F, 'NR>1{n++; a+=$9; if($7>m)m=$7} END{printf "%d epochs, %.1f %% available, max HPL %.1f m\n", n, 100*a/n, m}' examples/out/predict.csv
 echo "--- single-point positioning with RAIM (examples/out/spp_3040.jsonl):"
 wc -l < examples/out/spp_3040.jsonl
+echo "--- geozones (examples/out/zones_validate.txt, zones_at.json, zones.geojson):"
+tail -1 examples/out/zones_validate.txt
+grep -E '"(zone|why)"' examples/out/zones_at.json
