@@ -1,5 +1,6 @@
 #include "maps/geoid.hpp"
 
+#include "maps/gdal_support.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/parse_error.hpp"
 
@@ -34,40 +35,17 @@ constexpr double kPoleTol_deg = 1e-9;
 /// degree (to rounding); other angular units (grads, radians) are refused.
 constexpr double kDegreeUnitTol = 1e-9;
 
-void registerGdalOnce() {
-  static const bool registered = [] {
-    GDALAllRegister();
-    return true;
-  }();
-  (void)registered;
-}
-
-/// GDAL's last error message, or a fallback when GDAL left none.
-std::string gdalMessage(const char* fallback) {
-  const char* msg = CPLGetLastErrorMsg();
-  return (msg != nullptr && *msg != '\0') ? std::string(msg) : std::string(fallback);
-}
-
-void requireFinite(double lat_rad, double lon_rad, const char* what) {
-  if (!std::isfinite(lat_rad) || !std::isfinite(lon_rad) || std::abs(lat_rad) > M_PI / 2 + 1e-12) {
-    std::ostringstream msg;
-    msg << what << ": position (lat " << rad2deg(lat_rad) << " deg, lon " << rad2deg(lon_rad)
-        << " deg) is not finite or latitude is outside [-90, 90] deg";
-    throw std::invalid_argument(msg.str());
-  }
-}
-
 }  // namespace
 
 Geoid::Geoid(const std::string& grid_path) : path_(grid_path) {
-  registerGdalOnce();
+  detail::registerGdalOnce();
   // GDAL reports through a thread-local handler stack: keep its messages off stderr, they go
   // into the ParseError instead.
   CPLErrorHandlerPusher quiet(CPLQuietErrorHandler);
   CPLErrorReset();
   GDALDatasetUniquePtr ds(GDALDataset::Open(grid_path.c_str(),
                                             GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR));
-  if (!ds) throw ParseError(path_, 0, "grid", "unreadable (" + gdalMessage("GDAL cannot open it") + ")", kExpectedGrid);
+  if (!ds) throw ParseError(path_, 0, "grid", "unreadable (" + detail::gdalMessage("GDAL cannot open it") + ")", kExpectedGrid);
   if (ds->GetRasterCount() < 1) throw ParseError(path_, 0, "grid", "no raster band", kExpectedGrid);
 
   const OGRSpatialReference* srs = ds->GetSpatialRef();
@@ -126,7 +104,7 @@ Geoid::Geoid(const std::string& grid_path) : path_(grid_path) {
   for (int r = 0; r < rows_; ++r) {
     if (band->RasterIO(GF_Read, 0, r, cols_, 1, row.data(), cols_, 1, GDT_Float64, 0, 0, nullptr) != CE_None) {
       throw ParseError(path_, 0, "grid.band1", "unreadable row " + std::to_string(r) + " (" +
-                       gdalMessage("read error") + ")", kExpectedGrid);
+                       detail::gdalMessage("read error") + ")", kExpectedGrid);
     }
     for (int c = 0; c < cols_; ++c) {
       const double raw = row[static_cast<std::size_t>(c)];
@@ -163,7 +141,7 @@ double Geoid::clampedRow(double lat_deg) const {
 }
 
 double Geoid::undulation_m(double lat_rad, double lon_rad) const {
-  requireFinite(lat_rad, lon_rad, "Geoid::undulation_m");
+  detail::requireLatLon(lat_rad, lon_rad, "Geoid::undulation_m");
   const double x = wrappedColumn(rad2deg(lon_rad));
   const double y = clampedRow(rad2deg(lat_rad));
   const int c0 = std::min(static_cast<int>(x), period_cols_ - 1);

@@ -1,5 +1,6 @@
 #include "maps/terrain.hpp"
 
+#include "maps/gdal_support.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/geoid.hpp"
 #include "maps/parse_error.hpp"
@@ -32,29 +33,6 @@ constexpr double kProjectedPad_px = 1.0;
 /// One degree is this many degrees of a geographic CRS's angular unit when that unit is the
 /// degree (to rounding); only then are longitudes wrapped by 360.
 constexpr double kDegreeUnitTol = 1e-9;
-
-void registerGdalOnce() {
-  static const bool registered = [] {
-    GDALAllRegister();
-    return true;
-  }();
-  (void)registered;
-}
-
-/// GDAL's last error message, or a fallback when GDAL left none.
-std::string gdalMessage(const char* fallback) {
-  const char* msg = CPLGetLastErrorMsg();
-  return (msg != nullptr && *msg != '\0') ? std::string(msg) : std::string(fallback);
-}
-
-void requireLatLon(double lat_rad, double lon_rad, const char* what) {
-  if (!std::isfinite(lat_rad) || !std::isfinite(lon_rad) || std::abs(lat_rad) > M_PI / 2 + 1e-12) {
-    std::ostringstream msg;
-    msg << what << ": position (lat " << rad2deg(lat_rad) << " deg, lon " << rad2deg(lon_rad)
-        << " deg) is not finite or latitude is outside [-90, 90] deg";
-    throw std::invalid_argument(msg.str());
-  }
-}
 
 /// x wrapped by whole turns into [centre − 180, centre + 180).
 double wrapDeg(double x_deg, double centre_deg) {
@@ -130,14 +108,14 @@ Terrain Terrain::flat(double alt_amsl_m) {
 }
 
 Terrain Terrain::fromRaster(const std::string& path, HeightDatum datum) {
-  registerGdalOnce();
+  detail::registerGdalOnce();
   // GDAL reports through a thread-local handler stack: keep its messages off stderr, they go
   // into the ParseError instead.
   CPLErrorHandlerPusher quiet(CPLQuietErrorHandler);
   CPLErrorReset();
   GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(),
                                             GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR));
-  if (!ds) throw ParseError(path, 0, "raster", "unreadable (" + gdalMessage("GDAL cannot open it") + ")", kExpectedRaster);
+  if (!ds) throw ParseError(path, 0, "raster", "unreadable (" + detail::gdalMessage("GDAL cannot open it") + ")", kExpectedRaster);
   if (ds->GetRasterCount() < 1) throw ParseError(path, 0, "raster", "no raster band", kExpectedRaster);
 
   auto r = std::make_shared<Raster>();
@@ -176,7 +154,7 @@ Terrain Terrain::fromRaster(const std::string& path, HeightDatum datum) {
       r->to_raster.reset(OGRCreateCoordinateTransformation(&wgs84, &srs));
       to_wgs84.reset(OGRCreateCoordinateTransformation(&srs, &wgs84));
       if (!r->to_raster || !to_wgs84) {
-        throw ParseError(path, 0, "raster.crs", r->crs + " (" + gdalMessage("no transformation from WGS-84") + ")",
+        throw ParseError(path, 0, "raster.crs", r->crs + " (" + detail::gdalMessage("no transformation from WGS-84") + ")",
                          "a CRS PROJ can transform WGS-84 longitude/latitude into");
       }
     }
@@ -214,7 +192,7 @@ Terrain Terrain::fromRaster(const std::string& path, HeightDatum datum) {
   r->z_m.resize(static_cast<std::size_t>(r->cols) * static_cast<std::size_t>(r->rows));
   for (int j = 0; j < r->rows; ++j) {
     if (band->RasterIO(GF_Read, 0, j, r->cols, 1, row.data(), r->cols, 1, GDT_Float64, 0, 0, nullptr) != CE_None) {
-      throw ParseError(path, 0, "raster.band1", "unreadable row " + std::to_string(j) + " (" + gdalMessage("read error") + ")",
+      throw ParseError(path, 0, "raster.band1", "unreadable row " + std::to_string(j) + " (" + detail::gdalMessage("read error") + ")",
                        kExpectedRaster);
     }
     float* out = r->z_m.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(r->cols);
@@ -233,7 +211,7 @@ Terrain Terrain::fromRaster(const std::string& path, HeightDatum datum) {
 }
 
 std::optional<double> Terrain::altAmsl_m(double lat_rad, double lon_rad) const {
-  requireLatLon(lat_rad, lon_rad, "Terrain::altAmsl_m");
+  detail::requireLatLon(lat_rad, lon_rad, "Terrain::altAmsl_m");
   if (!raster_) return flat_alt_amsl_m_;
   const auto uv = raster_->toPixel(rad2deg(lat_rad), rad2deg(lon_rad));
   if (!uv) return std::nullopt;
@@ -243,7 +221,7 @@ std::optional<double> Terrain::altAmsl_m(double lat_rad, double lon_rad) const {
 }
 
 std::optional<double> Terrain::heightEllipsoid_m(double lat_rad, double lon_rad) const {
-  requireLatLon(lat_rad, lon_rad, "Terrain::heightEllipsoid_m");
+  detail::requireLatLon(lat_rad, lon_rad, "Terrain::heightEllipsoid_m");
   if (!raster_) return Geoid::egm96().ellipsoidalFromAmsl_m(lat_rad, lon_rad, flat_alt_amsl_m_);
   const auto uv = raster_->toPixel(rad2deg(lat_rad), rad2deg(lon_rad));
   if (!uv) return std::nullopt;
@@ -255,7 +233,7 @@ std::optional<double> Terrain::heightEllipsoid_m(double lat_rad, double lon_rad)
 std::optional<std::pair<double, double>> Terrain::rangeAmsl_m(
     const std::vector<std::pair<double, double>>& ring_lat_lon_rad) const {
   if (ring_lat_lon_rad.empty()) throw std::invalid_argument("Terrain::rangeAmsl_m: the ring has no vertex");
-  for (const auto& [lat_rad, lon_rad] : ring_lat_lon_rad) requireLatLon(lat_rad, lon_rad, "Terrain::rangeAmsl_m");
+  for (const auto& [lat_rad, lon_rad] : ring_lat_lon_rad) detail::requireLatLon(lat_rad, lon_rad, "Terrain::rangeAmsl_m");
   if (!raster_) return std::make_pair(flat_alt_amsl_m_, flat_alt_amsl_m_);
 
   // --- bounding box in degrees; longitudes unwrapped along the ring -----------------------
