@@ -119,11 +119,15 @@ std::optional<double> parseTimeOfDay(const std::string& text) {
   return h * 3600.0 + m * 60.0 + seconds - offset_s;
 }
 
-std::optional<unsigned> weekdayMask(const std::string& code) {
+const char* weekdayName(unsigned d) {
   static const char* const kDays[] = {"MON", "TUE", "WED", "THU", "FRI", "SAT", "SUN"};
+  return d < 7 ? kDays[d] : "?";
+}
+
+std::optional<unsigned> weekdayMask(const std::string& code) {
   if (code == "ANY") return 0x7fu;
   for (unsigned d = 0; d < 7; ++d) {
-    if (code == kDays[d]) return 1u << d;
+    if (code == weekdayName(d)) return 1u << d;
   }
   return std::nullopt;
 }

@@ -32,6 +32,8 @@ namespace skylane::airspace {
 /// the day. nullopt when the text is not such a time.
 [[nodiscard]] std::optional<double> parseTimeOfDay(const std::string& text);
 
+/// \brief The ED-269/ED-318 code of weekday d (0 = MON … 6 = SUN).
+[[nodiscard]] const char* weekdayName(unsigned d);
 /// \brief Weekday code (MON … SUN, ANY) → bit mask of DailyPeriod::days; nullopt otherwise.
 [[nodiscard]] std::optional<unsigned> weekdayMask(const std::string& code);
 

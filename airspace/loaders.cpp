@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <string>
 
 namespace skylane::airspace {
@@ -42,6 +43,11 @@ struct Node {
     if (!j.is_object()) fail("an object");
     if (!j.contains(key)) throw ParseError(source, 0, path + "." + key, "", "a value");
     return {j.at(key), path + "." + key, source};
+  }
+  /// The value at `key`, or a null value with that path when the key is absent.
+  [[nodiscard]] Node orNull(const char* key) const {
+    static const json kNull;
+    return has(key) ? at(key) : Node{kNull, path + "." + key, source};
   }
   [[nodiscard]] Node item(std::size_t i) const { return {j.at(i), path + "[" + std::to_string(i) + "]", source}; }
   [[nodiscard]] const json& array() const {
@@ -321,34 +327,29 @@ std::vector<Zone> parseEd269(const json& doc, const std::string& source) {
 
 // --- GeoJSON (ED-318 and plain) --------------------------------------------
 
-/// Vertical limits of an ED-318 layer, or of plain-GeoJSON properties.
-std::pair<VerticalLimit, VerticalLimit> ed318Layer(const Node& layer) {
-  const double scale = layer.has("uom") ? unitScale(layer.at("uom")) : 1.0;
-  const VerticalReference lower_ref =
-      layer.has("lowerReference") ? reference(layer.at("lowerReference")) : VerticalReference::kAgl;
-  const VerticalReference upper_ref =
-      layer.has("upperReference") ? reference(layer.at("upperReference")) : VerticalReference::kAgl;
-  const json null_value;
-  const VerticalLimit lower = layer.has("lower") ? limit(layer.at("lower"), lower_ref, scale, false)
-                                                 : limit(Node{null_value, layer.path + ".lower", layer.source},
-                                                         lower_ref, scale, false);
-  const VerticalLimit upper =
-      layer.has("upper") ? limit(layer.at("upper"), upper_ref, scale, true, kEd318Unlimited)
-                         : limit(Node{null_value, layer.path + ".upper", layer.source}, upper_ref, scale, true);
-  return {lower, upper};
-}
+/// Where a GeoJSON flavour keeps its vertical limits.
+struct LimitKeys {
+  const char* lower;
+  const char* upper;
+  const char* lower_reference;
+  const char* upper_reference;
+  VerticalReference default_reference;
+  double unlimited_value;  ///< a ceiling at or above this is unlimited
+};
 
-std::pair<VerticalLimit, VerticalLimit> plainLimits(const Node& props) {
-  const double scale = props.has("uom") ? unitScale(props.at("uom")) : 1.0;
-  const VerticalReference lower_ref =
-      props.has("lower_reference") ? reference(props.at("lower_reference")) : VerticalReference::kAmsl;
-  const VerticalReference upper_ref =
-      props.has("upper_reference") ? reference(props.at("upper_reference")) : VerticalReference::kAmsl;
-  const json null_value;
-  const auto get = [&](const char* key) {
-    return props.j.is_object() && props.j.contains(key) ? props.at(key) : Node{null_value, props.path + "." + key, props.source};
-  };
-  return {limit(get("lower"), lower_ref, scale, false), limit(get("upper"), upper_ref, scale, true)};
+/// ED-318 `layer` (references default to AGL; 99999 = unlimited).
+constexpr LimitKeys kEd318Layer{"lower", "upper", "lowerReference", "upperReference", VerticalReference::kAgl,
+                                kEd318Unlimited};
+/// Plain GeoJSON properties (README "Zone files"; references default to AMSL).
+constexpr LimitKeys kPlainProperties{"lower", "upper", "lower_reference", "upper_reference", VerticalReference::kAmsl,
+                                     std::numeric_limits<double>::infinity()};
+
+/// Floor and ceiling from `n` under `keys`; absent or null values: no floor / unlimited.
+std::pair<VerticalLimit, VerticalLimit> geoJsonLimits(const Node& n, const LimitKeys& keys) {
+  const double scale = n.has("uom") ? unitScale(n.at("uom")) : 1.0;
+  const auto ref = [&](const char* key) { return n.has(key) ? reference(n.at(key)) : keys.default_reference; };
+  return {limit(n.orNull(keys.lower), ref(keys.lower_reference), scale, false),
+          limit(n.orNull(keys.upper), ref(keys.upper_reference), scale, true, keys.unlimited_value)};
 }
 
 void geoJsonVolumes(const Node& geometry, const Node& props, bool ed318,
@@ -357,7 +358,7 @@ void geoJsonVolumes(const Node& geometry, const Node& props, bool ed318,
   if (type == "GeometryCollection") {
     const Node members = geometry.at("geometries");
     std::optional<std::pair<VerticalLimit, VerticalLimit>> own;
-    if (ed318 && geometry.has("layer")) own = ed318Layer(geometry.at("layer"));
+    if (ed318 && geometry.has("layer")) own = geoJsonLimits(geometry.at("layer"), kEd318Layer);
     for (std::size_t i = 0; i < members.array().size(); ++i) {
       geoJsonVolumes(members.item(i), props, ed318, own ? own : inherited, z);
     }
@@ -366,16 +367,16 @@ void geoJsonVolumes(const Node& geometry, const Node& props, bool ed318,
   std::pair<VerticalLimit, VerticalLimit> limits;
   if (ed318) {
     if (geometry.has("layer")) {
-      limits = ed318Layer(geometry.at("layer"));
+      limits = geoJsonLimits(geometry.at("layer"), kEd318Layer);
     } else if (inherited) {
       limits = *inherited;
     } else {
       const json empty = json::object();
-      limits = ed318Layer(Node{empty, geometry.path + ".layer", geometry.source});
+      limits = geoJsonLimits(Node{empty, geometry.path + ".layer", geometry.source}, kEd318Layer);
       z.notes.push_back(geometry.path + " has no layer: surface (no floor) to unlimited");
     }
   } else {
-    limits = plainLimits(props);
+    limits = geoJsonLimits(props, kPlainProperties);
   }
   const auto add = [&](Outline o) { z.volumes.push_back({std::move(o), limits.first, limits.second}); };
   if (type == "Polygon") {

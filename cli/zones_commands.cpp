@@ -78,10 +78,9 @@ json applicabilityJson(const airspace::Zone& z) {
     if (a.end) j["end"] = maps::formatRfc3339(*a.end);
     json schedule = json::array();
     for (const airspace::DailyPeriod& p : a.schedule) {
-      static const char* const kDays[] = {"MON", "TUE", "WED", "THU", "FRI", "SAT", "SUN"};
       json days = json::array();
       for (unsigned d = 0; d < 7; ++d) {
-        if (p.days & (1u << d)) days.push_back(kDays[d]);
+        if (p.days & (1u << d)) days.push_back(airspace::weekdayName(d));
       }
       schedule.push_back({{"day", days}, {"start_utc_s", p.start_s}, {"end_utc_s", p.end_s}});
     }
@@ -202,24 +201,13 @@ void runAt(const AtOptions& o) {
   std::cout << out.dump(2) << "\n";
 }
 
-/// Ellipsoidal and AMSL range of a limit over the outline's vertices (or the circle's centre
-/// and four rim points): exact for WGS84 and AMSL limits up to the geoid's variation, a
-/// sample of the terrain for AGL limits.
+/// A limit's resolved range over the outline (airspace::limitRange), both references.
 json resolvedRange(const airspace::VerticalLimit& l, bool ceiling, const airspace::Outline& o,
                    const airspace::VerticalModel& model) {
-  std::vector<airspace::LatLon> pts = o.ring;
-  if (o.kind == airspace::Outline::Kind::kCircle) pts.push_back(o.centre);
-  double lo_ell = INFINITY, hi_ell = -INFINITY, lo_amsl = INFINITY, hi_amsl = -INFINITY;
-  for (const airspace::LatLon& p : pts) {
-    const auto h = airspace::limitHeightEllipsoid_m(l, ceiling, p, model);
-    if (!h) return json("unknown terrain");
-    const double amsl = std::isfinite(*h) ? model.geoid.amslFromEllipsoidal_m(p.lat_rad, p.lon_rad, *h) : *h;
-    lo_ell = std::min(lo_ell, *h);
-    hi_ell = std::max(hi_ell, *h);
-    lo_amsl = std::min(lo_amsl, amsl);
-    hi_amsl = std::max(hi_amsl, amsl);
-  }
-  return {{"h_ell_m", {height(lo_ell), height(hi_ell)}}, {"alt_amsl_m", {height(lo_amsl), height(hi_amsl)}}};
+  const auto r = airspace::limitRange(l, ceiling, o, model);
+  if (!r) return json("unknown terrain");
+  return {{"h_ell_m", {height(r->h_ell_min_m), height(r->h_ell_max_m)}},
+          {"alt_amsl_m", {height(r->alt_amsl_min_m), height(r->alt_amsl_max_m)}}};
 }
 
 json positionJson(const airspace::LatLon& p) {

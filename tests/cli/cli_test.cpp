@@ -1,5 +1,7 @@
 // End-to-end checks of the skylane command: output shape and the exit-status contract
 // (0 success, 2 bad input with one line naming file/field/value/expectation).
+#include "maps/geodesy.hpp"
+#include "maps/geoid.hpp"
 #include "tests/test_util.hpp"
 
 #include <nlohmann/json.hpp>
@@ -208,8 +210,19 @@ TEST(Cli, ZonesExportWritesGeoJsonWithBothHeightReferences) {
   ASSERT_EQ(j["features"].size(), 10u + 3u);  // one feature per volume (CHE-1: 1+3+3+1+1+1)
   const nlohmann::json& montreux = j["features"][0]["properties"];
   EXPECT_EQ(montreux["upper"]["as_given"], "6259 M AMSL");
-  const double n = montreux["upper_resolved"]["h_ell_m"][0].get<double>() - 6259.0;
-  EXPECT_NEAR(n, 49.76, 0.05);  // EGM96 undulation at Montreux
+  // The ceiling's ellipsoidal range is 6259 m + the EGM96 undulation's range over the 3 km
+  // circle's bounding box (conservative: every grid node the interpolation can use there),
+  // so it brackets N = 49.76 m at the centre and equals the geoid's own range for that box
+  // (± 3000 m is ± 0.02699° of latitude and ± 0.03917° of longitude at 46.43° N).
+  const double lat = maps::deg2rad(46.430758), lon = maps::deg2rad(6.913146);
+  const auto [n_min, n_max] = maps::Geoid::egm96().undulationRange_m(
+      lat - maps::deg2rad(0.02699), lat + maps::deg2rad(0.02699), lon - maps::deg2rad(0.03917), lon + maps::deg2rad(0.03917));
+  const double h_lo = montreux["upper_resolved"]["h_ell_m"][0].get<double>();
+  const double h_hi = montreux["upper_resolved"]["h_ell_m"][1].get<double>();
+  EXPECT_NEAR(h_lo, 6259.0 + n_min, 1e-3);
+  EXPECT_NEAR(h_hi, 6259.0 + n_max, 1e-3);
+  EXPECT_LE(h_lo, 6259.0 + 49.76);  // EGM96 undulation at Montreux
+  EXPECT_GE(h_hi, 6259.0 + 49.76);
   EXPECT_EQ(montreux["upper_resolved"]["alt_amsl_m"][0], 6259.0);
   // The polygon of Lausanne's second volume: the repeated vertex is gone, the ring closed again.
   EXPECT_EQ(j["features"][5]["geometry"]["coordinates"][0].size(), 4u);

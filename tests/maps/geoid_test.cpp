@@ -2,6 +2,7 @@
 
 #include "maps/geodesy.hpp"
 #include "maps/parse_error.hpp"
+#include "tests/maps/raster_fixture.hpp"
 #include "tests/test_util.hpp"
 
 #include <gdal_priv.h>
@@ -47,25 +48,10 @@ const std::vector<ReferencePoint> kNgaReadmePoints = {
     {"0.47S 0.0023E (Gulf of Guinea)", -0.4667440, 0.0023000, 17.329},
 };
 
-/// Writes a one-band Float32 GeoTIFF in WGS-84 lon/lat with the given geotransform; value(row, col).
+/// A one-band Float32 GeoTIFF in WGS-84 lon/lat with the given geotransform; value(row, col).
 std::string writeGrid(const std::string& name, int cols, int rows, const double (&gt)[6],
                       const std::function<double(int, int)>& value) {
-  GDALAllRegister();
-  const std::string path = ::testing::TempDir() + name;
-  GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
-  GDALDatasetUniquePtr ds(gtiff->Create(path.c_str(), cols, rows, 1, GDT_Float32, nullptr));
-  double geo[6];
-  std::copy(std::begin(gt), std::end(gt), geo);
-  EXPECT_EQ(ds->SetGeoTransform(geo), CE_None);
-  OGRSpatialReference srs;
-  srs.SetWellKnownGeogCS("WGS84");
-  EXPECT_EQ(ds->SetSpatialRef(&srs), CE_None);
-  std::vector<float> z(static_cast<std::size_t>(cols) * rows);
-  for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) z[static_cast<std::size_t>(r) * cols + c] = static_cast<float>(value(r, c));
-  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, cols, rows, z.data(), cols, rows, GDT_Float32, 0, 0, nullptr),
-            CE_None);
-  return path;
+  return test::writeGeoTiff(name, cols, rows, gt, "WGS84", value);
 }
 
 TEST(Geoid, Egm96MatchesNgaReadmeValuesWithinBilinearGridError) {
