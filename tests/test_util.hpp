@@ -5,6 +5,9 @@
 
 #include <Eigen/Core>
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -14,6 +17,24 @@ namespace skylane::test {
 
 /// Path of a file under tests/data.
 inline std::string dataPath(const std::string& rel) { return std::string(SKYLANE_TEST_DATA) + "/" + rel; }
+
+/// Path of a scratch file in a directory of this test process alone: ctest runs every test as
+/// its own process, two at a time, so a fixed name under TempDir() would be written by one test
+/// while another reads it.
+/// The directory goes when the process ends.
+inline std::string scratchPath(const std::string& name) {
+  struct Dir {
+    std::filesystem::path path =
+        std::filesystem::path(::testing::TempDir()) / ("skylane-test-" + std::to_string(::getpid()));
+    Dir() { std::filesystem::create_directories(path); }
+    ~Dir() {
+      std::error_code ec;
+      std::filesystem::remove_all(path, ec);
+    }
+  };
+  static const Dir dir;
+  return (dir.path / name).string();
+}
 
 /// Whole file as text.
 inline std::string readData(const std::string& rel) {

@@ -204,7 +204,7 @@ TEST(ZoneLoaders, ErrorsNameFileZoneFieldAndExpectation) {
 }
 
 TEST(ZoneLoaders, JsonSyntaxErrorNamesTheLine) {
-  const std::string path = ::testing::TempDir() + "/broken_zones.json";
+  const std::string path = test::scratchPath("broken_zones.json");
   {
     std::ofstream f(path);
     f << "{\n  \"UASZoneList\": [\n    {\"identifier\": \"X\",,}\n  ]\n}\n";

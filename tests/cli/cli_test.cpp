@@ -31,7 +31,7 @@ RunResult run(const std::string& args) {
 }
 
 std::string writeTemp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/" + name;
+  const std::string path = test::scratchPath(name);
   std::ofstream(path) << text;
   return path;
 }
@@ -98,7 +98,7 @@ TEST(Cli, BadInputExitsTwoWithOneLineNamingTheProblem) {
 }
 
 TEST(Cli, PredictWritesCsvAndSvg) {
-  const std::string svg = ::testing::TempDir() + "/predict.svg";
+  const std::string svg = test::scratchPath("predict.svg");
   const RunResult r = run("integrity predict --method raim --almanac " + test::dataPath("gnss/alm01jan2020.txt") +
                           " --lat 35.13 --lon 139.62 --start 2020-01-01T00:00:00Z --duration 2h --step 30m --plot " + svg);
   ASSERT_EQ(r.status, 0) << r.out;
@@ -142,7 +142,7 @@ TEST(Cli, SppPrintsOneJsonLinePerEpoch) {
 
 TEST(Cli, AvailabilityMapHasCellsColourScaleAndCoastlines) {
   // GIVEN a coarse 30° grid over 1 h (a seconds-long run)
-  const std::string svg = ::testing::TempDir() + "/availability.svg";
+  const std::string svg = test::scratchPath("availability.svg");
   const RunResult r = run("integrity availability --almanac " + test::dataPath("gnss/alm01jan2020.txt") +
                           " --grid-deg 30 --start 2020-01-01T00:00:00Z --duration 1h --step 30m --method raim --map " + svg);
   ASSERT_EQ(r.status, 0) << r.out;
@@ -200,7 +200,7 @@ TEST(Cli, ZonesAtSaysWhichZonesApplyAndWhy) {
 }
 
 TEST(Cli, ZonesExportWritesGeoJsonWithBothHeightReferences) {
-  const std::string out = ::testing::TempDir() + "/zones.geojson";
+  const std::string out = test::scratchPath("zones.geojson");
   const RunResult r = run("zones export " + test::dataPath("geozones/geo-awareness-che-1.json") + " " +
                           test::dataPath("geozones/qgc_fence.plan") + " --to geojson -o " + out);
   ASSERT_EQ(r.status, 0) << r.out;

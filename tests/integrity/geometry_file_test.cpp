@@ -62,7 +62,7 @@ TEST(GeometryFile, ErrorsNameTheFieldTheValueAndWhatWasExpected) {
 }
 
 TEST(GeometryFile, JsonSyntaxErrorNamesTheLine) {
-  const std::string path = ::testing::TempDir() + "/bad_geometry.json";
+  const std::string path = test::scratchPath("bad_geometry.json");
   {
     std::ofstream f(path);
     f << "{\n \"satellites\": [\n  {\"id\": \"G01\",}\n ]\n}\n";

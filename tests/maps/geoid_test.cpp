@@ -149,7 +149,7 @@ TEST(Geoid, GdalPixelCentresAreTheNodesOfASyntheticGeoTiffGrid) {
 }
 
 TEST(Geoid, MissingGridIsAParseErrorNamingTheFileAndWhereToGetIt) {
-  const std::string path = ::testing::TempDir() + "no_such_geoid.gtx";
+  const std::string path = test::scratchPath("no_such_geoid.gtx");
   const std::string msg = test::messageOf<ParseError>([&] { Geoid g(path); });
   EXPECT_NE(msg.find(path), std::string::npos) << msg;
   EXPECT_NE(msg.find("'grid'"), std::string::npos) << msg;

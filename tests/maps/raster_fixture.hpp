@@ -2,6 +2,8 @@
 /// \file
 /// \brief Test rasters written with GDAL at test time (geoid and terrain tests).
 
+#include "tests/test_util.hpp"
+
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
 #include <ogr_spatialref.h>
@@ -21,7 +23,7 @@ inline std::string writeGeoTiff(const std::string& name, int cols, int rows, con
                          const std::string& srs_user_input, const std::function<double(int, int)>& value,
                          double nodata = NAN) {
   GDALAllRegister();
-  const std::string path = ::testing::TempDir() + name;
+  const std::string path = test::scratchPath(name);
   GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
   GDALDatasetUniquePtr ds(gtiff->Create(path.c_str(), cols, rows, 1, GDT_Float32, nullptr));
   double geo[6];

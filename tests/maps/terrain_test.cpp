@@ -213,7 +213,7 @@ TEST(Terrain, ConcurrentQueriesOnAProjectedRasterAgreeWithSerialOnes) {
 // --- ESRI ASCII grid without CRS ---------------------------------------------------------------
 TEST(Terrain, EsriAsciiGridWithoutCrsIsTakenAsWgs84LonLat) {
   // GIVEN 4 × 3 cells of 0.5° from 46°N 7°E, one void; centres lon 7.25 … 8.75, lat 47.25 … 46.25
-  const std::string path = ::testing::TempDir() + "skylane_grid.asc";
+  const std::string path = test::scratchPath("skylane_grid.asc");
   std::ofstream(path) << "ncols 4\nnrows 3\nxllcorner 7.0\nyllcorner 46.0\ncellsize 0.5\nNODATA_value -9999\n"
                          "100 110 120 130\n"
                          "200 210 -9999 230\n"
@@ -236,7 +236,7 @@ TEST(Terrain, EsriAsciiGridWithoutCrsIsTakenAsWgs84LonLat) {
 TEST(Terrain, SrtmHgtTileHasItsCentresOnWholeDegreesAndAVoid) {
   // GIVEN N46E007.hgt: 1201 × 1201 big-endian int16, row 0 at 47°N, column 0 at 7°E, 3" apart;
   // z = 1000 + row − 2·column (a plane), with a void (−32768) at row 600, column 600 (46.5°N 7.5°E)
-  const std::string path = ::testing::TempDir() + "N46E007.hgt";
+  const std::string path = test::scratchPath("N46E007.hgt");
   {
     std::ofstream out(path, std::ios::binary);
     for (int r = 0; r < 1201; ++r) {
@@ -330,12 +330,12 @@ TEST(Terrain, FlatTerrainIsTheSameEverywhere) {
 }
 
 TEST(Terrain, UnreadableFileIsAParseErrorNamingTheFile) {
-  const std::string missing = ::testing::TempDir() + "no_such_dem.tif";
+  const std::string missing = test::scratchPath("no_such_dem.tif");
   std::string msg = test::messageOf<ParseError>([&] { (void)Terrain::fromRaster(missing); });
   EXPECT_NE(msg.find(missing), std::string::npos) << msg;
   EXPECT_NE(msg.find("'raster'"), std::string::npos) << msg;
 
-  const std::string garbage = ::testing::TempDir() + "skylane_not_a_dem.tif";
+  const std::string garbage = test::scratchPath("skylane_not_a_dem.tif");
   std::ofstream(garbage) << "this is not a raster\n";
   msg = test::messageOf<ParseError>([&] { (void)Terrain::fromRaster(garbage); });
   EXPECT_NE(msg.find(garbage), std::string::npos) << msg;
