@@ -2,12 +2,14 @@
 // (0 success, 2 bad input with one line naming file/field/value/expectation).
 #include "maps/geodesy.hpp"
 #include "maps/geoid.hpp"
+#include "tests/maps/raster_fixture.hpp"
 #include "tests/test_util.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <array>
 #include <cstdio>
+#include <sstream>
 #include <sys/wait.h>
 
 namespace skylane {
@@ -197,6 +199,34 @@ TEST(Cli, ZonesAtSaysWhichZonesApplyAndWhy) {
   // Above the 120 m AGL ceiling of the preserve.
   const RunResult high = run("zones at " + che + " --lat 46.430758 --lon 6.913146 --height-agl 150 --time 2022-06-20T18:00:00Z");
   EXPECT_EQ(nlohmann::json::parse(high.out)["applies"].size(), 0u) << high.out;
+}
+
+TEST(Cli, ZonesAtResolvesAglLimitsOverSlopingTerrain) {
+  // GIVEN terrain rising 20 m per 0.01° eastward (700 m AMSL at 7.1°E, 1100 m at 7.3°E) and a
+  // prohibited zone from 0 to 120 m AGL over 7.05–7.45°E
+  const double gt[6] = {7.0, 0.01, 0.0, 46.6, 0.0, -0.01};
+  const std::string dem = test::writeGeoTiff("slope.tif", 50, 20, gt, "EPSG:4326",
+                                             [](int, int c) { return 500.0 + 2000.0 * (c + 0.5) * 0.01; });
+  const std::string zone = writeTemp("slope_zone.geojson", R"({"type":"FeatureCollection","features":[
+    {"type":"Feature","id":"SLOPE","properties":{"restriction":"PROHIBITED","lower":0,"lower_reference":"AGL",
+     "upper":120,"upper_reference":"AGL"},"geometry":{"type":"Polygon","coordinates":[[[7.05,46.45],[7.45,46.45],
+     [7.45,46.55],[7.05,46.55],[7.05,46.45]]]}}]})");
+  const auto applies = [&](double lon, double alt_amsl) {
+    std::ostringstream cmd;
+    cmd << "zones at " << zone << " --terrain " << dem << " --lat 46.5 --lon " << lon << " --alt-amsl " << alt_amsl
+        << " --time 2026-11-23T12:00:00Z";
+    const RunResult r = run(cmd.str());
+    EXPECT_EQ(r.status, 0) << r.out;
+    return nlohmann::json::parse(r.out)["applies"].size() == 1;
+  };
+  // THEN the zone spans ground … ground + 120 m: 700 … 820 m at 7.1°E, 900 … 1020 m at 7.2°E,
+  // 1100 … 1220 m at 7.3°E
+  EXPECT_TRUE(applies(7.1, 750.0));
+  EXPECT_FALSE(applies(7.1, 850.0));   // above the ceiling here …
+  EXPECT_FALSE(applies(7.2, 850.0));   // … and below the floor further east
+  EXPECT_TRUE(applies(7.2, 950.0));
+  EXPECT_TRUE(applies(7.3, 1200.0));
+  EXPECT_FALSE(applies(7.3, 1230.0));
 }
 
 TEST(Cli, ZonesExportWritesGeoJsonWithBothHeightReferences) {
