@@ -18,6 +18,12 @@ namespace {
 using nlohmann::json;
 using maps::ParseError;
 
+/// The member's text when it is a string, "" otherwise (absent, a number, an array …).
+std::string stringMember(const json& doc, const char* key) {
+  const auto it = doc.find(key);
+  return it != doc.end() && it->is_string() ? it->get<std::string>() : std::string();
+}
+
 /// ED-318 writes 99999 (in the layer's unit) for "no upper limit".
 constexpr double kEd318Unlimited = 99999.0;
 /// Longest text kept from a JSON value quoted in an error message.
@@ -452,7 +458,7 @@ Zone geoJsonZone(const Node& feature, bool ed318) {
 std::vector<Zone> parseGeoJson(const json& doc, const std::string& source, bool ed318) {
   const Node root{doc, "", source};
   std::vector<Zone> zones;
-  if (doc.is_object() && doc.value("type", "") == "Feature") {
+  if (doc.is_object() && stringMember(doc, "type") == "Feature") {
     zones.push_back(geoJsonZone(Node{doc, "feature", source}, ed318));
     return zones;
   }
@@ -536,8 +542,8 @@ std::optional<ZoneFormat> parseZoneFormat(std::string_view text) {
 std::optional<ZoneFormat> detectZoneFormat(const json& doc) {
   if (!doc.is_object()) return std::nullopt;
   if (doc.contains("UASZoneList")) return ZoneFormat::kEd269;
-  if (doc.value("fileType", "") == "Plan" || doc.contains("geoFence")) return ZoneFormat::kQgcPlan;
-  if (doc.value("type", "") == "Feature") return ZoneFormat::kGeoJson;
+  if (stringMember(doc, "fileType") == "Plan" || doc.contains("geoFence")) return ZoneFormat::kQgcPlan;
+  if (stringMember(doc, "type") == "Feature") return ZoneFormat::kGeoJson;
   const auto features = doc.find("features");
   if (features == doc.end() || !features->is_array()) return std::nullopt;
   for (const json& f : *features) {

@@ -5,8 +5,11 @@
 
 // The libraries are built with -fsanitize=undefined, whose reports are recoverable by default:
 // UBSan would print and carry on, and libFuzzer would never keep the input. Halting turns every
-// report into a crash. (UBSAN_OPTIONS in the environment still overrides single flags.)
-extern "C" const char* __ubsan_default_options() { return "halt_on_error=1:print_stacktrace=1"; }
+// report into a crash. Known reports inside third-party code are suppressed by fuzz/ubsan.supp
+// (each line says why). (UBSAN_OPTIONS in the environment still overrides single flags.)
+extern "C" const char* __ubsan_default_options() {
+  return "halt_on_error=1:print_stacktrace=1:suppressions=" SKYLANE_UBSAN_SUPPRESSIONS;
+}
 
 namespace skylane::fuzz {
 namespace {

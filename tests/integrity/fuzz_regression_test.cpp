@@ -1,5 +1,7 @@
 // Replays every input the fuzzers (fuzz/) found or confirmed: each parser must either succeed
 // or throw ParseError, and whatever it accepts must be usable without a crash or exception.
+#include "airspace/loaders.hpp"
+#include "airspace/validation.hpp"
 #include "integrity/geometry_file.hpp"
 #include "integrity/gnss/almanac.hpp"
 #include "integrity/gnss/parse_error.hpp"
@@ -48,6 +50,11 @@ void replay(const std::string& name, const std::string& text) {
     EXPECT_TRUE(!d || (std::isfinite(*d) && *d > 0)) << name;
     (void)parseRfc3339(text);
     (void)parseSatId(text);
+  } else if (name.rfind("zones", 0) == 0) {
+    const nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
+    if (doc.is_discarded()) return;
+    std::vector<airspace::Zone> zones = airspace::parseZones(doc, name);
+    (void)airspace::validateZones(zones, true);
   } else {
     ADD_FAILURE() << "no replay rule for " << name;
   }
@@ -55,7 +62,7 @@ void replay(const std::string& name, const std::string& text) {
 
 TEST(FuzzRegression, EveryReproducerGivesAResultOrAParseError) {
   const auto files = regressionFiles();
-  ASSERT_GE(files.size(), 13u);
+  ASSERT_GE(files.size(), 14u);
   for (const std::string& f : files) {
     const std::string text = test::readData("fuzz_regressions/" + f);
     try {
