@@ -1,0 +1,245 @@
+#include "geofence/corridor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <limits>
+#include <utility>
+#include <sstream>
+#include <stdexcept>
+
+namespace skylane::geofence {
+namespace {
+
+double dimension(const Vehicle& v, Dimension d) {
+  switch (d) {
+    case Dimension::kLateral: return v.lateral_m;
+    case Dimension::kLongitudinal: return v.longitudinal_m;
+    case Dimension::kHeight: return v.height_m;
+  }
+  return 0.0;
+}
+
+const char* dimensionName(Dimension d) {
+  switch (d) {
+    case Dimension::kLateral: return "lateral";
+    case Dimension::kLongitudinal: return "longitudinal";
+    case Dimension::kHeight: return "height";
+  }
+  return "?";
+}
+
+/// Checks k against [lo, hi]; outside it throws, or with override records a warning.
+void checkFactor(const char* name, double k, double lo, double hi, bool override_ranges,
+                 std::vector<std::string>& warnings) {
+  if (!(std::isfinite(k) && k > 0.0)) {
+    std::ostringstream s;
+    s << name << " must be a positive finite factor, got " << k;
+    throw std::invalid_argument(s.str());
+  }
+  if (k >= lo && k <= hi) return;
+  std::ostringstream s;
+  s << name << " = " << k << " is outside seed 000's range [" << lo << ", " << hi << "]";
+  if (!override_ranges) throw std::invalid_argument(s.str() + " (pass the override to accept it)");
+  warnings.push_back(s.str() + ": accepted by override");
+}
+
+/// A segment's piece at a horizontal point: distance to the segment and the centre line's
+/// height band there (a vertical segment spans its whole climb), with the slope g that bounds
+/// how fast that band moves as the point moves (the nearest point moves by ≤ the point's move).
+struct PieceAt {
+  double distance_m = 0.0;
+  double z_lo_m = 0.0, z_hi_m = 0.0;
+  double slope = 0.0;
+};
+
+PieceAt pieceAt(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector2d& x) {
+  const Eigen::Vector2d d = (b - a).head<2>();
+  const double length2 = d.squaredNorm();
+  // Nearest point of the horizontal projection: t = clamp((x − a)·d / |d|², 0, 1).
+  const double t = length2 > 0 ? std::clamp((x - a.head<2>()).dot(d) / length2, 0.0, 1.0) : 0.0;
+  PieceAt p;
+  p.distance_m = (x - (a.head<2>() + t * d)).norm();
+  p.z_lo_m = length2 > 0 ? a.z() + t * (b.z() - a.z()) : std::min(a.z(), b.z());
+  p.z_hi_m = length2 > 0 ? p.z_lo_m : std::max(a.z(), b.z());
+  p.slope = length2 > 0 ? std::abs(b.z() - a.z()) / std::sqrt(length2) : 0.0;
+  return p;
+}
+
+/// Margins of the piece for every point within `reach_m` of x, for heights z ± vpl:
+/// horizontal HAL − d − reach (exact for one segment: the distance to a convex set grows by
+/// exactly `reach` across a disk of that radius), vertical the band shrunk by g·reach.
+std::pair<double, double> pieceMargins(const PieceAt& p, double reach_m, double z, double vpl, double hal,
+                                       double val) {
+  const double h = hal - p.distance_m - reach_m;
+  const double v = std::min((p.z_hi_m + val - p.slope * reach_m) - (z + vpl), (z - vpl) - (p.z_lo_m - val + p.slope * reach_m));
+  return {h, v};
+}
+
+}  // namespace
+
+LevelLimits alertLimits(const Vehicle& vehicle, const BoxLevels& levels) {
+  LevelLimits out;
+  for (Dimension d : {levels.mapping.horizontal, levels.mapping.vertical}) {
+    const double size = dimension(vehicle, d);
+    if (!(std::isfinite(size) && size > 0.0)) {
+      std::ostringstream s;
+      s << "vehicle " << dimensionName(d) << " size must be a positive number of metres, got " << size;
+      throw std::invalid_argument(s.str());
+    }
+  }
+  checkFactor("k1", levels.k1, 1.1, 1.3, levels.override_ranges, out.warnings);
+  checkFactor("k2", levels.k2, 100.0, 1000.0, levels.override_ranges, out.warnings);
+  const double h = dimension(vehicle, levels.mapping.horizontal), v = dimension(vehicle, levels.mapping.vertical);
+  out.level1 = {levels.k1 * h, levels.k1 * v};
+  out.level2 = {levels.k2 * h, levels.k2 * v};
+  return out;
+}
+
+const char* verdictName(Verdict v) {
+  switch (v) {
+    case Verdict::kInside: return "inside";
+    case Verdict::kOutside: return "outside";
+    case Verdict::kIndeterminate: return "indeterminate";
+  }
+  return "?";
+}
+
+Corridor::Corridor(std::vector<Eigen::Vector3d> path_map, AlertLimits limits, OperatingLimits operating)
+    : path_(std::move(path_map)), limits_(limits), operating_(operating) {
+  if (path_.size() < 2) {
+    throw std::invalid_argument("a corridor needs at least 2 waypoints, got " + std::to_string(path_.size()));
+  }
+  for (std::size_t i = 0; i < path_.size(); ++i) {
+    if (!path_[i].allFinite()) throw std::invalid_argument("corridor waypoint " + std::to_string(i) + " is not finite");
+  }
+  if (!(std::isfinite(limits_.hal_m) && limits_.hal_m > 0 && std::isfinite(limits_.val_m) && limits_.val_m > 0)) {
+    std::ostringstream s;
+    s << "corridor alert limits must be positive, got HAL " << limits_.hal_m << " m, VAL " << limits_.val_m << " m";
+    throw std::invalid_argument(s.str());
+  }
+  if (std::isnan(operating_.floor_h_ell_m) || std::isnan(operating_.ceiling_h_ell_m) ||
+      operating_.floor_h_ell_m >= operating_.ceiling_h_ell_m) {
+    std::ostringstream s;
+    s << "operating limits must have floor < ceiling, got " << operating_.floor_h_ell_m << " … "
+      << operating_.ceiling_h_ell_m << " m";
+    throw std::invalid_argument(s.str());
+  }
+}
+
+std::array<Eigen::Vector3d, 8> Corridor::segmentBoxCorners(std::size_t segment) const {
+  if (segment >= segmentCount()) throw std::out_of_range("segmentBoxCorners: no segment " + std::to_string(segment));
+  const Eigen::Vector3d& a = path_[segment];
+  const Eigen::Vector3d& b = path_[segment + 1];
+  const Eigen::Vector2d d = (b - a).head<2>();
+  const double length_m = d.norm();
+  // u along the segment (east for a vertical one), n to its left; a vertical segment gets a
+  // square of half-side HAL.
+  const Eigen::Vector2d u = length_m > 0 ? Eigen::Vector2d(d / length_m) : Eigen::Vector2d(1, 0);
+  const Eigen::Vector2d n(-u.y(), u.x());
+  const bool vertical = length_m == 0.0;
+  const Eigen::Vector2d reach = vertical ? Eigen::Vector2d(limits_.hal_m * u) : Eigen::Vector2d::Zero();
+  const double z_min = std::min(a.z(), b.z()), z_max = std::max(a.z(), b.z());
+  const double za_lo = (vertical ? z_min : a.z()) - limits_.val_m, za_hi = (vertical ? z_max : a.z()) + limits_.val_m;
+  const double zb_lo = (vertical ? z_min : b.z()) - limits_.val_m, zb_hi = (vertical ? z_max : b.z()) + limits_.val_m;
+  const Eigen::Vector2d a2 = a.head<2>() - reach, b2 = b.head<2>() + reach, w = limits_.hal_m * n;
+  const auto at = [](const Eigen::Vector2d& p, double z) { return Eigen::Vector3d(p.x(), p.y(), z); };
+  return {at(a2 - w, za_lo), at(b2 - w, zb_lo), at(b2 + w, zb_lo), at(a2 + w, za_lo),
+          at(a2 - w, za_hi), at(b2 - w, zb_hi), at(b2 + w, zb_hi), at(a2 + w, za_hi)};
+}
+
+Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_m) const {
+  const Eigen::Vector3d& c = volume.p_map;
+  if (!c.allFinite()) throw std::invalid_argument("protection volume position is not finite");
+  if (!(std::isfinite(volume.hpl_m) && volume.hpl_m >= 0 && std::isfinite(volume.vpl_m) && volume.vpl_m >= 0)) {
+    std::ostringstream s;
+    s << "protection levels must be finite and ≥ 0, got HPL " << volume.hpl_m << " m, VPL " << volume.vpl_m << " m";
+    throw std::invalid_argument(s.str());
+  }
+  const double hpl = volume.hpl_m, vpl = volume.vpl_m, hal = limits_.hal_m, val = limits_.val_m;
+  // The operating limits bound every piece.
+  const double operating_margin_m =
+      std::min(operating_.ceiling_h_ell_m - (c.z() + vpl), (c.z() - vpl) - operating_.floor_h_ell_m);
+
+  const auto piece = [&](std::size_t i, const Eigen::Vector2d& x) { return pieceAt(path_[i], path_[i + 1], x); };
+  const auto margins = [&](std::size_t i, const Eigen::Vector2d& x, double reach_m) {
+    auto [h, v] = pieceMargins(piece(i, x), reach_m, c.z(), vpl, hal, val);
+    return std::pair{h, std::min(v, operating_margin_m)};
+  };
+
+  // One piece holding the whole volume: exact in the horizontal, the slope term in the vertical.
+  std::size_t best = 0, reached = 0;
+  double best_m = -std::numeric_limits<double>::infinity();
+  Containment out;
+  for (std::size_t i = 0; i < segmentCount(); ++i) {
+    const auto [h, v] = margins(i, c.head<2>(), hpl);
+    if (std::min(h, v) > best_m) {
+      best_m = std::min(h, v);
+      best = i;
+      out.margin_h_m = h;
+      out.margin_v_m = v;
+    }
+    if (piece(i, c.head<2>()).distance_m <= hal + hpl) ++reached;
+  }
+  out.segment = best;
+  if (best_m < tolerance_m && reached >= 2) {
+    // Across a joint: no single piece holds the disk, but their union may. The volume's margin
+    // in the union is min over the disk of f(x) = max_k min(h_k(x), v_k(x)) (the margins of
+    // the point x in piece k); it is bounded on a quadtree cell (centre q, circumradius ρ) from
+    // below by the same maximum with reach ρ (the bounds used above), and from above by f at
+    // any point of the disk. Best-first branch and bound narrows the two to `accuracy`.
+    const double accuracy_m = std::max(tolerance_m, 1e-3 * hal);
+    const Eigen::Vector2d c2 = c.head<2>();
+    const auto bound = [&](const Eigen::Vector2d& q, double reach_m) {
+      double f = -std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < segmentCount(); ++i) {
+        const auto [h, v] = margins(i, q, reach_m);
+        f = std::max(f, std::min(h, v));
+      }
+      return f;
+    };
+    struct Cell {
+      double lower;
+      Eigen::Vector2d q;
+      double half;
+      bool operator<(const Cell& o) const { return lower > o.lower; }  // smallest first
+    };
+    std::priority_queue<Cell> cells;
+    const double half0 = std::max(hpl, accuracy_m);
+    cells.push({bound(c2, half0 * std::sqrt(2.0)), c2, half0});
+    double upper = bound(c2, 0.0);  // f at the centre
+    double lower = upper;
+    for (int evaluations = 0; !cells.empty(); ++evaluations) {
+      const Cell cell = cells.top();
+      lower = cell.lower;
+      if (lower >= upper - accuracy_m || evaluations > 200000) break;
+      cells.pop();
+      // f at the cell's point nearest to its centre inside the disk tightens the upper bound.
+      const Eigen::Vector2d x = (cell.q - c2).norm() > hpl ? Eigen::Vector2d(c2 + hpl * (cell.q - c2).normalized()) : cell.q;
+      upper = std::min(upper, bound(x, 0.0));
+      const double half = cell.half / 2;
+      for (const Eigen::Vector2d& o : {Eigen::Vector2d(-1, -1), Eigen::Vector2d(1, -1), Eigen::Vector2d(1, 1), Eigen::Vector2d(-1, 1)}) {
+        const Eigen::Vector2d q = cell.q + o * half;
+        const double rho = half * std::sqrt(2.0);
+        if ((q - c2).norm() - rho > hpl) continue;  // misses the disk
+        cells.push({bound(q, rho), q, half});
+      }
+      if (cells.empty()) lower = upper;
+    }
+    // lower ≤ the union margin ≤ upper (a point of the volume has margin `upper`); report the
+    // certified lower bound.
+    const double m = lower;
+    if (m > best_m) {
+      out.across_joint = true;
+      out.margin_h_m = out.margin_v_m = m;
+      out.verdict = lower > tolerance_m ? Verdict::kInside
+                                        : (upper < -tolerance_m ? Verdict::kOutside : Verdict::kIndeterminate);
+      return out;
+    }
+  }
+  const double m = std::min(out.margin_h_m, out.margin_v_m);
+  out.verdict = std::abs(m) <= tolerance_m ? Verdict::kIndeterminate : (m > 0 ? Verdict::kInside : Verdict::kOutside);
+  return out;
+}
+
+}  // namespace skylane::geofence

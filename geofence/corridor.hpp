@@ -1,0 +1,138 @@
+#pragma once
+/// \file
+/// \brief The two box levels of seed 000 (claims 8 and 9; DESIGN.md "The two box levels"):
+/// alert limits from the vehicle's size, first-level corridor and second-level airspace boxes
+/// along a path, and whether a protection volume lies inside them, with margins.
+///
+/// Frame: the **mission map frame** — x east and y north in metres in the azimuthal
+/// equidistant plane at the mission origin (maps::PlaneFrame), z the WGS-84 ellipsoidal
+/// height [m]. The protection volume is a vertical cylinder (radius HPL, half-height VPL), so
+/// the vertical axis is the local vertical, as the protection levels are.
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace skylane::geofence {
+
+/// \brief A dimension of the vehicle.
+enum class Dimension { kLateral, kLongitudinal, kHeight };
+
+/// \brief The vehicle's size [m]: span, length and height.
+struct Vehicle {
+  double lateral_m = 0.0;
+  double longitudinal_m = 0.0;
+  double height_m = 0.0;
+};
+
+/// \brief Which dimension each alert limit scales. Seed 000's mapping is the default: the
+/// horizontal limit from the lateral size, the vertical one from the longitudinal size.
+struct AlertMapping {
+  Dimension horizontal = Dimension::kLateral;
+  Dimension vertical = Dimension::kLongitudinal;
+};
+
+/// \brief The box-level factors: k₁ ∈ [1.1, 1.3] (corridor), k₂ ∈ [100, 1000] (airspace).
+struct BoxLevels {
+  double k1 = 1.2;
+  double k2 = 300.0;
+  AlertMapping mapping;
+  bool override_ranges = false;  ///< accept k outside its range, with a warning
+};
+
+/// \brief Horizontal and vertical alert limits (half-width and half-height of a box) [m].
+struct AlertLimits {
+  double hal_m = 0.0;
+  double val_m = 0.0;
+};
+
+/// \brief Both levels' limits and the warnings an override produced.
+struct LevelLimits {
+  AlertLimits level1;
+  AlertLimits level2;
+  std::vector<std::string> warnings;
+};
+
+/// \brief HAL_n = k_n · (mapped horizontal size), VAL_n = k_n · (mapped vertical size).
+/// \throws std::invalid_argument for a non-positive or non-finite mapped size, or for a k
+/// outside its range without override_ranges (the message names k, its value and the range).
+[[nodiscard]] LevelLimits alertLimits(const Vehicle& vehicle, const BoxLevels& levels);
+
+/// \brief A protection volume: vertical cylinder of radius HPL and half-height VPL round the
+/// estimated position (map frame).
+struct ProtectionVolume {
+  Eigen::Vector3d p_map = Eigen::Vector3d::Zero();
+  double hpl_m = 0.0;
+  double vpl_m = 0.0;
+};
+
+/// \brief Three-valued verdict: indeterminate when the deciding margin is within the
+/// tolerance of zero (touching counts as neither inside nor outside).
+enum class Verdict { kInside, kOutside, kIndeterminate };
+
+/// \brief "inside", "outside", "indeterminate".
+[[nodiscard]] const char* verdictName(Verdict v);
+
+/// \brief The result of a containment check.
+struct Containment {
+  Verdict verdict = Verdict::kOutside;
+  /// The segment whose piece holds the volume (or the nearest, when outside).
+  std::size_t segment = 0;
+  bool across_joint = false;  ///< held by the union of neighbouring pieces, by no single one
+  /// How much HPL (resp. VPL) could still grow and the volume stay inside; negative: by how
+  /// much it sticks out. For one piece the horizontal margin is exact and the vertical one a
+  /// lower bound on a sloping segment. Across a joint both fields hold the one combined
+  /// margin, min over the volume's points of their best piece's margin, certified from below
+  /// to within max(tolerance, HAL/1000) by branch and bound; it is a lower bound on how much
+  /// either PL could grow (the margins are 1-Lipschitz in the point).
+  double margin_h_m = 0.0;
+  double margin_v_m = 0.0;
+};
+
+/// \brief Operating limits of the mission that clip the boxes vertically [m, ellipsoidal].
+struct OperatingLimits {
+  double floor_h_ell_m = -std::numeric_limits<double>::infinity();
+  double ceiling_h_ell_m = std::numeric_limits<double>::infinity();
+};
+
+/// \brief Boxes along a path: one per segment, half-width HAL and half-height VAL round the
+/// centre line, and a vertical cylinder of radius HAL at each waypoint covering the joint (and
+/// the path's ends). A segment's **piece** is the set of points whose horizontal distance to
+/// the segment is ≤ HAL and whose height is within VAL of the centre line at the nearest
+/// point of the segment (the box plus the halves of the two end cylinders).
+class Corridor {
+ public:
+  /// \brief The path (map frame, ≥ 2 waypoints, finite), the limits and the operating limits.
+  /// \throws std::invalid_argument for fewer than 2 waypoints, a non-finite coordinate or
+  /// non-positive limits.
+  Corridor(std::vector<Eigen::Vector3d> path_map, AlertLimits limits, OperatingLimits operating = {});
+
+  /// \brief The waypoints.
+  [[nodiscard]] const std::vector<Eigen::Vector3d>& path() const { return path_; }
+  /// \brief HAL and VAL.
+  [[nodiscard]] const AlertLimits& limits() const { return limits_; }
+  /// \brief Number of segments.
+  [[nodiscard]] std::size_t segmentCount() const { return path_.size() - 1; }
+
+  /// \brief The segment's box as 8 corners (bottom four, then top four, counter-clockwise seen
+  /// from above): a box along the horizontal direction of the segment, sheared to follow its
+  /// climb; a convex hexahedron for the collision library.
+  [[nodiscard]] std::array<Eigen::Vector3d, 8> segmentBoxCorners(std::size_t segment) const;
+
+  /// \brief Whether the protection volume lies inside one piece or inside the union of the
+  /// pieces it touches (across a joint), and within the operating limits. `tolerance_m`: a
+  /// deciding margin with |margin| ≤ tolerance is indeterminate.
+  /// \throws std::invalid_argument for a non-finite position or a negative/non-finite PL.
+  [[nodiscard]] Containment contains(const ProtectionVolume& volume, double tolerance_m = 1e-6) const;
+
+ private:
+  std::vector<Eigen::Vector3d> path_;
+  AlertLimits limits_;
+  OperatingLimits operating_;
+};
+
+}  // namespace skylane::geofence

@@ -1,0 +1,216 @@
+#include "geofence/corridor.hpp"
+
+#include "tests/test_util.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <functional>
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace skylane::geofence {
+namespace {
+
+constexpr double kPi = 3.141592653589793;
+
+// --- alert limits ------------------------------------------------------------------------------
+
+TEST(BoxLevels, AlertLimitsScaleTheMappedDimensions) {
+  // GIVEN a 1.0 m span, 0.8 m long, 0.3 m high vehicle with seed 000's mapping
+  const Vehicle v{1.0, 0.8, 0.3};
+  const LevelLimits l = alertLimits(v, BoxLevels{});
+  // THEN HAL = k·lateral and VAL = k·longitudinal at k₁ = 1.2 and k₂ = 300
+  EXPECT_DOUBLE_EQ(l.level1.hal_m, 1.2);
+  EXPECT_DOUBLE_EQ(l.level1.val_m, 0.96);
+  EXPECT_DOUBLE_EQ(l.level2.hal_m, 300.0);
+  EXPECT_DOUBLE_EQ(l.level2.val_m, 240.0);
+  EXPECT_TRUE(l.warnings.empty());
+  // AND the mapping is configurable (VAL from the height)
+  BoxLevels by_height;
+  by_height.mapping.vertical = Dimension::kHeight;
+  EXPECT_DOUBLE_EQ(alertLimits(v, by_height).level1.val_m, 1.2 * 0.3);
+}
+
+TEST(BoxLevels, FactorsOutsideTheSeedRangesNeedAnOverride) {
+  const Vehicle v{1.0, 0.8, 0.3};
+  BoxLevels wide;
+  wide.k1 = 1.5;
+  const std::string msg = test::messageOf<std::invalid_argument>([&] { (void)alertLimits(v, wide); });
+  EXPECT_NE(msg.find("k1 = 1.5 is outside seed 000's range [1.1, 1.3]"), std::string::npos) << msg;
+  wide.override_ranges = true;
+  const LevelLimits l = alertLimits(v, wide);
+  EXPECT_DOUBLE_EQ(l.level1.hal_m, 1.5);
+  ASSERT_EQ(l.warnings.size(), 1u);
+  EXPECT_NE(l.warnings[0].find("accepted by override"), std::string::npos);
+  BoxLevels tiny;
+  tiny.k2 = 50;
+  EXPECT_THROW((void)alertLimits(v, tiny), std::invalid_argument);
+  EXPECT_THROW((void)alertLimits(Vehicle{0.0, 0.8, 0.3}, BoxLevels{}), std::invalid_argument);
+}
+
+// --- containment ---------------------------------------------------------------------------------
+
+TEST(Corridor, StraightLevelSegmentMarginsAreTheOffsetsFromTheWalls) {
+  // GIVEN a level corridor 100 m east at 100 m, HAL 6 m, VAL 4 m
+  const Corridor c({{0, 0, 100}, {100, 0, 100}}, {6.0, 4.0});
+  // WHEN the volume is 2 m off the centre line and 1 m high, HPL 3, VPL 2
+  const Containment in = c.contains({{50, 2, 101}, 3.0, 2.0});
+  // THEN the margins are 6 − 2 − 3 = 1 and 4 − 1 − 2 = 1
+  EXPECT_EQ(in.verdict, Verdict::kInside);
+  EXPECT_NEAR(in.margin_h_m, 1.0, 1e-12);
+  EXPECT_NEAR(in.margin_v_m, 1.0, 1e-12);
+  EXPECT_FALSE(in.across_joint);
+  // A larger HPL sticks out by 0.5 m; exactly at the wall is indeterminate.
+  EXPECT_EQ(c.contains({{50, 2, 101}, 4.5, 2.0}).verdict, Verdict::kOutside);
+  EXPECT_NEAR(c.contains({{50, 2, 101}, 4.5, 2.0}).margin_h_m, -0.5, 1e-12);
+  EXPECT_EQ(c.contains({{50, 2, 101}, 4.0, 2.0}).verdict, Verdict::kIndeterminate);
+  // The centre inside but the volume's top through the ceiling: outside (the volume counts).
+  EXPECT_EQ(c.contains({{50, 0, 103}, 1.0, 2.0}).verdict, Verdict::kOutside);
+  // Beyond the end, within the end cylinder: inside.
+  EXPECT_EQ(c.contains({{103, 0, 100}, 2.0, 1.0}).verdict, Verdict::kInside);
+  EXPECT_THROW((void)c.contains({{NAN, 0, 100}, 1.0, 1.0}), std::invalid_argument);
+  EXPECT_THROW((void)c.contains({{0, 0, 100}, -1.0, 1.0}), std::invalid_argument);
+}
+
+TEST(Corridor, ClimbingSegmentTakesTheSlopeAcrossTheDisk) {
+  // GIVEN a segment climbing 50 m over 100 m (slope 0.5), VAL 4
+  const Corridor c({{0, 0, 0}, {100, 0, 50}}, {6.0, 4.0});
+  // WHEN a volume of HPL 2, VPL 1 is on the centre line at x = 50 (z = 25)
+  const Containment r = c.contains({{50, 0, 25}, 2.0, 1.0});
+  // THEN the ceiling over the disk is lowest at x = 48: 24 + 4 = 28, the top 26 → margin 2
+  EXPECT_EQ(r.verdict, Verdict::kInside);
+  EXPECT_NEAR(r.margin_v_m, 2.0, 1e-12);
+}
+
+TEST(Corridor, OperatingLimitsClipTheBoxes) {
+  // GIVEN a level-2 box (HAL 300, VAL 240 round 100 m) under a 150 m operating ceiling
+  const Corridor c({{0, 0, 100}, {100, 0, 100}}, {300.0, 240.0}, {0.0, 150.0});
+  // THEN a volume reaching 148 m is inside by 2 m, one reaching 153 m is out by 3 m
+  EXPECT_NEAR(c.contains({{50, 0, 140}, 5.0, 8.0}).margin_v_m, 2.0, 1e-12);
+  const Containment r = c.contains({{50, 0, 145}, 5.0, 8.0});
+  EXPECT_EQ(r.verdict, Verdict::kOutside);
+  EXPECT_NEAR(r.margin_v_m, -3.0, 1e-12);
+  EXPECT_THROW(Corridor({{0, 0, 0}, {1, 0, 0}}, {1, 1}, {10.0, 5.0}), std::invalid_argument);
+  EXPECT_THROW(Corridor({{0, 0, 0}}, {1, 1}), std::invalid_argument);
+}
+
+TEST(Corridor, JointAtARightAngleTurnIsCovered) {
+  // GIVEN a path east then north with a 90° turn at (100, 0), HAL 6
+  const Corridor c({{0, 0, 50}, {100, 0, 50}, {100, 100, 50}}, {6.0, 4.0});
+  // WHEN the volume is off the outer corner, at (103, −3), HPL 1: outside both boxes' rectangles
+  const Containment r = c.contains({{103, -3, 50}, 1.0, 1.0});
+  // THEN the joint cylinder holds it: margin 6 − √18 − 1
+  EXPECT_EQ(r.verdict, Verdict::kInside);
+  EXPECT_NEAR(r.margin_h_m, 6.0 - std::sqrt(18.0) - 1.0, 1e-12);
+  // AND inside the turn, a volume at (98, 2) with HPL 4.5 is held by no single piece
+  // (6 − 2 − 4.5 < 0) but by their union: its farthest point from the path lies along the
+  // bisector, 2 + 4.5/√2 from both legs, so the union margin is 6 − 2 − 4.5/√2 = 0.818 m.
+  const Containment inner = c.contains({{98, 2, 50}, 4.5, 1.0});
+  EXPECT_EQ(inner.verdict, Verdict::kInside);
+  EXPECT_TRUE(inner.across_joint);
+  EXPECT_LE(inner.margin_h_m, 6.0 - 2.0 - 4.5 / std::sqrt(2.0) + 1e-12);
+  EXPECT_GE(inner.margin_h_m, 6.0 - 2.0 - 4.5 / std::sqrt(2.0) - 6e-3);  // certified to HAL/1000
+  // AND at (97, 3) with HPL 5 the bisector point is 3 + 5/√2 = 6.54 m from both legs: outside
+  EXPECT_EQ(c.contains({{97, 3, 50}, 5.0, 1.0}).verdict, Verdict::kOutside);
+}
+
+/// The whole scene moved: rotated about the vertical by `yaw` and translated by `t`.
+Eigen::Vector3d moved(const Eigen::Vector3d& p, double yaw, const Eigen::Vector3d& t) {
+  return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * p + t;
+}
+
+TEST(Corridor, VerdictsAndMarginsAreFrameInvariant) {
+  const std::vector<Eigen::Vector3d> path{{0, 0, 50}, {100, 0, 60}, {100, 100, 60}, {30, 150, 40}};
+  const std::vector<ProtectionVolume> volumes{{{50, 2, 56}, 3.0, 2.0}, {{103, -3, 60}, 1.0, 1.0},
+                                              {{98, 2, 59}, 4.5, 1.0}, {{97, 3, 60}, 5.0, 1.0},
+                                              {{70, 120, 52}, 2.0, 1.5}, {{0, 0, 50}, 10.0, 1.0}};
+  const Corridor base(path, {6.0, 4.0});
+  for (const double yaw : {0.3, -2.0, kPi / 2}) {
+    const Eigen::Vector3d t(-250000.0, 4.2e6, 300.0);
+    std::vector<Eigen::Vector3d> p2;
+    for (const Eigen::Vector3d& p : path) p2.push_back(moved(p, yaw, t));
+    const Corridor turned(p2, {6.0, 4.0});
+    for (std::size_t k = 0; k < volumes.size(); ++k) {
+      const Containment a = base.contains(volumes[k]);
+      const Containment b = turned.contains({moved(volumes[k].p_map, yaw, t), volumes[k].hpl_m, volumes[k].vpl_m});
+      EXPECT_EQ(a.verdict, b.verdict) << "volume " << k << " yaw " << yaw;
+      // Exact for one piece; across a joint both are certified to within HAL/1000.
+      const double tol = a.across_joint ? 6e-3 : 1e-6;
+      EXPECT_EQ(a.across_joint, b.across_joint) << "volume " << k << " yaw " << yaw;
+      EXPECT_NEAR(a.margin_h_m, b.margin_h_m, tol) << "volume " << k << " yaw " << yaw;
+      EXPECT_NEAR(a.margin_v_m, b.margin_v_m, tol) << "volume " << k << " yaw " << yaw;
+    }
+  }
+}
+
+/// Whether the point lies in some piece, computed independently: horizontal distance to the
+/// segment ≤ HAL and height within VAL of the centre line at the nearest point.
+bool inSomePiece(const std::vector<Eigen::Vector3d>& path, const Eigen::Vector3d& x, double hal, double val) {
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    const Eigen::Vector2d a = path[i].head<2>(), b = path[i + 1].head<2>();
+    const double t = std::clamp((x.head<2>() - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+    const double z = path[i].z() + t * (path[i + 1].z() - path[i].z());
+    if ((x.head<2>() - (a + t * (b - a))).norm() <= hal && std::abs(x.z() - z) <= val) return true;
+  }
+  return false;
+}
+
+TEST(Corridor, RandomScenesInsideMeansEverySampledPointIsInAPieceAndLargerPlsNeverTurnInside) {
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int inside = 0, outside = 0, joints = 0;
+  for (int scene = 0; scene < 300; ++scene) {
+    std::vector<Eigen::Vector3d> path{{0, 0, 100}};
+    for (int k = 0; k < 4; ++k) {
+      const double heading = 2 * kPi * u(rng), length = 20 + 80 * u(rng);
+      path.push_back(path.back() + Eigen::Vector3d(length * std::cos(heading), length * std::sin(heading), -10 + 20 * u(rng)));
+    }
+    const double hal = 3 + 10 * u(rng), val = 2 + 6 * u(rng);
+    const Corridor c(path, {hal, val});
+    for (int k = 0; k < 20; ++k) {
+      // A position near a random point of the path.
+      const std::size_t seg = rng() % 4;
+      const Eigen::Vector3d on = path[seg] + u(rng) * (path[seg + 1] - path[seg]);
+      const Eigen::Vector3d p = on + Eigen::Vector3d(hal * (2 * u(rng) - 1), hal * (2 * u(rng) - 1), val * (2 * u(rng) - 1));
+      const double hpl = hal * u(rng), vpl = val * u(rng);
+      const Containment r = c.contains({p, hpl, vpl});
+      if (r.verdict == Verdict::kInside) {
+        ++inside;
+        joints += r.across_joint ? 1 : 0;
+        // THEN every sampled point of the cylinder lies in some piece
+        for (int s = 0; s < 200; ++s) {
+          const double a = 2 * kPi * u(rng), rr = hpl * std::sqrt(u(rng));
+          const Eigen::Vector3d x = p + Eigen::Vector3d(rr * std::cos(a), rr * std::sin(a), vpl * (2 * u(rng) - 1));
+          ASSERT_TRUE(inSomePiece(path, x, hal, val)) << "scene " << scene << " volume " << k << " sample " << s;
+        }
+      } else {
+        ++outside;
+      }
+      // AND a larger HPL or VPL never turns "not inside" into "inside"
+      if (r.verdict != Verdict::kInside) {
+        EXPECT_NE(c.contains({p, hpl * 1.1 + 0.01, vpl}).verdict, Verdict::kInside) << "scene " << scene;
+        EXPECT_NE(c.contains({p, hpl, vpl * 1.1 + 0.01}).verdict, Verdict::kInside) << "scene " << scene;
+      }
+    }
+  }
+  // The scenes exercise both outcomes and the joints.
+  EXPECT_GT(inside, 500);
+  EXPECT_GT(outside, 500);
+  EXPECT_GT(joints, 10);
+}
+
+TEST(Corridor, SegmentBoxCornersFollowTheClimb) {
+  const Corridor c({{0, 0, 0}, {100, 0, 50}}, {6.0, 4.0});
+  const auto k = c.segmentBoxCorners(0);
+  EXPECT_TRUE(test::nearVec(k[0], Eigen::Vector3d(0, -6, -4), 1e-12));
+  EXPECT_TRUE(test::nearVec(k[2], Eigen::Vector3d(100, 6, 46), 1e-12));
+  EXPECT_TRUE(test::nearVec(k[6], Eigen::Vector3d(100, 6, 54), 1e-12));
+  EXPECT_THROW((void)c.segmentBoxCorners(1), std::out_of_range);
+}
+
+}  // namespace
+}  // namespace skylane::geofence
