@@ -88,7 +88,8 @@ struct Containment {
   /// lower bound on a sloping segment. Across a joint both fields hold the one combined
   /// margin, min over the volume's points of their best piece's margin, certified from below
   /// to within max(tolerance, HAL/1000) by branch and bound; it is a lower bound on how much
-  /// either PL could grow (the margins are 1-Lipschitz in the point).
+  /// either PL could grow (the margins are 1-Lipschitz in the point). A larger PL never turns
+  /// a verdict into "inside" except, across a joint, within that accuracy.
   double margin_h_m = 0.0;
   double margin_v_m = 0.0;
 };
