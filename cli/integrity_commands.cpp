@@ -1,5 +1,6 @@
 #include "cli/integrity_commands.hpp"
 
+#include "cli/skymask_commands.hpp"
 #include "cli/svg_plot.hpp"
 #include "integrity/availability.hpp"
 #include "integrity/geometry_file.hpp"
@@ -229,6 +230,9 @@ struct PredictOptions {
   std::string user_model = "dual_frequency";
   std::string method = "araim";
   bool progress = false;
+  std::string buildings;
+  std::string terrain;
+  std::optional<double> ground_amsl_m;
 };
 
 void runPredict(const PredictOptions& o) {
@@ -248,6 +252,11 @@ void runPredict(const PredictOptions& o) {
   if (!o.ism.empty()) applyIsmFile(o.ism, req.model);
   if (o.format != "csv" && o.format != "jsonl") throw ParseError("--format", 0, "--format", o.format, "csv or jsonl");
 
+  if (!o.buildings.empty() || !o.terrain.empty()) {
+    // Satellites behind the buildings and terrain around the place are dropped (--alt is the antenna).
+    const maps::Terrain ground = groundModel(o.terrain, o.ground_amsl_m);
+    req.sky_mask = skyMaskAt(req.place, o.buildings, ground, !o.terrain.empty(), maps::SkyMaskOptions{});
+  }
   const integrity::OrbitSource orbits = loadOrbits(o.almanacs, o.navs);
   const double age = orbits.almanacAge_s(req.start);
   if (age > 4 * integrity::kSecondsPerWeek) {
@@ -292,6 +301,7 @@ void runPredict(const PredictOptions& o) {
       j["hdop"] = r4(s.dops.hdop);
       j["vdop"] = r4(s.dops.vdop);
       j["satellites"] = satList(ids);
+      if (req.sky_mask) j["blocked_by_sky_mask"] = s.blocked;
       out << j.dump() << "\n";
     }
   }
@@ -486,6 +496,9 @@ void addIntegrityCommands(CLI::App& app) {
   c->add_option("--ism", pr->ism, "JSON file with an ism object overriding the defaults");
   c->add_option("--user-model", pr->user_model, "dual_frequency or single_frequency");
   c->add_option("--method", pr->method, "integrity method: araim (default) or raim");
+  c->add_option("--buildings", pr->buildings, "GeoJSON buildings: drop satellites behind them (sky mask at the place)");
+  c->add_option("--terrain", pr->terrain, "terrain raster: ground under --buildings, and drop satellites behind the terrain");
+  c->add_option("--ground-amsl", pr->ground_amsl_m, "flat ground under --buildings at this altitude AMSL [m] (default 0)");
   c->add_flag("--progress", pr->progress, "show a progress bar even when stderr is not a terminal");
   c->callback([pr] { runPredict(*pr); });
 

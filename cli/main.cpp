@@ -2,6 +2,7 @@
 /// \brief The `skylane` command: parse, call, print; errors → one line on stderr, exit 2.
 
 #include "cli/integrity_commands.hpp"
+#include "cli/skymask_commands.hpp"
 #include "cli/zones_commands.hpp"
 #include "integrity/gnss/parse_error.hpp"
 
@@ -15,6 +16,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   skylane::cli::addIntegrityCommands(app);
   skylane::cli::addZonesCommands(app);
+  skylane::cli::addSkyMaskCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -179,4 +179,43 @@ std::string renderAvailabilityMapSvg(const std::string& title, const std::vector
   return s.str();
 }
 
+std::string renderSkyPlotSvg(const std::string& title, const std::vector<double>& blocked_deg, double bin_deg,
+                             const std::string& footer) {
+  const double size = 560, cx = size / 2, cy = 60 + size / 2 - 20, r_horizon = size / 2 - 50;
+  // Radius of an elevation: linear in zenith angle (equidistant polar plot, as sky plots are drawn).
+  const auto radius = [&](double el_deg) { return r_horizon * (90.0 - std::clamp(el_deg, 0.0, 90.0)) / 90.0; };
+  const auto X = [&](double az_deg, double rr) { return cx + rr * std::sin(az_deg * M_PI / 180.0); };
+  const auto Y = [&](double az_deg, double rr) { return cy - rr * std::cos(az_deg * M_PI / 180.0); };
+  std::ostringstream s;
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << size << "\" height=\"" << cy + r_horizon + 60
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  s << "<text x=\"" << cx << "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">" << escape(title) << "</text>\n";
+  // The blocked sky: one wedge per bin, from the horizon circle in to the blocked elevation.
+  s << "<g fill=\"#8c8c8c\" stroke=\"#8c8c8c\" stroke-width=\"0.5\">\n";  // the stroke closes the seams between wedges
+  for (std::size_t k = 0; k < blocked_deg.size(); ++k) {
+    if (!(blocked_deg[k] > 0.0)) continue;
+    const double a0 = static_cast<double>(k) * bin_deg, a1 = a0 + bin_deg, r_in = radius(blocked_deg[k]);
+    s << "<path d=\"M" << fmt(X(a0, r_horizon)) << "," << fmt(Y(a0, r_horizon)) << " A" << fmt(r_horizon) << ","
+      << fmt(r_horizon) << " 0 0 1 " << fmt(X(a1, r_horizon)) << "," << fmt(Y(a1, r_horizon)) << " L" << fmt(X(a1, r_in))
+      << "," << fmt(Y(a1, r_in));
+    if (r_in > 0.0) s << " A" << fmt(r_in) << "," << fmt(r_in) << " 0 0 0 " << fmt(X(a0, r_in)) << "," << fmt(Y(a0, r_in));
+    s << " Z\"/>\n";
+  }
+  s << "</g>\n";
+  for (int el = 0; el < 90; el += 30) {
+    s << "<circle cx=\"" << cx << "\" cy=\"" << cy << "\" r=\"" << fmt(radius(el)) << "\" fill=\"none\" stroke=\""
+      << (el == 0 ? "#222" : "#bbb") << "\"/>\n";
+    if (el > 0) s << "<text x=\"" << cx + 3 << "\" y=\"" << fmt(cy - radius(el) - 3) << "\" fill=\"#444\">" << el << "°</text>\n";
+  }
+  for (int az = 0; az < 360; az += 30) {
+    s << "<line x1=\"" << cx << "\" y1=\"" << cy << "\" x2=\"" << fmt(X(az, r_horizon)) << "\" y2=\"" << fmt(Y(az, r_horizon))
+      << "\" stroke=\"#ddd\"/>\n";
+    static const char* kNames[] = {"N", "30°", "60°", "E", "120°", "150°", "S", "210°", "240°", "W", "300°", "330°"};
+    s << "<text x=\"" << fmt(X(az, r_horizon + 16)) << "\" y=\"" << fmt(Y(az, r_horizon + 16) + 4)
+      << "\" text-anchor=\"middle\">" << kNames[az / 30] << "</text>\n";
+  }
+  s << "<text x=\"" << 20 << "\" y=\"" << fmt(cy + r_horizon + 45) << "\">" << escape(footer) << "</text>\n</svg>\n";
+  return s.str();
+}
+
 }  // namespace skylane::cli

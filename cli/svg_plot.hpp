@@ -37,4 +37,11 @@ struct MapCell {
 [[nodiscard]] std::string renderAvailabilityMapSvg(const std::string& title, const std::vector<MapCell>& cells,
                                                    double cell_deg, const std::string& footer);
 
+/// \brief A polar sky plot (zenith at the centre, horizon on the circle, north up and east to
+/// the right, as GNSS sky plots are drawn): each azimuth bin shaded from the horizon up to its blocked
+/// elevation [deg] (bins at or below 0° are not shaded); elevation rings every 30°.
+/// `bin_deg` is the bins' width, bin k covering [k·bin_deg, (k+1)·bin_deg).
+[[nodiscard]] std::string renderSkyPlotSvg(const std::string& title, const std::vector<double>& blocked_deg, double bin_deg,
+                                           const std::string& footer);
+
 }  // namespace skylane::cli

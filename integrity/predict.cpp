@@ -32,7 +32,13 @@ std::vector<PredictSample> predictIntegrity(const OrbitSource& orbits, const Pre
   for (std::size_t k = 0; k < n; ++k) {
     PredictSample s;
     s.t = req.start.plus(static_cast<double>(k) * req.step_s);
-    for (const VisibleSatellite& v : orbits.visible(p_user, s.t, req.mask_rad)) s.sats.push_back({v.sat, v.look});
+    for (const VisibleSatellite& v : orbits.visible(p_user, s.t, req.mask_rad)) {
+      if (req.sky_mask && !req.sky_mask->isVisible(v.look)) {
+        ++s.blocked;
+        continue;
+      }
+      s.sats.push_back({v.sat, v.look});
+    }
     const Geometry g = buildGeometry(s.sats, req.model, tau);
     s.dops = computeDops(g);
     s.pl = protectionLevels(g, method, req.model, req.raim, req.araim);

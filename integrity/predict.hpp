@@ -7,8 +7,10 @@
 #include "integrity/araim/mhss.hpp"
 #include "integrity/pl_summary.hpp"
 #include "integrity/raim/raim.hpp"
+#include "maps/sky_mask.hpp"
 
 #include <functional>
+#include <optional>
 #include <vector>
 
 namespace skylane::integrity {
@@ -23,6 +25,9 @@ struct PredictRequest {
   ErrorModel model;
   RaimConfig raim;
   AraimConfig araim;  ///< its requirements are the ones used for availability
+  /// Buildings and terrain around the place (maps::computeSkyMask): a satellite above
+  /// mask_rad but not above its azimuth bin's blocked elevation is dropped.
+  std::optional<maps::SkyMask> sky_mask;
 };
 
 
@@ -35,7 +40,8 @@ struct Dops {
 /// \brief One predicted epoch.
 struct PredictSample {
   GpsTime t;
-  std::vector<SatLook> sats;
+  std::vector<SatLook> sats;  ///< the satellites used: above the mask and not behind the sky mask
+  std::size_t blocked = 0;    ///< satellites above mask_rad dropped by the sky mask
   Dops dops;
   PlSummary pl;
 };

@@ -4,6 +4,7 @@
 #include "maps/geodesy.hpp"
 #include "maps/geoid.hpp"
 #include "maps/parse_error.hpp"
+#include "maps/plane_frame.hpp"
 
 #include <cpl_error.h>
 #include <gdal_priv.h>
@@ -68,6 +69,7 @@ struct Terrain::Raster {
   CtPtr to_raster;            ///< WGS-84 lon/lat → raster CRS (when not identity).
   mutable std::mutex ct_mutex;
   double lat_min_deg = 0, lat_max_deg = 0, lon_min_deg = 0, lon_max_deg = 0;  ///< WGS-84 footprint.
+  double cell_m = NAN;        ///< Cell size on the ground at the centre (NaN: unknown).
 
   [[nodiscard]] float at(int r, int c) const {
     return z_m[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)];
@@ -182,6 +184,24 @@ Terrain Terrain::fromRaster(const std::string& path, HeightDatum datum) {
   }
   if (first) throw ParseError(path, 0, "raster.crs", r->crs, "a raster whose footprint maps to WGS-84 longitude/latitude");
 
+  // --- cell size on the ground at the centre: geodesics to the neighbouring cell centres ----
+  {
+    const double uc = std::floor(0.5 * r->cols) + 0.5, vc = std::floor(0.5 * r->rows) + 0.5;
+    const double uv[3][2] = {{uc, vc}, {uc + 1.0, vc}, {uc, vc + 1.0}};
+    double lon[3], lat[3];
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) {
+      lon[k] = edgeX(uv[k][0], uv[k][1]);
+      lat[k] = edgeY(uv[k][0], uv[k][1]);
+      if (to_wgs84 && (!to_wgs84->Transform(1, &lon[k], &lat[k]))) ok = false;
+      ok = ok && std::isfinite(lon[k]) && std::abs(lat[k]) <= 90.0;
+    }
+    if (ok) {
+      r->cell_m = std::min(geodesicDistance_m(deg2rad(lat[0]), deg2rad(lon[0]), deg2rad(lat[1]), deg2rad(lon[1])),
+                           geodesicDistance_m(deg2rad(lat[0]), deg2rad(lon[0]), deg2rad(lat[2]), deg2rad(lon[2])));
+    }
+  }
+
   // --- band 1, whole, voids as NaN -----------------------------------------------------------
   GDALRasterBand* band = ds->GetRasterBand(1);
   int has_nodata = 0, has_scale = 0, has_offset = 0;
@@ -218,6 +238,11 @@ std::optional<double> Terrain::altAmsl_m(double lat_rad, double lon_rad) const {
   const std::optional<double> z_m = raster_->interpolate(uv->first, uv->second);
   if (!z_m || datum_ == HeightDatum::kAmslEgm96) return z_m;
   return Geoid::egm96().amslFromEllipsoidal_m(lat_rad, lon_rad, *z_m);
+}
+
+std::optional<double> Terrain::cellSize_m() const {
+  if (!raster_ || !(raster_->cell_m > 0.0)) return std::nullopt;
+  return raster_->cell_m;
 }
 
 std::optional<double> Terrain::heightEllipsoid_m(double lat_rad, double lon_rad) const {

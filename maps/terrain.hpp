@@ -78,6 +78,11 @@ class Terrain {
   [[nodiscard]] std::optional<std::pair<double, double>> rangeAmsl_m(
       const std::vector<std::pair<double, double>>& ring_lat_lon_rad) const;
 
+  /// \brief The raster's cell size on the ground [m]: the shorter of a cell's two sides at the
+  /// raster's centre (geodesic lengths between neighbouring cell centres); nullopt for flat
+  /// terrain or when the centre cannot be mapped to WGS-84.
+  [[nodiscard]] std::optional<double> cellSize_m() const;
+
   /// \brief True for the constant-altitude terrain of flat().
   [[nodiscard]] bool isFlat() const { return raster_ == nullptr; }
 

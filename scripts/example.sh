@@ -31,3 +31,7 @@ wc -l < examples/out/spp_3040.jsonl
 echo "--- geozones (examples/out/zones_validate.txt, zones_at.json, zones.geojson):"
 tail -1 examples/out/zones_validate.txt
 grep -E '"(zone|why)"' examples/out/zones_at.json
+./build/skylane skymask --lat 47.3769 --lon 8.5417 --height-agl 1.5 --ground-amsl 408 \
+  --buildings examples/skymask/buildings.geojson --svg examples/out/skymask.svg > examples/out/skymask.json
+echo "--- sky mask among buildings (examples/out/skymask.json, plot examples/out/skymask.svg):"
+python3 -c 'import json; j=json.load(open("examples/out/skymask.json")); print(j["buildings"]["count"], "buildings; highest blocked elevation", j["max_blocked_elevation_deg"], "deg")'

@@ -161,6 +161,52 @@ TEST(Cli, AvailabilityMapHasCellsColourScaleAndCoastlines) {
   EXPECT_NE(text.find("availability"), std::string::npos);
 }
 
+TEST(Cli, SkymaskPrintsBlockedElevationPerBinAndDrawsASkyPlot) {
+  // GIVEN one 20 m building whose near face is 30 m north of a point 1.5 m above flat ground
+  const double lat = 47.3769, lon = 8.5417;
+  const maps::LocalFrame frame({maps::deg2rad(lat), maps::deg2rad(lon), 0.0});
+  std::string ring;
+  for (const auto& [e, n] : {std::pair{-15.0, 30.0}, {15.0, 30.0}, {15.0, 40.0}, {-15.0, 40.0}, {-15.0, 30.0}}) {
+    const maps::Geodetic g = frame.fromEnu({e, n, 0});
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%s[%.10f,%.10f]", ring.empty() ? "" : ",", maps::rad2deg(g.lon_rad), maps::rad2deg(g.lat_rad));
+    ring += buf;
+  }
+  const std::string file = writeTemp("block.geojson", R"({"type":"FeatureCollection","features":[{"type":"Feature","id":"way/1",)"
+                                                      R"("properties":{"height":"20 m"},"geometry":{"type":"Polygon","coordinates":[[)" + ring + "]]}}]}");
+  const std::string svg = test::scratchPath("sky.svg");
+  const RunResult r = run("skymask --lat 47.3769 --lon 8.5417 --height-agl 1.5 --ground-amsl 400 --bin-deg 2 --buildings " + file +
+                          " --svg " + svg);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["azimuth_from_deg"].size(), 180u);
+  EXPECT_EQ(j["azimuth_from_deg"][1].get<double>(), 2.0);
+  EXPECT_EQ(j["buildings"]["count"].get<int>(), 1);
+  // THEN the bin facing it holds atan(18.5 / 30) = 31.66° (the geoid's spread over the
+  // footprint raises the top by at most a few decimetres: 0.4° at 30 m)
+  const double north = j["blocked_elevation_deg"][0].get<double>();
+  EXPECT_GE(north, 31.66 - 0.01);
+  EXPECT_LE(north, 31.66 + 0.4);
+  // AND half the face's width, atan(15 / 30) = 26.6°, ends the blocked bins (2° bins: 0 … 26)
+  EXPECT_GT(j["blocked_elevation_deg"][13].get<double>(), 20.0);
+  EXPECT_LT(j["blocked_elevation_deg"][14].get<double>(), 0.0);
+  EXPECT_LT(j["blocked_elevation_deg"][90].get<double>(), 0.0) << "south: the flat ground's horizon";
+  EXPECT_NEAR(j["position"]["alt_amsl_m"].get<double>(), 401.5, 1e-3);
+  std::ifstream in(svg);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_NE(ss.str().find("<svg"), std::string::npos);
+  EXPECT_NE(ss.str().find("1 buildings from"), std::string::npos);
+
+  // Bad input: the feature, the field and the value in one line, exit 2.
+  const std::string bad = writeTemp("bad_block.geojson", R"({"type":"FeatureCollection","features":[{"type":"Feature","id":"way/9",)"
+                                                         R"("properties":{"building:levels":"many"},"geometry":{"type":"Polygon","coordinates":[[)" + ring + "]]}}]}");
+  const RunResult e = run("skymask --lat 47.3769 --lon 8.5417 --h-ell 450 --buildings " + bad);
+  EXPECT_EQ(e.status, 2);
+  EXPECT_NE(e.out.find("bad_block.geojson: field 'features[0](way/9).properties.building:levels': got 'many'"), std::string::npos) << e.out;
+  EXPECT_EQ(run("skymask --lat 47.3769 --lon 8.5417 --h-ell 450 --bin-deg 7 --buildings " + file).status, 2);
+}
+
 TEST(Cli, ZonesValidateReportsEveryZoneAndExitsTwoWhenInvalid) {
   const RunResult ok = run("zones validate " + test::dataPath("geozones/geo-awareness-che-1.json") + " " +
                            test::dataPath("geozones/cis_source_sample_ed318.json"));

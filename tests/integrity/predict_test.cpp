@@ -52,5 +52,44 @@ TEST(Predict, DopsOfASymmetricSky) {
   EXPECT_NEAR(d.vdop, std::sqrt(5.0 / 4.0), 1e-12);
 }
 
+TEST(Predict, ASatelliteBehindABuildingIsDropped) {
+  // GIVEN the MOPS constellation over Zürich at one epoch, and the lowest satellite above 15°
+  OrbitSource orbits;
+  orbits.addAlmanac(loadAlmanac(test::dataPath("gnss/almmops.txt")));
+  PredictRequest req;
+  req.place = {maps::deg2rad(47.3769), maps::deg2rad(8.5417), 450.0};
+  req.start = *parseRfc3339("2020-01-01T00:00:00Z");
+  req.duration_s = 0;
+  const PredictSample open_sky = predictIntegrity(orbits, req, IntegrityMethod::kRaim).front();
+  const SatLook* target = nullptr;
+  for (const SatLook& s : open_sky.sats) {
+    if (s.look.elevation_rad > maps::deg2rad(15) && (!target || s.look.elevation_rad < target->look.elevation_rad)) target = &s;
+  }
+  ASSERT_NE(target, nullptr);
+  // WHEN a building 20 m away in its direction, 10 m wide, rises 5° above it
+  const double az = target->look.azimuth_rad, d = 20.0;
+  const double height = 1.5 + d * std::tan(target->look.elevation_rad + maps::deg2rad(5));
+  const maps::LocalFrame frame({req.place.lat_rad, req.place.lon_rad, 448.5});
+  const Eigen::Vector2d u(std::sin(az), std::cos(az)), v(std::cos(az), -std::sin(az));
+  maps::Building b;
+  for (const auto& [across, along] : {std::pair{-5.0, d}, {5.0, d}, {5.0, d + 8}, {-5.0, d + 8}}) {
+    const Eigen::Vector2d p = across * v + along * u;
+    const maps::Geodetic g = frame.fromEnu({p.x(), p.y(), 0});
+    b.ring_lat_lon_rad.emplace_back(g.lat_rad, g.lon_rad);
+  }
+  b.base_h_ell_m = 448.5;
+  b.top_h_ell_m = 448.5 + height;
+  const maps::BuildingIndex index({b});
+  req.sky_mask = maps::computeSkyMask(req.place, &index, nullptr);
+  const PredictSample masked = predictIntegrity(orbits, req, IntegrityMethod::kRaim).front();
+  // THEN that satellite is gone, counted as blocked, and every satellite left was in the open sky
+  EXPECT_GE(masked.blocked, 1u);
+  EXPECT_EQ(masked.sats.size() + masked.blocked, open_sky.sats.size());
+  for (const SatLook& s : masked.sats) {
+    EXPECT_NE(s.sat.str(), target->sat.str());
+    EXPECT_TRUE(req.sky_mask->isVisible(s.look)) << s.sat.str();
+  }
+}
+
 }  // namespace
 }  // namespace skylane::integrity
