@@ -2,6 +2,7 @@
 
 #include "airspace/applicability.hpp"
 #include "maps/geodesy.hpp"
+#include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
 
@@ -17,6 +18,8 @@ namespace {
 
 using nlohmann::json;
 using maps::ParseError;
+using maps::quoteJson;
+using Node = maps::JsonNode;
 
 /// The member's text when it is a string, "" otherwise (absent, a number, an array …).
 std::string stringMember(const json& doc, const char* key) {
@@ -26,71 +29,23 @@ std::string stringMember(const json& doc, const char* key) {
 
 /// ED-318 writes 99999 (in the layer's unit) for "no upper limit".
 constexpr double kEd318Unlimited = 99999.0;
-/// Longest text kept from a JSON value quoted in an error message.
-constexpr std::size_t kQuoteChars = 60;
 
-std::string quote(const json& j) {
-  std::string s = j.is_string() ? j.get<std::string>() : j.dump();
-  if (s.size() > kQuoteChars) s = s.substr(0, kQuoteChars) + "…";
-  return s.empty() ? std::string("\"\"") : s;
+/// A string, or the en-GB (else first) text of an ED-318 [{text, lang}] list.
+std::string text(const Node& n) {
+  if (n.j.is_string()) return n.j.get<std::string>();
+  if (!n.j.is_array()) n.fail("a string or a list of {text, lang}");
+  std::string first;
+  for (std::size_t i = 0; i < n.j.size(); ++i) {
+    const Node entry = n.item(i);
+    const std::string t = entry.at("text").str();
+    const std::string lang = entry.has("lang") ? entry.at("lang").str() : "";
+    if (lang == "en-GB" || lang == "en") return t;
+    if (i == 0) first = t;
+  }
+  return first;
 }
 
-/// A JSON value with its path in the file, for error messages.
-struct Node {
-  const json& j;
-  std::string path;
-  const std::string& source;
-
-  [[noreturn]] void fail(const std::string& expected) const {
-    throw ParseError(source, 0, path, j.is_null() ? "null" : quote(j), expected);
-  }
-  [[nodiscard]] bool has(const char* key) const { return j.is_object() && j.contains(key) && !j.at(key).is_null(); }
-  [[nodiscard]] Node at(const char* key) const {
-    if (!j.is_object()) fail("an object");
-    if (!j.contains(key)) throw ParseError(source, 0, path + "." + key, "", "a value");
-    return {j.at(key), path + "." + key, source};
-  }
-  /// The value at `key`, or a null value with that path when the key is absent.
-  [[nodiscard]] Node orNull(const char* key) const {
-    static const json kNull;
-    return has(key) ? at(key) : Node{kNull, path + "." + key, source};
-  }
-  [[nodiscard]] Node item(std::size_t i) const { return {j.at(i), path + "[" + std::to_string(i) + "]", source}; }
-  [[nodiscard]] const json& array() const {
-    if (!j.is_array()) fail("an array");
-    return j;
-  }
-  [[nodiscard]] std::string str() const {
-    if (!j.is_string()) fail("a string");
-    return j.get<std::string>();
-  }
-  [[nodiscard]] double number() const {
-    if (!j.is_number()) fail("a number");
-    const double v = j.get<double>();
-    if (!std::isfinite(v)) fail("a finite number");
-    return v;
-  }
-  [[nodiscard]] bool boolean() const {
-    if (!j.is_boolean()) fail("true or false");
-    return j.get<bool>();
-  }
-  /// A string, or the en-GB (else first) text of an ED-318 [{text, lang}] list.
-  [[nodiscard]] std::string text() const {
-    if (j.is_string()) return j.get<std::string>();
-    if (!j.is_array()) fail("a string or a list of {text, lang}");
-    std::string first;
-    for (std::size_t i = 0; i < j.size(); ++i) {
-      const Node entry = item(i);
-      const std::string t = entry.at("text").str();
-      const std::string lang = entry.has("lang") ? entry.at("lang").str() : "";
-      if (lang == "en-GB" || lang == "en") return t;
-      if (i == 0) first = t;
-    }
-    return first;
-  }
-};
-
-std::string optionalText(const Node& n, const char* key) { return n.has(key) ? n.at(key).text() : std::string(); }
+std::string optionalText(const Node& n, const char* key) { return n.has(key) ? text(n.at(key)) : std::string(); }
 
 std::vector<std::string> stringList(const Node& n) {
   std::vector<std::string> out;
@@ -228,7 +183,7 @@ DailyPeriod dailyPeriod(const Node& n, Zone& zone) {
     }
     if (n.has(event_key)) {
       p.approximated = true;
-      zone.notes.push_back(n.path + "." + event_key + " '" + quote(n.at(event_key).j) +
+      zone.notes.push_back(n.path + "." + event_key + " '" + quoteJson(n.at(event_key).j) +
                            "' (sunrise/sunset event) taken as the whole day, on the safe side");
     }
     return whole_day_value;
@@ -414,7 +369,7 @@ Zone geoJsonZone(const Node& feature, bool ed318) {
   const json empty = json::object();
   const Node props0 = feature.has("properties") ? feature.at("properties") : Node{empty, feature.path + ".properties", feature.source};
   if (props0.has("identifier")) {
-    z.identifier = props0.at("identifier").text();
+    z.identifier = text(props0.at("identifier"));
   } else if (feature.has("id")) {
     z.identifier = feature.at("id").j.is_string() ? feature.at("id").str() : feature.at("id").j.dump();
   }
@@ -563,7 +518,7 @@ std::vector<Zone> parseZones(const json& doc, const std::string& source, ZoneFor
   if (format == ZoneFormat::kAuto) {
     const auto detected = detectZoneFormat(doc);
     if (!detected) {
-      throw ParseError(source, 0, "(format)", quote(doc),
+      throw ParseError(source, 0, "(format)", quoteJson(doc),
                        "an ED-269 zone list, an ED-318 or GeoJSON FeatureCollection, or a QGroundControl .plan");
     }
     format = *detected;

@@ -1,6 +1,7 @@
 #include "maps/buildings.hpp"
 
 #include "maps/geoid.hpp"
+#include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/plane_frame.hpp"
 #include "maps/text_file.hpp"
@@ -21,8 +22,6 @@ using nlohmann::json;
 
 /// Metres per international foot.
 constexpr double kMetresPerFoot = 0.3048;
-/// Longest text kept from a JSON value quoted in an error message.
-constexpr std::size_t kQuoteChars = 60;
 /// Mean Earth radius [m], only to turn degrees into metres for the footprint checks below.
 constexpr double kMeanEarthRadius_m = 6371008.8;
 /// Smallest footprint area accepted [m²]: below a 10 cm square nothing is left to extrude.
@@ -33,44 +32,7 @@ constexpr double kMaxHeight_m = 2000.0;
 /// Most levels accepted.
 constexpr double kMaxLevels = 300.0;
 
-std::string quote(const json& j) {
-  std::string s = j.is_string() ? j.get<std::string>() : j.dump();
-  if (s.size() > kQuoteChars) s = s.substr(0, kQuoteChars) + "…";
-  return s.empty() ? std::string("\"\"") : s;
-}
-
-/// A JSON value with its path in the file, for error messages (the zone loaders' convention:
-/// airspace/loaders.cpp).
-struct Node {
-  const json& j;
-  std::string path;
-  const std::string& source;
-
-  [[noreturn]] void fail(const std::string& expected) const {
-    throw ParseError(source, 0, path, j.is_null() ? "null" : quote(j), expected);
-  }
-  [[nodiscard]] bool has(const char* key) const { return j.is_object() && j.contains(key) && !j.at(key).is_null(); }
-  [[nodiscard]] Node at(const char* key) const {
-    if (!j.is_object()) fail("an object");
-    if (!j.contains(key)) throw ParseError(source, 0, path + "." + key, "", "a value");
-    return {j.at(key), path + "." + key, source};
-  }
-  [[nodiscard]] Node item(std::size_t i) const { return {j.at(i), path + "[" + std::to_string(i) + "]", source}; }
-  [[nodiscard]] const json& array() const {
-    if (!j.is_array()) fail("an array");
-    return j;
-  }
-  [[nodiscard]] std::string str() const {
-    if (!j.is_string()) fail("a string");
-    return j.get<std::string>();
-  }
-  [[nodiscard]] double number() const {
-    if (!j.is_number()) fail("a number");
-    const double v = j.get<double>();
-    if (!std::isfinite(v)) fail("a finite number");
-    return v;
-  }
-};
+using Node = JsonNode;
 
 /// A plain number, or a numeric string (OSM writes `building:levels` as "5").
 double numberOrNumericString(const Node& n, const std::string& expected) {
@@ -288,7 +250,7 @@ std::string featureLabel(const Node& feature, const Node& props) {
   } else if (props.has("id")) {
     id = props.j.at("id").is_string() ? props.j.at("id").get<std::string>() : props.j.at("id").dump();
   }
-  if (id.size() > kQuoteChars) id = id.substr(0, kQuoteChars) + "…";
+  if (id.size() > kJsonQuoteChars) id = id.substr(0, kJsonQuoteChars) + "…";
   return id.empty() ? feature.path : feature.path + "(" + id + ")";
 }
 
@@ -375,7 +337,7 @@ std::vector<Building> parseBuildings(const json& doc, const std::string& source,
   }
   const Node root{doc, "", source};
   if (!doc.is_object() || !doc.contains("features")) {
-    throw ParseError(source, 0, "features", doc.is_object() ? "" : quote(doc), "a GeoJSON FeatureCollection of buildings");
+    throw ParseError(source, 0, "features", doc.is_object() ? "" : quoteJson(doc), "a GeoJSON FeatureCollection of buildings");
   }
   const Node list{doc.at("features"), "features", source};
   for (std::size_t i = 0; i < list.array().size(); ++i) parseFeature(list.item(i), terrain, options, out);

@@ -1,0 +1,78 @@
+#pragma once
+/// \file
+/// \brief A JSON value together with its path in the file, for loaders whose errors must name
+/// the file, the feature and the field (zones, buildings).
+
+#include "maps/parse_error.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstddef>
+#include <string>
+
+namespace skylane::maps {
+
+/// \brief Longest text kept from a JSON value quoted in an error message.
+inline constexpr std::size_t kJsonQuoteChars = 60;
+
+/// \brief The value as text for a message: strings as they are, the rest dumped; cut at
+/// kJsonQuoteChars.
+[[nodiscard]] inline std::string quoteJson(const nlohmann::json& j) {
+  std::string s = j.is_string() ? j.get<std::string>() : j.dump();
+  if (s.size() > kJsonQuoteChars) s = s.substr(0, kJsonQuoteChars) + "…";
+  return s.empty() ? std::string("\"\"") : s;
+}
+
+/// \brief A JSON value with its path in the file (e.g. "features[3].properties.height");
+/// every accessor throws ParseError naming the source, the path, the value and what was
+/// expected. Holds references: the document and the source outlive it.
+struct JsonNode {
+  const nlohmann::json& j;
+  std::string path;
+  const std::string& source;
+
+  /// \brief Throws ParseError for this value.
+  [[noreturn]] void fail(const std::string& expected) const {
+    throw ParseError(source, 0, path, j.is_null() ? "null" : quoteJson(j), expected);
+  }
+  /// \brief An object with a non-null member `key`.
+  [[nodiscard]] bool has(const char* key) const { return j.is_object() && j.contains(key) && !j.at(key).is_null(); }
+  /// \brief The member `key` (an error when this is not an object or the key is absent).
+  [[nodiscard]] JsonNode at(const char* key) const {
+    if (!j.is_object()) fail("an object");
+    if (!j.contains(key)) throw ParseError(source, 0, path + "." + key, "", "a value");
+    return {j.at(key), path + "." + key, source};
+  }
+  /// \brief The value at `key`, or a null value with that path when the key is absent.
+  [[nodiscard]] JsonNode orNull(const char* key) const {
+    static const nlohmann::json kNull;
+    return has(key) ? at(key) : JsonNode{kNull, path + "." + key, source};
+  }
+  /// \brief Element i of an array.
+  [[nodiscard]] JsonNode item(std::size_t i) const { return {j.at(i), path + "[" + std::to_string(i) + "]", source}; }
+  /// \brief The array itself (an error when not an array).
+  [[nodiscard]] const nlohmann::json& array() const {
+    if (!j.is_array()) fail("an array");
+    return j;
+  }
+  /// \brief A string.
+  [[nodiscard]] std::string str() const {
+    if (!j.is_string()) fail("a string");
+    return j.get<std::string>();
+  }
+  /// \brief A finite number.
+  [[nodiscard]] double number() const {
+    if (!j.is_number()) fail("a number");
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) fail("a finite number");
+    return v;
+  }
+  /// \brief true or false.
+  [[nodiscard]] bool boolean() const {
+    if (!j.is_boolean()) fail("true or false");
+    return j.get<bool>();
+  }
+};
+
+}  // namespace skylane::maps
