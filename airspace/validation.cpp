@@ -30,15 +30,8 @@ constexpr double kSameVertex_rad = 1e-11;
 /// for a ring that does not, ±2π for one that does).
 constexpr double kPoleWinding_rad = kPi;
 
-/// Longitude difference wrapped into (−π, π].
-double wrapDelta(double d) {
-  while (d > kPi) d -= 2 * kPi;
-  while (d <= -kPi) d += 2 * kPi;
-  return d;
-}
-
 bool same(const LatLon& a, const LatLon& b) {
-  return std::abs(a.lat_rad - b.lat_rad) <= kSameVertex_rad && std::abs(wrapDelta(a.lon_rad - b.lon_rad)) <= kSameVertex_rad;
+  return std::abs(a.lat_rad - b.lat_rad) <= kSameVertex_rad && std::abs(maps::wrapLongitudeDelta_rad(a.lon_rad - b.lon_rad)) <= kSameVertex_rad;
 }
 
 std::string degrees(const LatLon& p) {
@@ -144,7 +137,7 @@ bool checkRing(Outline& o, const Context& ctx, bool repair, std::vector<std::str
   // Continuous longitudes (a ring across the antimeridian runs past ±π).
   bool unwrapped = false;
   for (std::size_t i = 1; i < r.size(); ++i) {
-    const double lon = r[i - 1].lon_rad + wrapDelta(r[i].lon_rad - r[i - 1].lon_rad);
+    const double lon = r[i - 1].lon_rad + maps::wrapLongitudeDelta_rad(r[i].lon_rad - r[i - 1].lon_rad);
     if (lon != r[i].lon_rad) unwrapped = true;
     r[i].lon_rad = lon;
   }
@@ -173,7 +166,7 @@ bool checkRing(Outline& o, const Context& ctx, bool repair, std::vector<std::str
     return false;
   }
   // Closing edge back across the antimeridian: a ring round a pole does not close in longitude.
-  const double winding = r.back().lon_rad - r.front().lon_rad - wrapDelta(r.back().lon_rad - r.front().lon_rad);
+  const double winding = r.back().lon_rad - r.front().lon_rad - maps::wrapLongitudeDelta_rad(r.back().lon_rad - r.front().lon_rad);
   if (std::abs(winding) > kPoleWinding_rad) {
     ctx.error("ring goes round a pole (longitudes wind by 360°): not supported, split the zone");
     return false;

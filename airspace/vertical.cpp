@@ -1,5 +1,6 @@
 #include "airspace/vertical.hpp"
 
+#include "maps/geodesy.hpp"
 #include "maps/plane_frame.hpp"
 
 #include <algorithm>
@@ -39,10 +40,7 @@ std::optional<HeightRange> limitRange(const VerticalLimit& l, bool ceiling, cons
     for (const auto& [x, y] : {std::pair{-1.0, -1.0}, {1.0, -1.0}, {1.0, 1.0}, {-1.0, 1.0}}) {
       const Eigen::Vector2d p = frame.toLatLon({x * o.radius_m, y * o.radius_m});
       // Keep the square's longitudes next to the centre's (continuous across the antimeridian).
-      double lon = p.y();
-      while (lon - o.centre.lon_rad > M_PI) lon -= 2 * M_PI;
-      while (lon - o.centre.lon_rad < -M_PI) lon += 2 * M_PI;
-      ring.emplace_back(p.x(), lon);
+      ring.emplace_back(p.x(), maps::continuousLongitude_rad(p.y(), o.centre.lon_rad));
     }
   } else {
     for (const LatLon& v : o.ring) ring.emplace_back(v.lat_rad, v.lon_rad);

@@ -1,5 +1,7 @@
 #include "airspace/zone_geometry.hpp"
 
+#include "maps/geodesy.hpp"
+
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Partition_traits_2.h>
@@ -46,18 +48,23 @@ void requireBufferArguments(double distance_m, double max_error_m) {
   requirePositive(max_error_m, "buffer error");
 }
 
-/// Vertices of a regular polygon whose inscribed circle has radius `inner_m` and whose vertices
-/// lie at most `budget_m` beyond it: vertex k at azimuth 2πk/N, distance inner/cos(π/N).
-std::vector<Eigen::Vector2d> circumscribedPolygon(double inner_m, double budget_m) {
-  const int n = circleVertexCount(inner_m, budget_m, SafeSide::kContain);
-  const double r_vertex = inner_m / std::cos(kPi / n);
+/// A regular N-gon round the origin with its vertices at `r_vertex_m`, vertex k at azimuth
+/// −2πk/N (x east, y north): decreasing azimuth, so counter-clockwise.
+std::vector<Eigen::Vector2d> regularPolygon(int n, double r_vertex_m) {
   std::vector<Eigen::Vector2d> v;
   v.reserve(n);
   for (int k = 0; k < n; ++k) {
-    const double az = 2.0 * kPi * k / n;  // clockwise from north; listed in reverse below
-    v.emplace_back(r_vertex * std::sin(-az), r_vertex * std::cos(-az));
+    const double az = -2.0 * kPi * k / n;
+    v.emplace_back(r_vertex_m * std::sin(az), r_vertex_m * std::cos(az));
   }
-  return v;  // counter-clockwise: azimuths decreasing
+  return v;
+}
+
+/// A regular polygon whose inscribed circle has radius `inner_m` and whose vertices lie at
+/// most `budget_m` beyond it (distance inner/cos(π/N)), counter-clockwise.
+std::vector<Eigen::Vector2d> circumscribedPolygon(double inner_m, double budget_m) {
+  const int n = circleVertexCount(inner_m, budget_m, SafeSide::kContain);
+  return regularPolygon(n, inner_m / std::cos(kPi / n));
 }
 
 CGAL::Polygon_2<Epeck> exactPolygon(const PlanarRing& ring) {
@@ -171,30 +178,23 @@ Outline circleToPolygon(const Outline& o, double max_error_m, SafeSide side) {
   requirePositive(max_error_m, "circle approximation error");
   const double r = o.radius_m, e = max_error_m;
   // Between r + e/4 and r + e (contain) or r − e and r − e/4 (contained): see the header.
-  int n = 0;
-  double r_vertex = 0.0;
+  std::vector<Eigen::Vector2d> vertices;
   if (side == SafeSide::kContain) {
-    n = circleVertexCount(r + e / 4.0, 0.75 * e, SafeSide::kContain);
-    r_vertex = (r + e / 4.0) / std::cos(kPi / n);
+    vertices = circumscribedPolygon(r + e / 4.0, 0.75 * e);
   } else {
     if (e >= r) (void)circleVertexCount(r, e, side);  // throws with the message
-    n = circleVertexCount(r - e / 4.0, 0.75 * e, SafeSide::kContained);
-    r_vertex = r - e / 4.0;
+    vertices = regularPolygon(circleVertexCount(r - e / 4.0, 0.75 * e, SafeSide::kContained), r - e / 4.0);
   }
   const maps::PlaneFrame frame(o.centre.lat_rad, o.centre.lon_rad);
   Outline poly;
   poly.kind = Outline::Kind::kPolygon;
-  poly.ring.reserve(n);
-  for (int k = 0; k < n; ++k) {
-    const double az = -2.0 * kPi * k / n;  // decreasing azimuth = counter-clockwise
-    const Eigen::Vector2d ll = frame.toLatLon({r_vertex * std::sin(az), r_vertex * std::cos(az)});
+  poly.ring.reserve(vertices.size());
+  for (const Eigen::Vector2d& v : vertices) {
+    const Eigen::Vector2d ll = frame.toLatLon(v);
     poly.ring.push_back({ll.x(), ll.y()});
   }
   // Keep longitudes continuous with the centre's (a circle on the antimeridian).
-  for (LatLon& v : poly.ring) {
-    while (v.lon_rad - o.centre.lon_rad > kPi) v.lon_rad -= 2 * kPi;
-    while (v.lon_rad - o.centre.lon_rad < -kPi) v.lon_rad += 2 * kPi;
-  }
+  for (LatLon& v : poly.ring) v.lon_rad = maps::continuousLongitude_rad(v.lon_rad, o.centre.lon_rad);
   return poly;
 }
 
@@ -277,11 +277,7 @@ Outline bufferOutline(const Outline& o, double distance_m, double max_error_m) {
   out.kind = Outline::Kind::kPolygon;
   for (const Eigen::Vector2d& p : minkowskiBuffer(ring, inner_m, budget_m)) {
     const Eigen::Vector2d ll = frame.toLatLon(p);
-    double lon = ll.y();
-    const double lon0 = lon_sum / n;
-    while (lon - lon0 > kPi) lon -= 2 * kPi;
-    while (lon - lon0 < -kPi) lon += 2 * kPi;
-    out.ring.push_back({ll.x(), lon});
+    out.ring.push_back({ll.x(), maps::continuousLongitude_rad(ll.y(), lon_sum / n)});
   }
   return out;
 }

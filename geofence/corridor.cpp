@@ -162,9 +162,12 @@ Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_
       std::min(operating_.ceiling_h_ell_m - (c.z() + vpl), (c.z() - vpl) - operating_.floor_h_ell_m);
 
   const auto piece = [&](std::size_t i, const Eigen::Vector2d& x) { return pieceAt(path_[i], path_[i + 1], x); };
-  const auto margins = [&](std::size_t i, const Eigen::Vector2d& x, double reach_m) {
-    auto [h, v] = pieceMargins(piece(i, x), reach_m, c.z(), vpl, hal, val);
+  const auto marginsOf = [&](const PieceAt& p, double reach_m) {
+    auto [h, v] = pieceMargins(p, reach_m, c.z(), vpl, hal, val);
     return std::pair{h, std::min(v, operating_margin_m)};
+  };
+  const auto margins = [&](std::size_t i, const Eigen::Vector2d& x, double reach_m) {
+    return marginsOf(piece(i, x), reach_m);
   };
 
   // One piece holding the whole volume: exact in the horizontal, the slope term in the vertical.
@@ -172,14 +175,15 @@ Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_
   double best_m = -std::numeric_limits<double>::infinity();
   Containment out;
   for (std::size_t i = 0; i < segmentCount(); ++i) {
-    const auto [h, v] = margins(i, c.head<2>(), hpl);
+    const PieceAt p = piece(i, c.head<2>());
+    const auto [h, v] = marginsOf(p, hpl);
     if (std::min(h, v) > best_m) {
       best_m = std::min(h, v);
       best = i;
       out.margin_h_m = h;
       out.margin_v_m = v;
     }
-    if (piece(i, c.head<2>()).distance_m <= hal + hpl) ++reached;
+    if (p.distance_m <= hal + hpl) ++reached;
   }
   out.segment = best;
   if (best_m < tolerance_m && reached >= 2) {

@@ -91,7 +91,7 @@ std::vector<Eigen::Vector2d> roughPlane(const std::vector<std::pair<double, doub
   const double lat0 = ring.front().first, lon0 = ring.front().second;
   const double cos_lat0 = std::cos(lat0);
   for (const auto& [lat, lon] : ring) {
-    const double dlon = std::remainder(lon - lon0, 2.0 * M_PI);
+    const double dlon = wrapLongitudeDelta_rad(lon - lon0);
     out.emplace_back(dlon * cos_lat0 * kMeanEarthRadius_m, (lat - lat0) * kMeanEarthRadius_m);
   }
   return out;
@@ -227,7 +227,7 @@ void placeOnTerrain(Building& b, const HeightSpec& h, const Terrain& terrain, co
   for (const auto& [lat, lon] : b.ring_lat_lon_rad) {
     lat_min = std::min(lat_min, lat);
     lat_max = std::max(lat_max, lat);
-    const double u = lon0 + std::remainder(lon - lon0, 2.0 * M_PI);
+    const double u = continuousLongitude_rad(lon, lon0);
     west = std::min(west, u);
     east = std::max(east, u);
   }

@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
+
 namespace skylane::maps {
 
 /// \brief WGS-84 semi-major axis [m] (NIMA TR8350.2).
@@ -67,6 +69,15 @@ class LocalFrame {
   Eigen::Vector3d p_origin_ecef_;
   Eigen::Matrix3d R_enu_ecef_;
 };
+
+/// \brief A longitude difference wrapped into [−π, π] [rad].
+[[nodiscard]] inline double wrapLongitudeDelta_rad(double d_rad) { return std::remainder(d_rad, 2.0 * M_PI); }
+
+/// \brief `lon_rad` moved by whole turns to lie within π of `ref_rad`: rings and circles across
+/// the antimeridian keep continuous longitudes.
+[[nodiscard]] inline double continuousLongitude_rad(double lon_rad, double ref_rad) {
+  return ref_rad + wrapLongitudeDelta_rad(lon_rad - ref_rad);
+}
 
 /// \brief Degrees → radians.
 [[nodiscard]] constexpr double deg2rad(double deg) { return deg * 0.017453292519943295; }

@@ -5,9 +5,15 @@
 namespace skylane::integrity {
 namespace {
 
-TEST(Predict, MopsConstellationGivesRaimEverywhereOverADayInJapan) {
+/// The DO-229 MOPS almanac (24 GPS satellites).
+OrbitSource mopsOrbits() {
   OrbitSource orbits;
   orbits.addAlmanac(loadAlmanac(test::dataPath("gnss/almmops.txt")));
+  return orbits;
+}
+
+TEST(Predict, MopsConstellationGivesRaimEverywhereOverADayInJapan) {
+  const OrbitSource orbits = mopsOrbits();
   PredictRequest req;
   req.place = {maps::deg2rad(35.0), maps::deg2rad(139.0), 0.0};
   req.start = *parseRfc3339("2020-01-01T00:00:00Z");
@@ -54,8 +60,7 @@ TEST(Predict, DopsOfASymmetricSky) {
 
 TEST(Predict, ASatelliteBehindABuildingIsDropped) {
   // GIVEN the MOPS constellation over Zürich at one epoch, and the lowest satellite above 15°
-  OrbitSource orbits;
-  orbits.addAlmanac(loadAlmanac(test::dataPath("gnss/almmops.txt")));
+  const OrbitSource orbits = mopsOrbits();
   PredictRequest req;
   req.place = {maps::deg2rad(47.3769), maps::deg2rad(8.5417), 450.0};
   req.start = *parseRfc3339("2020-01-01T00:00:00Z");
