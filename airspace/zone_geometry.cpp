@@ -344,4 +344,39 @@ bool segmentMeetsPrism(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const
   return exactSegmentMeetsRing(p, q, exactRing(prism.ring));
 }
 
+bool cylinderMeetsPrism(const Eigen::Vector3d& centre, double radius_m, double half_height_m,
+                        const PlanarPrism& prism) {
+  if (!centre.allFinite()) throw std::invalid_argument("cylinderMeetsPrism: non-finite centre");
+  if (!(std::isfinite(radius_m) && radius_m >= 0 && std::isfinite(half_height_m) && half_height_m >= 0)) {
+    std::ostringstream s;
+    s << "cylinderMeetsPrism: radius and half-height must be finite and ≥ 0, got " << radius_m << " m, "
+      << half_height_m << " m";
+    throw std::invalid_argument(s.str());
+  }
+  // Heights: [z − hh, z + hh] meets [floor, ceiling] ⇔ z − hh ≤ ceiling and z + hh ≥ floor
+  // (an infinite limit constrains nothing on its own side, everything on the other).
+  const ExactFt z(centre.z()), hh(half_height_m);
+  const auto above = [&](double ceiling_m) {
+    return std::isfinite(ceiling_m) ? z - hh > ExactFt(ceiling_m) : ceiling_m < 0;
+  };
+  const auto below = [&](double floor_m) { return std::isfinite(floor_m) ? z + hh < ExactFt(floor_m) : floor_m > 0; };
+  if (above(prism.ceiling_h_ell_m) || below(prism.floor_h_ell_m)) return false;
+  const ExactPoint c(centre.x(), centre.y());
+  const ExactFt r(radius_m);
+  if (prism.ring.empty()) {
+    const ExactFt reach = r + ExactFt(prism.radius_m);
+    return CGAL::squared_distance(c, ExactPoint(prism.centre.x(), prism.centre.y())) <= reach * reach;
+  }
+  const std::vector<ExactPoint> ring = exactRing(prism.ring);
+  if (CGAL::bounded_side_2(ring.begin(), ring.end(), c, Epeck()) != CGAL::ON_UNBOUNDED_SIDE) return true;
+  const ExactFt r2 = r * r;
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    const ExactPoint& p = ring[i];
+    const ExactPoint& q = ring[(i + 1) % ring.size()];
+    const ExactFt d2 = p == q ? CGAL::squared_distance(p, c) : CGAL::squared_distance(ExactSegment(p, q), c);
+    if (d2 <= r2) return true;
+  }
+  return false;
+}
+
 }  // namespace skylane::airspace

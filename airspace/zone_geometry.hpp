@@ -115,4 +115,12 @@ struct PlanarPrism {
 /// tested with segmentMeetsRing / segmentMeetsDisk exactly.
 [[nodiscard]] bool segmentMeetsPrism(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const PlanarPrism& prism);
 
+/// \brief Whether the closed vertical cylinder round `centre` (x, y, h_ell) with the given
+/// radius and half-height meets the closed prism: the height intervals overlap and the disk
+/// meets the ring (the centre lies in it or an edge comes within the radius) or the prism's
+/// disk. Exact rational arithmetic on the given doubles, so touching counts as meeting.
+/// \throws std::invalid_argument for a non-finite centre or a negative/non-finite size.
+[[nodiscard]] bool cylinderMeetsPrism(const Eigen::Vector3d& centre, double radius_m, double half_height_m,
+                                      const PlanarPrism& prism);
+
 }  // namespace skylane::airspace

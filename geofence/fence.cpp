@@ -1,0 +1,224 @@
+#include "geofence/fence.hpp"
+
+#include "airspace/applicability.hpp"
+#include "maps/geodesy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+namespace skylane::geofence {
+namespace {
+
+/// The least radius of curvature of the WGS-84 ellipsoid: the meridian radius at the equator,
+/// a(1 − e²) [m]. Scale bounds use it so that they hold everywhere on the ellipsoid.
+constexpr double kLeastRadiusOfCurvature_m = 6378137.0 * (1.0 - 0.00669437999014);
+
+/// Verdict of a deciding margin m (positive: the check holds) against the tolerance.
+Verdict verdictOf(double m, double tolerance_m) {
+  return std::abs(m) <= tolerance_m ? Verdict::kIndeterminate : (m > 0 ? Verdict::kInside : Verdict::kOutside);
+}
+
+/// The worse of two verdicts: outside over indeterminate over inside.
+int severity(Verdict v) { return v == Verdict::kOutside ? 2 : (v == Verdict::kIndeterminate ? 1 : 0); }
+
+Check boxCheck(Level level, const Corridor& box, const ProtectionVolume& v, double tolerance_m) {
+  const Containment c = box.contains(v, tolerance_m);
+  Check out;
+  out.level = level;
+  out.verdict = c.verdict;
+  out.index = c.segment;
+  out.subject = "segment " + std::to_string(c.segment);
+  out.margin_h_m = c.margin_h_m;
+  out.margin_v_m = c.margin_v_m;
+  out.across_joint = c.across_joint;
+  return out;
+}
+
+}  // namespace
+
+const char* levelName(Level l) {
+  switch (l) {
+    case Level::kCorridor: return "level1";
+    case Level::kAirspace: return "level2";
+    case Level::kZone: return "zone";
+    case Level::kObstacle: return "obstacle";
+  }
+  return "?";
+}
+
+bool counts(const airspace::Zone& zone, const ZonePolicy& policy) {
+  if (zone.keep_in) return false;
+  const bool authorised = policy.authorisations.count(zone.identifier) > 0;
+  switch (zone.restriction) {
+    case airspace::Restriction::kProhibited: return true;
+    case airspace::Restriction::kReqAuthorisation: return !authorised;
+    case airspace::Restriction::kConditional: return policy.count_conditional && !authorised;
+    case airspace::Restriction::kNoRestriction: return policy.count_no_restriction;
+  }
+  return true;
+}
+
+std::vector<ScenePiece> zonePieces(const std::vector<airspace::Zone>& zones, const maps::PlaneFrame& frame,
+                                   const airspace::VerticalModel& model) {
+  std::vector<ScenePiece> pieces;
+  const Eigen::Vector2d origin_ll = frame.toLatLon(Eigen::Vector2d::Zero());
+  for (std::size_t zi = 0; zi < zones.size(); ++zi) {
+    const airspace::Zone& z = zones[zi];
+    if (z.keep_in) continue;
+    for (std::size_t vi = 0; vi < z.volumes.size(); ++vi) {
+      const airspace::Volume& v = z.volumes[vi];
+      const auto floor = airspace::limitRange(v.lower, false, v.outline, model);
+      const auto ceiling = airspace::limitRange(v.upper, true, v.outline, model);
+      if (!floor || !ceiling) {
+        throw std::invalid_argument(airspace::describe(z) + ": volume " + std::to_string(vi) +
+                                    ": an AGL limit lies where the terrain model has no data");
+      }
+      airspace::PlanarPrism prism;
+      prism.floor_h_ell_m = floor->h_ell_min_m;
+      prism.ceiling_h_ell_m = ceiling->h_ell_max_m;
+      if (v.outline.kind == airspace::Outline::Kind::kCircle) {
+        const airspace::LatLon& c = v.outline.centre;
+        // Azimuthal scale k' = c / sin c of the azimuthal equidistant projection, c = ρ/R the
+        // angular distance from the centre (Snyder, "Map Projections — A Working Manual", USGS
+        // PP 1395, 1987, §25, sphere); the radial scale is 1. Taken at the circle's farthest
+        // point from the origin, it bounds the stretch of every radius of the circle.
+        const double rho_m = maps::geodesicDistance_m(origin_ll.x(), origin_ll.y(), c.lat_rad, c.lon_rad) +
+                             v.outline.radius_m;
+        const double x = std::min(rho_m / kLeastRadiusOfCurvature_m, 3.0);
+        const double k = x > 0 ? x / std::sin(x) : 1.0;
+        prism.centre = frame.toPlane(c.lat_rad, c.lon_rad);
+        prism.radius_m = v.outline.radius_m * k + kCircleRounding_m;
+        pieces.push_back({prism, PieceOwner::kZone, zi});
+        continue;
+      }
+      airspace::PlanarRing ring;
+      ring.reserve(v.outline.ring.size());
+      for (const airspace::LatLon& p : v.outline.ring) ring.push_back(frame.toPlane(p.lat_rad, p.lon_rad));
+      if (airspace::twiceSignedArea_m2(ring) < 0) std::reverse(ring.begin(), ring.end());
+      for (airspace::PlanarRing& piece : airspace::convexPieces(ring)) {
+        airspace::PlanarPrism q = prism;
+        q.ring = std::move(piece);
+        pieces.push_back({std::move(q), PieceOwner::kZone, zi});
+      }
+    }
+  }
+  return pieces;
+}
+
+std::vector<ScenePiece> obstaclePieces(const std::vector<maps::Building>& buildings, const maps::PlaneFrame& frame) {
+  std::vector<ScenePiece> pieces;
+  for (std::size_t bi = 0; bi < buildings.size(); ++bi) {
+    const maps::Building& b = buildings[bi];
+    airspace::PlanarRing ring;
+    ring.reserve(b.ring_lat_lon_rad.size());
+    for (const auto& [lat, lon] : b.ring_lat_lon_rad) ring.push_back(frame.toPlane(lat, lon));
+    if (airspace::twiceSignedArea_m2(ring) < 0) std::reverse(ring.begin(), ring.end());
+    for (airspace::PlanarRing& piece : airspace::convexPieces(ring)) {
+      airspace::PlanarPrism q;
+      q.ring = std::move(piece);
+      q.floor_h_ell_m = b.base_h_ell_m;
+      q.ceiling_h_ell_m = b.top_h_ell_m;
+      pieces.push_back({std::move(q), PieceOwner::kObstacle, bi});
+    }
+  }
+  return pieces;
+}
+
+Fence::Fence(Corridor level1, Corridor level2, std::vector<airspace::Zone> zones, std::vector<maps::Building> buildings,
+             Scene scene, ZonePolicy policy, FenceOptions options)
+    : level1_(std::move(level1)),
+      level2_(std::move(level2)),
+      zones_(std::move(zones)),
+      buildings_(std::move(buildings)),
+      scene_(std::move(scene)),
+      policy_(std::move(policy)),
+      options_(options) {
+  if (!(std::isfinite(options_.tolerance_m) && options_.tolerance_m >= 0)) {
+    throw std::invalid_argument("fence tolerance must be a finite number of metres ≥ 0");
+  }
+  if (!(std::isfinite(options_.horizon_m) && options_.horizon_m >= 0)) {
+    throw std::invalid_argument("fence clearance horizon must be a finite number of metres ≥ 0");
+  }
+  for (const ScenePiece& p : scene_.pieces()) {
+    const std::size_t n = p.owner == PieceOwner::kZone ? zones_.size() : buildings_.size();
+    if (p.owner_index >= n) {
+      throw std::invalid_argument(std::string("scene piece names ") + (p.owner == PieceOwner::kZone ? "zone " : "obstacle ") +
+                                  std::to_string(p.owner_index) + " but there are only " + std::to_string(n));
+    }
+  }
+  zone_counts_.reserve(zones_.size());
+  for (const airspace::Zone& z : zones_) zone_counts_.push_back(counts(z, policy_));
+}
+
+FenceVerdict Fence::check(const TimedVolume& v) const {
+  FenceVerdict out;
+  out.checks.push_back(boxCheck(Level::kCorridor, level1_, v.volume, options_.tolerance_m));
+  out.checks.push_back(boxCheck(Level::kAirspace, level2_, v.volume, options_.tolerance_m));
+
+  // Zones count when the policy says so and they are active in the interval; obstacles always.
+  const maps::GpsTime t1 = v.t1 - v.t0 > 0 ? v.t1 : v.t0;
+  const auto accept = [&](const ScenePiece& p) {
+    if (p.owner == PieceOwner::kObstacle) return true;
+    return zone_counts_[p.owner_index] &&
+           (t1 - v.t0 > 0 ? airspace::isActiveDuring(zones_[p.owner_index], v.t0, t1)
+                          : airspace::isActive(zones_[p.owner_index], v.t0));
+  };
+  const std::vector<SceneHit> hits = scene_.query(v.volume, options_.horizon_m, accept);
+
+  // One check per zone or obstacle: its worst piece (least deciding margin max(h, v)).
+  std::vector<Check> near;
+  for (const SceneHit& h : hits) {
+    const ScenePiece& p = scene_.pieces()[h.piece];
+    const Separation& s = h.separation;
+    const Level level = p.owner == PieceOwner::kZone ? Level::kZone : Level::kObstacle;
+    const double deciding_m = s.meets ? std::min(std::max(s.margin_h_m, s.margin_v_m), 0.0)
+                                      : std::max({s.margin_h_m, s.margin_v_m, 0.0});
+    Check c;
+    c.level = level;
+    c.index = p.owner_index;
+    c.subject = level == Level::kZone ? zones_[p.owner_index].identifier : buildings_[p.owner_index].feature;
+    c.margin_h_m = s.margin_h_m;
+    c.margin_v_m = s.margin_v_m;
+    c.clearance_m = s.clearance_m;
+    c.exact = s.exact;
+    // The exact predicate has the last word on meeting; the margin says how close it is.
+    c.verdict = s.meets ? (deciding_m >= -options_.tolerance_m ? Verdict::kIndeterminate : Verdict::kOutside)
+                        : verdictOf(deciding_m, options_.tolerance_m);
+    const auto same = std::find_if(near.begin(), near.end(), [&](const Check& o) { return o.level == c.level && o.index == c.index; });
+    if (same == near.end()) {
+      near.push_back(std::move(c));
+    } else if (severity(c.verdict) > severity(same->verdict) ||
+               (severity(c.verdict) == severity(same->verdict) && *c.clearance_m < *same->clearance_m)) {
+      *same = std::move(c);
+    }
+  }
+  std::stable_sort(near.begin(), near.end(), [](const Check& a, const Check& b) {
+    if (a.level != b.level) return a.level < b.level;
+    if (severity(a.verdict) != severity(b.verdict)) return severity(a.verdict) > severity(b.verdict);
+    return *a.clearance_m < *b.clearance_m;
+  });
+  out.checks.insert(out.checks.end(), near.begin(), near.end());
+
+  for (int wanted : {2, 1}) {
+    for (std::size_t i = 0; i < out.checks.size() && !out.deciding; ++i) {
+      if (severity(out.checks[i].verdict) == wanted) out.deciding = i;
+    }
+  }
+  if (out.deciding) {
+    out.verdict = out.checks[*out.deciding].verdict;
+    out.violated = out.checks[*out.deciding].level;
+  }
+  return out;
+}
+
+std::vector<FenceVerdict> Fence::check(const std::vector<TimedVolume>& samples) const {
+  std::vector<FenceVerdict> out;
+  out.reserve(samples.size());
+  for (const TimedVolume& s : samples) out.push_back(check(s));
+  return out;
+}
+
+}  // namespace skylane::geofence

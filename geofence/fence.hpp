@@ -1,0 +1,138 @@
+#pragma once
+/// \file
+/// \brief The fence check of seed 000 (claims 8–9; DESIGN.md "The two box levels"): a
+/// protection volume is trusted only when it lies inside its first-level corridor, inside its
+/// second-level airspace box, and clear of every zone active at the time and every obstacle.
+/// One verdict type serves every level; the same checker serves a predicted trajectory and a
+/// live fix.
+
+#include "airspace/vertical.hpp"
+#include "airspace/zone.hpp"
+#include "geofence/corridor.hpp"
+#include "geofence/scene.hpp"
+#include "maps/buildings.hpp"
+#include "maps/plane_frame.hpp"
+#include "maps/time.hpp"
+
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace skylane::geofence {
+
+/// \brief The level a check belongs to.
+enum class Level { kCorridor, kAirspace, kZone, kObstacle };
+
+/// \brief "level1", "level2", "zone", "obstacle".
+[[nodiscard]] const char* levelName(Level l);
+
+/// \brief One check of a protection volume.
+///
+/// `verdict` says whether the volume lies inside the space the check allows: the box for
+/// levels 1 and 2, everything outside the zone or obstacle otherwise. Margins in metres are how
+/// much HPL (margin_h) and VPL (margin_v) could still grow and the verdict stay; negative: by
+/// how much they are exceeded. A box is kept when both margins are positive, a zone when
+/// either is (see Separation); within the tolerance of that the verdict is indeterminate.
+struct Check {
+  Level level = Level::kCorridor;
+  Verdict verdict = Verdict::kInside;
+  std::size_t index = 0;    ///< segment (levels 1, 2) or zone / obstacle index
+  std::string subject;      ///< "segment 3", the zone's identifier, the obstacle's feature
+  double margin_h_m = 0.0;
+  double margin_v_m = 0.0;
+  std::optional<double> clearance_m;  ///< zones and obstacles: 3-D distance (0 when met)
+  bool across_joint = false;          ///< levels 1, 2: held only by the union at a joint
+  bool exact = false;                 ///< zones and obstacles: decided by exact predicates
+};
+
+/// \brief The outcome for one protection volume.
+struct FenceVerdict {
+  /// inside only when every check is; outside when any check is; indeterminate otherwise.
+  Verdict verdict = Verdict::kInside;
+  /// The first level (in the order 1, 2, zone, obstacle) with an outside check, or else with an
+  /// indeterminate one; empty when inside.
+  std::optional<Level> violated;
+  /// That check's index in `checks`.
+  std::optional<std::size_t> deciding;
+  /// Level 1 and level 2 always (their deciding segment); then every zone and obstacle within
+  /// the clearance horizon, nearest first within each level.
+  std::vector<Check> checks;
+};
+
+/// \brief Which zones count.
+struct ZonePolicy {
+  /// Identifiers of zones the mission is authorised for (REQ_AUTHORISATION) or whose conditions
+  /// it meets (CONDITIONAL). A PROHIBITED zone counts whatever this says.
+  std::set<std::string> authorisations;
+  bool count_conditional = true;       ///< CONDITIONAL zones without an entry above count
+  bool count_no_restriction = false;   ///< NO_RESTRICTION zones count (off: they restrict nothing)
+};
+
+/// \brief Whether the zone counts under the policy (its activity in time aside).
+[[nodiscard]] bool counts(const airspace::Zone& zone, const ZonePolicy& policy);
+
+/// \brief Tunables of the check.
+struct FenceOptions {
+  double tolerance_m = 1e-6;      ///< a deciding margin within this of 0 is indeterminate
+  double horizon_m = 100.0;       ///< zones and obstacles within this are reported with their clearance
+};
+
+/// \brief Added to a circle's radius in the map frame for the rounding of the projection [m].
+inline constexpr double kCircleRounding_m = 1e-3;
+
+/// \brief Convex pieces of the zones in the map frame, each volume's floor at its lowest and
+/// ceiling at its highest over the outline (airspace::limitRange), so the pieces contain the
+/// zone. Polygons: vertices projected into the frame and cut into convex pieces. Circles: a
+/// disk whose radius is the zone's times the largest scale of the frame along the circle,
+/// k(ρ) = (ρ/R)/sin(ρ/R) at the circle's farthest point from the origin (the azimuthal
+/// equidistant projection stretches azimuthally by k and not radially; R the least radius of
+/// curvature of the ellipsoid, so the disk contains the circle), plus kCircleRounding_m.
+/// Keep-in zones are left out (they are not "to stay clear of"; see the README).
+/// \throws std::invalid_argument naming the zone when a limit cannot be resolved (an AGL limit
+/// where the terrain is unknown).
+[[nodiscard]] std::vector<ScenePiece> zonePieces(const std::vector<airspace::Zone>& zones,
+                                                 const maps::PlaneFrame& frame,
+                                                 const airspace::VerticalModel& model);
+
+/// \brief Convex pieces of buildings and obstacles in the map frame, between their base and top.
+[[nodiscard]] std::vector<ScenePiece> obstaclePieces(const std::vector<maps::Building>& buildings,
+                                                     const maps::PlaneFrame& frame);
+
+/// \brief A protection volume at a time (or over a time interval [t0, t1)).
+struct TimedVolume {
+  maps::GpsTime t0;
+  maps::GpsTime t1;  ///< ≤ t0: the instant t0
+  ProtectionVolume volume;
+};
+
+/// \brief Both box levels, the zones and the obstacles, checked together.
+class Fence {
+ public:
+  /// \brief `zones` and `buildings` give names and activity to the scene's pieces (a piece's
+  /// owner_index indexes them).
+  Fence(Corridor level1, Corridor level2, std::vector<airspace::Zone> zones, std::vector<maps::Building> buildings,
+        Scene scene, ZonePolicy policy = {}, FenceOptions options = {});
+
+  /// \brief Checks one volume against every level; zones count when active at some instant of
+  /// [t0, t1) (at t0 when t1 ≤ t0) and counted by the policy.
+  [[nodiscard]] FenceVerdict check(const TimedVolume& v) const;
+
+  /// \brief Checks each sample of a trajectory (predicted or flown).
+  [[nodiscard]] std::vector<FenceVerdict> check(const std::vector<TimedVolume>& samples) const;
+
+  [[nodiscard]] const Corridor& level1() const { return level1_; }
+  [[nodiscard]] const Corridor& level2() const { return level2_; }
+  [[nodiscard]] const std::vector<airspace::Zone>& zones() const { return zones_; }
+
+ private:
+  Corridor level1_, level2_;
+  std::vector<airspace::Zone> zones_;
+  std::vector<maps::Building> buildings_;
+  std::vector<bool> zone_counts_;
+  Scene scene_;
+  ZonePolicy policy_;
+  FenceOptions options_;
+};
+
+}  // namespace skylane::geofence

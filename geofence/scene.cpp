@@ -1,0 +1,248 @@
+#include "geofence/scene.hpp"
+
+#include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
+#include <fcl/geometry/shape/convex.h>
+#include <fcl/geometry/shape/cylinder.h>
+#include <fcl/narrowphase/collision_object.h>
+#include <fcl/narrowphase/distance.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+namespace skylane::geofence {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Signed horizontal distance from x to the piece's shape: positive outside (distance to the
+/// shape), negative inside (minus the distance to its boundary). A convex ring's interior
+/// distance to the boundary is the least distance to its edges' lines.
+double signedHorizontalDistance(const airspace::PlanarPrism& p, const Eigen::Vector2d& x) {
+  if (p.ring.empty()) return (x - p.centre).norm() - p.radius_m;
+  const std::size_t n = p.ring.size();
+  double outside = kInf, inside = kInf;
+  bool is_inside = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& a = p.ring[i];
+    const Eigen::Vector2d& b = p.ring[(i + 1) % n];
+    const Eigen::Vector2d e = b - a;
+    const double length = e.norm();
+    if (length == 0.0) continue;
+    const Eigen::Vector2d ax = x - a;
+    const double cross = e.x() * ax.y() - e.y() * ax.x();  // > 0: x left of the edge (inside side)
+    if (cross < 0) is_inside = false;
+    inside = std::min(inside, cross / length);
+    const double t = std::clamp(ax.dot(e) / (length * length), 0.0, 1.0);
+    outside = std::min(outside, (ax - t * e).norm());
+  }
+  return is_inside ? -inside : outside;
+}
+
+/// Signed vertical distance from z to [floor, ceiling]: positive outside, negative inside.
+double signedVerticalDistance(const airspace::PlanarPrism& p, double z) {
+  return std::max(p.floor_h_ell_m - z, z - p.ceiling_h_ell_m);
+}
+
+double clampHeight(double h) { return std::clamp(h, kSceneFloor_h_ell_m, kSceneCeiling_h_ell_m); }
+
+std::string pieceName(std::size_t i, const ScenePiece& p) {
+  std::ostringstream s;
+  s << "piece " << i << " (" << (p.owner == PieceOwner::kZone ? "zone " : "obstacle ") << p.owner_index << ")";
+  return s.str();
+}
+
+void validatePiece(std::size_t i, const ScenePiece& p) {
+  const airspace::PlanarPrism& q = p.prism;
+  if (std::isnan(q.floor_h_ell_m) || std::isnan(q.ceiling_h_ell_m) || !(q.floor_h_ell_m < q.ceiling_h_ell_m)) {
+    std::ostringstream s;
+    s << pieceName(i, p) << ": floor " << q.floor_h_ell_m << " m must be below ceiling " << q.ceiling_h_ell_m << " m";
+    throw std::invalid_argument(s.str());
+  }
+  if (q.ring.empty()) {
+    if (!q.centre.allFinite() || !(std::isfinite(q.radius_m) && q.radius_m > 0)) {
+      throw std::invalid_argument(pieceName(i, p) + ": a disk needs a finite centre and a positive radius");
+    }
+    return;
+  }
+  if (q.ring.size() < 3) throw std::invalid_argument(pieceName(i, p) + ": a ring needs at least 3 vertices");
+  double area2 = 0;
+  for (std::size_t k = 0; k < q.ring.size(); ++k) {
+    const Eigen::Vector2d& a = q.ring[k];
+    const Eigen::Vector2d& b = q.ring[(k + 1) % q.ring.size()];
+    const Eigen::Vector2d& c = q.ring[(k + 2) % q.ring.size()];
+    if (!a.allFinite()) throw std::invalid_argument(pieceName(i, p) + ": non-finite vertex");
+    const Eigen::Vector2d ab = b - a, bc = c - b;
+    if (ab.x() * bc.y() - ab.y() * bc.x() < 0) {
+      throw std::invalid_argument(pieceName(i, p) + ": the ring must be convex and counter-clockwise (vertex " +
+                                  std::to_string((k + 1) % q.ring.size()) + " turns right)");
+    }
+    area2 += a.x() * b.y() - b.x() * a.y();
+  }
+  if (!(area2 > 0)) throw std::invalid_argument(pieceName(i, p) + ": the ring has no area");
+}
+
+/// The piece as an FCL shape placed at its centre: a cylinder for a disk; for a ring, the
+/// convex prism with its faces listed FCL's way (count, then vertex indices, outward winding).
+std::unique_ptr<fcl::CollisionObjectd> fclObject(const airspace::PlanarPrism& q) {
+  const double z_lo = clampHeight(q.floor_h_ell_m), z_hi = clampHeight(q.ceiling_h_ell_m);
+  const double z_mid = 0.5 * (z_lo + z_hi), half = 0.5 * (z_hi - z_lo);
+  if (q.ring.empty()) {
+    auto shape = std::make_shared<fcl::Cylinderd>(q.radius_m, 2 * half);
+    fcl::Transform3d X_WP = fcl::Transform3d::Identity();
+    X_WP.translation() = fcl::Vector3d(q.centre.x(), q.centre.y(), z_mid);
+    return std::make_unique<fcl::CollisionObjectd>(shape, X_WP);
+  }
+  const std::size_t n = q.ring.size();
+  Eigen::Vector2d p_WP = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& v : q.ring) p_WP += v;
+  p_WP /= static_cast<double>(n);
+  auto vertices = std::make_shared<std::vector<fcl::Vector3d>>();
+  vertices->reserve(2 * n);
+  for (double z : {-half, half}) {
+    for (const Eigen::Vector2d& v : q.ring) vertices->emplace_back(v.x() - p_WP.x(), v.y() - p_WP.y(), z);
+  }
+  auto faces = std::make_shared<std::vector<int>>();
+  faces->reserve(2 * (n + 1) + 5 * n);
+  faces->push_back(static_cast<int>(n));  // bottom, clockwise from above = outward (down)
+  for (std::size_t k = n; k-- > 0;) faces->push_back(static_cast<int>(k));
+  faces->push_back(static_cast<int>(n));  // top, counter-clockwise from above
+  for (std::size_t k = 0; k < n; ++k) faces->push_back(static_cast<int>(n + k));
+  for (std::size_t k = 0; k < n; ++k) {  // walls
+    const int a = static_cast<int>(k), b = static_cast<int>((k + 1) % n);
+    faces->insert(faces->end(), {4, a, b, b + static_cast<int>(n), a + static_cast<int>(n)});
+  }
+  auto shape = std::make_shared<fcl::Convexd>(vertices, static_cast<int>(n + 2), faces);
+  fcl::Transform3d X_WP = fcl::Transform3d::Identity();
+  X_WP.translation() = fcl::Vector3d(p_WP.x(), p_WP.y(), z_mid);
+  return std::make_unique<fcl::CollisionObjectd>(shape, X_WP);
+}
+
+std::unique_ptr<fcl::CollisionObjectd> volumeObject(const Eigen::Vector3d& p, double radius_m, double half_height_m) {
+  fcl::Transform3d X_WV = fcl::Transform3d::Identity();
+  X_WV.translation() = p;
+  return std::make_unique<fcl::CollisionObjectd>(std::make_shared<fcl::Cylinderd>(radius_m, 2 * half_height_m), X_WV);
+}
+
+}  // namespace
+
+Separation separationMargins(const ProtectionVolume& volume, const airspace::PlanarPrism& piece) {
+  Separation s;
+  s.margin_h_m = signedHorizontalDistance(piece, volume.p_map.head<2>()) - volume.hpl_m;
+  s.margin_v_m = signedVerticalDistance(piece, volume.p_map.z()) - volume.vpl_m;
+  s.meets = std::max(s.margin_h_m, s.margin_v_m) <= 0;
+  s.clearance_m = std::hypot(std::max(s.margin_h_m, 0.0), std::max(s.margin_v_m, 0.0));
+  return s;
+}
+
+struct Scene::Impl {
+  std::vector<ScenePiece> pieces;
+  std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
+  fcl::DynamicAABBTreeCollisionManagerd manager;
+};
+
+Scene::Scene(std::vector<ScenePiece> pieces) : impl_(std::make_unique<Impl>()) {
+  impl_->pieces = std::move(pieces);
+  std::vector<fcl::CollisionObjectd*> registered;
+  registered.reserve(impl_->pieces.size());
+  for (std::size_t i = 0; i < impl_->pieces.size(); ++i) {
+    validatePiece(i, impl_->pieces[i]);
+    impl_->objects.push_back(fclObject(impl_->pieces[i].prism));
+    fcl::CollisionObjectd& o = *impl_->objects.back();
+    o.setUserData(reinterpret_cast<void*>(i + 1));  // 0 marks the query volume
+    o.computeAABB();
+    registered.push_back(&o);
+  }
+  impl_->manager.registerObjects(registered);
+  impl_->manager.setup();
+}
+
+Scene::~Scene() = default;
+Scene::Scene(Scene&&) noexcept = default;
+Scene& Scene::operator=(Scene&&) noexcept = default;
+
+const std::vector<ScenePiece>& Scene::pieces() const { return impl_->pieces; }
+
+std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizon_m,
+                                   const std::function<bool(const ScenePiece&)>& accept) const {
+  const Eigen::Vector3d& p = volume.p_map;
+  if (!p.allFinite()) throw std::invalid_argument("protection volume position is not finite");
+  if (!(std::isfinite(volume.hpl_m) && volume.hpl_m >= 0 && std::isfinite(volume.vpl_m) && volume.vpl_m >= 0)) {
+    std::ostringstream s;
+    s << "protection levels must be finite and ≥ 0, got HPL " << volume.hpl_m << " m, VPL " << volume.vpl_m << " m";
+    throw std::invalid_argument(s.str());
+  }
+  if (!(std::isfinite(horizon_m) && horizon_m >= 0)) {
+    throw std::invalid_argument("clearance horizon must be a finite number of metres ≥ 0, got " + std::to_string(horizon_m));
+  }
+  if (p.z() - volume.vpl_m < kSceneFloor_h_ell_m || p.z() + volume.vpl_m > kSceneCeiling_h_ell_m) {
+    std::ostringstream s;
+    s << "protection volume " << p.z() - volume.vpl_m << " … " << p.z() + volume.vpl_m
+      << " m (ellipsoidal) reaches outside the modelled heights " << kSceneFloor_h_ell_m << " … "
+      << kSceneCeiling_h_ell_m << " m";
+    throw std::invalid_argument(s.str());
+  }
+
+  // Broad phase: the volume grown by the horizon, against the AABB tree.
+  const std::unique_ptr<fcl::CollisionObjectd> reach = volumeObject(p, volume.hpl_m + horizon_m, volume.vpl_m + horizon_m);
+  reach->computeAABB();
+  struct Candidates {
+    const Impl* impl;
+    const std::function<bool(const ScenePiece&)>* accept;
+    std::vector<std::size_t> pieces;
+    std::exception_ptr error;
+  } candidates{impl_.get(), &accept, {}, nullptr};
+  const auto collect = [](fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) -> bool {
+    auto& c = *static_cast<Candidates*>(data);
+    const std::size_t tag = reinterpret_cast<std::size_t>(o1->getUserData() ? o1->getUserData() : o2->getUserData());
+    try {  // FCL's callbacks must not throw: keep the error and stop the traversal
+      if (tag > 0 && (*c.accept)(c.impl->pieces[tag - 1])) c.pieces.push_back(tag - 1);
+      return false;
+    } catch (...) {
+      c.error = std::current_exception();
+      return true;
+    }
+  };
+  impl_->manager.collide(reach.get(), &candidates, collect);
+  if (candidates.error) std::rethrow_exception(candidates.error);
+  std::sort(candidates.pieces.begin(), candidates.pieces.end());
+
+  // Narrow phase.
+  std::vector<SceneHit> hits;
+  if (candidates.pieces.empty()) return hits;
+  const std::unique_ptr<fcl::CollisionObjectd> body = volumeObject(p, volume.hpl_m, volume.vpl_m);
+  body->computeAABB();
+  const fcl::DistanceRequestd request;  // GJK through libccd, distance tolerance 1e-6
+  for (std::size_t i : candidates.pieces) {
+    const airspace::PlanarPrism& prism = impl_->pieces[i].prism;
+    Separation s = separationMargins(volume, prism);
+    double d = std::numeric_limits<double>::quiet_NaN();
+    try {
+      fcl::DistanceResultd result;
+      fcl::distance(body.get(), impl_->objects[i].get(), request, result);
+      d = result.min_distance;
+    } catch (const std::exception&) {
+      s.fcl_failed = true;  // FCL's EPA/GJK can throw near contact: the exact predicate decides
+    }
+    const double deciding_m = std::max(s.margin_h_m, s.margin_v_m);
+    if (!s.fcl_failed && d > kExactBand_m && deciding_m > 0) {
+      s.meets = false;  // FCL and the direct margins agree: clear
+      s.clearance_m = d;
+    } else if (!s.fcl_failed && d <= 0 && deciding_m < -kExactBand_m) {
+      s.meets = true;   // FCL reports contact and the margins put it deep inside
+      s.clearance_m = 0;
+    } else {
+      s.exact = true;
+      s.meets = airspace::cylinderMeetsPrism(p, volume.hpl_m, volume.vpl_m, prism);
+      if (s.meets) s.clearance_m = 0;
+    }
+    if (s.meets || s.clearance_m <= horizon_m) hits.push_back({i, s});
+  }
+  return hits;
+}
+
+}  // namespace skylane::geofence

@@ -1,0 +1,106 @@
+#pragma once
+/// \file
+/// \brief Zones and obstacles as convex pieces in the mission map frame, indexed by FCL (a
+/// dynamic AABB tree over one collision object per piece), and the separation of a protection
+/// volume from them: FCL narrow phase (GJK distance between the volume's cylinder and the
+/// piece), with the exact predicates of airspace/ deciding near contact and whenever FCL fails.
+///
+/// FCL stays inside scene.cpp. The map frame is the one of geofence/corridor.hpp: x east and
+/// y north [m] in the mission's azimuthal equidistant plane, z the ellipsoidal height [m].
+///
+/// **Touching** (the decision): zones and obstacles are closed sets, so a volume that touches a
+/// piece meets it (airspace::cylinderMeetsPrism is exact about it). Its deciding margin is 0,
+/// so the checks above report such a contact as indeterminate, never as clear.
+
+#include "airspace/zone_geometry.hpp"
+#include "geofence/corridor.hpp"
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <vector>
+
+namespace skylane::geofence {
+
+/// \brief What a piece belongs to.
+enum class PieceOwner { kZone, kObstacle };
+
+/// \brief Heights FCL works within [m, ellipsoidal]: an unlimited floor is cut at the bottom of
+/// this band and an unlimited ceiling at its top (FCL needs finite shapes). The band holds
+/// every surface on Earth (the Dead Sea shore is at about −400 m ellipsoidal) and every flight
+/// a U-space serves, so the cut changes no answer for a volume inside it; a volume reaching
+/// out of it is refused.
+inline constexpr double kSceneFloor_h_ell_m = -2000.0;
+inline constexpr double kSceneCeiling_h_ell_m = 20000.0;
+
+/// \brief FCL's GJK distance is trusted above this [m]; at or below it (contact, penetration or
+/// a near miss) the exact predicate decides. GJK stops at a relative 1e-6 of the shapes' size
+/// (kilometres here): millimetres, so a centimetre leaves a wide berth.
+inline constexpr double kExactBand_m = 0.01;
+
+/// \brief One convex piece of a zone or an obstacle: a convex counter-clockwise ring, or a
+/// disk (empty ring), between a floor and a ceiling (−∞ / +∞ allowed), in the map frame.
+struct ScenePiece {
+  airspace::PlanarPrism prism;
+  PieceOwner owner = PieceOwner::kZone;
+  std::size_t owner_index = 0;  ///< which zone or obstacle
+};
+
+/// \brief How far a protection volume is from a piece.
+///
+/// The volume and the piece are both a horizontal shape times a height interval, so with
+///   margin_h = (signed horizontal distance from the volume's centre to the piece) − HPL and
+///   margin_v = (signed vertical distance from the centre to the piece's height band) − VPL
+/// (signed: negative inside) the volume meets the piece iff max(margin_h, margin_v) ≤ 0, and
+/// their 3-D distance is hypot(max(margin_h, 0), max(margin_v, 0)). margin_h is how much HPL
+/// could grow, margin_v how much VPL could, before the volume meets the piece.
+struct Separation {
+  double margin_h_m = 0.0;
+  double margin_v_m = 0.0;
+  double clearance_m = 0.0;  ///< 3-D distance, 0 when meeting (FCL's GJK distance when trusted)
+  bool meets = false;        ///< the volume meets the piece (closed sets)
+  bool exact = false;        ///< decided by the exact predicate (near contact, or FCL failed)
+  bool fcl_failed = false;   ///< FCL threw; the exact predicate stood in
+};
+
+/// \brief The margins of the volume from the piece, computed directly in the piece's frame
+/// (the formulas of Separation; meets and clearance follow from them, in floating point).
+[[nodiscard]] Separation separationMargins(const ProtectionVolume& volume, const airspace::PlanarPrism& piece);
+
+/// \brief A piece the query reached and its separation from the volume.
+struct SceneHit {
+  std::size_t piece = 0;
+  Separation separation;
+};
+
+/// \brief Convex pieces behind an FCL dynamic AABB tree.
+class Scene {
+ public:
+  /// \brief Builds one FCL object per piece (a convex mesh for a ring, a cylinder for a disk;
+  /// vertices relative to the piece's centre for conditioning) and the broad phase over them.
+  /// \throws std::invalid_argument for a ring that is not convex and counter-clockwise, a
+  /// non-finite coordinate, a non-positive radius or a floor not below its ceiling (the
+  /// message names the piece).
+  explicit Scene(std::vector<ScenePiece> pieces);
+  ~Scene();
+  Scene(Scene&&) noexcept;
+  Scene& operator=(Scene&&) noexcept;
+
+  /// \brief The pieces, in the order given.
+  [[nodiscard]] const std::vector<ScenePiece>& pieces() const;
+
+  /// \brief Every piece with `accept(piece)` true whose 3-D distance from the volume is at most
+  /// `horizon_m`, with its separation. Broad phase: the volume's cylinder grown by the horizon
+  /// against the AABB tree; narrow phase: FCL's distance, and the exact predicate at or below
+  /// kExactBand_m or when FCL throws. Thread-safe (const, no shared scratch).
+  /// \throws std::invalid_argument for a non-finite position, a negative or non-finite PL or
+  /// horizon, or a volume reaching outside [kSceneFloor_h_ell_m, kSceneCeiling_h_ell_m].
+  [[nodiscard]] std::vector<SceneHit> query(const ProtectionVolume& volume, double horizon_m,
+                                            const std::function<bool(const ScenePiece&)>& accept) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace skylane::geofence
