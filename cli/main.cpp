@@ -1,6 +1,7 @@
 /// \file
 /// \brief The `skylane` command: parse, call, print; errors → one line on stderr, exit 2.
 
+#include "cli/fence_commands.hpp"
 #include "cli/integrity_commands.hpp"
 #include "cli/skymask_commands.hpp"
 #include "cli/zones_commands.hpp"
@@ -17,6 +18,7 @@ int main(int argc, char** argv) {
   skylane::cli::addIntegrityCommands(app);
   skylane::cli::addZonesCommands(app);
   skylane::cli::addSkyMaskCommands(app);
+  skylane::cli::addFenceCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -16,11 +16,6 @@ namespace {
 /// a(1 − e²) [m]. Scale bounds use it so that they hold everywhere on the ellipsoid.
 constexpr double kLeastRadiusOfCurvature_m = 6378137.0 * (1.0 - 0.00669437999014);
 
-/// Verdict of a deciding margin m (positive: the check holds) against the tolerance.
-Verdict verdictOf(double m, double tolerance_m) {
-  return std::abs(m) <= tolerance_m ? Verdict::kIndeterminate : (m > 0 ? Verdict::kInside : Verdict::kOutside);
-}
-
 /// The worse of two verdicts: outside over indeterminate over inside.
 int severity(Verdict v) { return v == Verdict::kOutside ? 2 : (v == Verdict::kIndeterminate ? 1 : 0); }
 
@@ -160,40 +155,31 @@ FenceVerdict Fence::check(const TimedVolume& v) const {
 
   // Zones count when the policy says so and they are active in the interval; obstacles always.
   const maps::GpsTime t1 = v.t1 - v.t0 > 0 ? v.t1 : v.t0;
-  const auto accept = [&](const ScenePiece& p) {
-    if (p.owner == PieceOwner::kObstacle) return true;
-    return zone_counts_[p.owner_index] &&
-           (t1 - v.t0 > 0 ? airspace::isActiveDuring(zones_[p.owner_index], v.t0, t1)
-                          : airspace::isActive(zones_[p.owner_index], v.t0));
+  const auto accept = [&](PieceOwner owner, std::size_t i) {
+    if (owner == PieceOwner::kObstacle) return true;
+    return zone_counts_[i] && (t1 - v.t0 > 0 ? airspace::isActiveDuring(zones_[i], v.t0, t1)
+                                             : airspace::isActive(zones_[i], v.t0));
   };
   const std::vector<SceneHit> hits = scene_.query(v.volume, options_.horizon_m, accept);
 
-  // One check per zone or obstacle: its worst piece (least deciding margin max(h, v)).
+  // One check per zone or obstacle, from the piece that decides it.
   std::vector<Check> near;
+  near.reserve(hits.size());
   for (const SceneHit& h : hits) {
-    const ScenePiece& p = scene_.pieces()[h.piece];
     const Separation& s = h.separation;
-    const Level level = p.owner == PieceOwner::kZone ? Level::kZone : Level::kObstacle;
-    const double deciding_m = s.meets ? std::min(std::max(s.margin_h_m, s.margin_v_m), 0.0)
-                                      : std::max({s.margin_h_m, s.margin_v_m, 0.0});
     Check c;
-    c.level = level;
-    c.index = p.owner_index;
-    c.subject = level == Level::kZone ? zones_[p.owner_index].identifier : buildings_[p.owner_index].feature;
+    c.level = h.owner == PieceOwner::kZone ? Level::kZone : Level::kObstacle;
+    c.index = h.owner_index;
+    c.subject = c.level == Level::kZone ? zones_[h.owner_index].identifier : buildings_[h.owner_index].feature;
     c.margin_h_m = s.margin_h_m;
     c.margin_v_m = s.margin_v_m;
     c.clearance_m = s.clearance_m;
     c.exact = s.exact;
-    // The exact predicate has the last word on meeting; the margin says how close it is.
+    // The narrow phase has the last word on meeting; the margin says how close it is.
+    const double deciding_m = std::max(s.margin_h_m, s.margin_v_m);
     c.verdict = s.meets ? (deciding_m >= -options_.tolerance_m ? Verdict::kIndeterminate : Verdict::kOutside)
-                        : verdictOf(deciding_m, options_.tolerance_m);
-    const auto same = std::find_if(near.begin(), near.end(), [&](const Check& o) { return o.level == c.level && o.index == c.index; });
-    if (same == near.end()) {
-      near.push_back(std::move(c));
-    } else if (severity(c.verdict) > severity(same->verdict) ||
-               (severity(c.verdict) == severity(same->verdict) && *c.clearance_m < *same->clearance_m)) {
-      *same = std::move(c);
-    }
+                        : (deciding_m <= options_.tolerance_m ? Verdict::kIndeterminate : Verdict::kInside);
+    near.push_back(std::move(c));
   }
   std::stable_sort(near.begin(), near.end(), [](const Check& a, const Check& b) {
     if (a.level != b.level) return a.level < b.level;

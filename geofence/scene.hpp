@@ -67,9 +67,11 @@ struct Separation {
 /// (the formulas of Separation; meets and clearance follow from them, in floating point).
 [[nodiscard]] Separation separationMargins(const ProtectionVolume& volume, const airspace::PlanarPrism& piece);
 
-/// \brief A piece the query reached and its separation from the volume.
+/// \brief A zone or obstacle the query reached: the piece that decides it and its separation.
 struct SceneHit {
-  std::size_t piece = 0;
+  PieceOwner owner = PieceOwner::kZone;
+  std::size_t owner_index = 0;
+  std::size_t piece = 0;  ///< a piece the volume meets, else the piece nearest to it
   Separation separation;
 };
 
@@ -89,14 +91,20 @@ class Scene {
   /// \brief The pieces, in the order given.
   [[nodiscard]] const std::vector<ScenePiece>& pieces() const;
 
-  /// \brief Every piece with `accept(piece)` true whose 3-D distance from the volume is at most
-  /// `horizon_m`, with its separation. Broad phase: the volume's cylinder grown by the horizon
-  /// against the AABB tree; narrow phase: FCL's distance, and the exact predicate at or below
-  /// kExactBand_m or when FCL throws. Thread-safe (const, no shared scratch).
+  /// \brief Every zone and obstacle (owner) that `accept(owner, owner_index)` takes with a piece
+  /// that meets the volume or lies within `horizon_m` of it; one hit per owner, sorted by owner.
+  ///
+  /// Broad phase: the volume's cylinder grown by the horizon against the AABB tree. Then, per
+  /// owner, the direct margins (separationMargins) rank its pieces; the narrow phase — FCL's
+  /// GJK distance, with the exact predicate at or below kExactBand_m, when FCL and the margins
+  /// disagree, or when FCL throws — runs on every piece the margins put within kExactBand_m of
+  /// meeting (until one meets), else on the nearest piece. Pieces the margins put farther than
+  /// the band cannot meet the volume (the margins' rounding is far below it) and are not
+  /// nearer than the one evaluated. Thread-safe (const, no shared scratch).
   /// \throws std::invalid_argument for a non-finite position, a negative or non-finite PL or
   /// horizon, or a volume reaching outside [kSceneFloor_h_ell_m, kSceneCeiling_h_ell_m].
   [[nodiscard]] std::vector<SceneHit> query(const ProtectionVolume& volume, double horizon_m,
-                                            const std::function<bool(const ScenePiece&)>& accept) const;
+                                            const std::function<bool(PieceOwner, std::size_t)>& accept) const;
 
  private:
   struct Impl;

@@ -304,5 +304,67 @@ TEST(Cli, ZonesExportWritesGeoJsonWithBothHeightReferences) {
   EXPECT_EQ(j["features"][5]["geometry"]["coordinates"][0].size(), 4u);
 }
 
+
+// --- fence check ---------------------------------------------------------------------------
+
+std::string fenceArgs() {
+  const std::string ex = std::string(SKYLANE_TEST_DATA) + "/../../examples/";
+  return "fence check --corridor " + ex + "fence/corridor.json --zones " + ex + "fence/zones_ed269.json --ground-amsl 408 " +
+         "--buildings " + ex + "skymask/buildings.geojson";
+}
+
+TEST(Cli, FenceCheckGivesTheVerdictOfOneFix) {
+  // On the first leg, 0.5 m above the centre line with VPL 1 m: VAL₁ = 1.44 m is exceeded by
+  // 0.06 m (level 1 violated); the airspace box and everything else hold.
+  const RunResult r = run(fenceArgs() +
+                          R"( --fix '{"time":"2026-11-23T12:00:00Z","lat":47.3763,"lon":8.5405,"h_ell_m":515.5,"hpl_m":1.0,"vpl_m":1.0}')");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["verdict"], "outside");
+  EXPECT_EQ(j["violated"], "level1");
+  EXPECT_EQ(j["checks"][0]["level"], "level1");
+  EXPECT_NEAR(j["checks"][0]["margin_v_m"].get<double>(), -0.06, 1e-3);
+  EXPECT_EQ(j["checks"][1]["verdict"], "inside");
+}
+
+TEST(Cli, FenceCheckStreamsVerdictsAndSkipsBadLines) {
+  const std::string fixes = writeTemp("fixes.jsonl",
+      R"({"id":"a","time":"2026-11-23T12:00:00Z","lat":47.3763,"lon":8.5405,"h_ell_m":515.0,"hpl_m":1.0,"vpl_m":1.0})" "\n"
+      R"({"id":"b","time":"2026-11-23T12:00:01Z","lat":47.3763,"lon":8.5405,"h_ell_m":515.0,"hpl_m":-1,"vpl_m":1.0})" "\n"
+      "not json\n"
+      R"({"id":"c","time":"2026-11-23T12:00:02Z","lat":47.37995,"lon":8.5452,"h_ell_m":515.0,"hpl_m":5,"vpl_m":5})" "\n"
+      R"({"id":"d","time":"2026-11-23T17:00:00Z","lat":47.37995,"lon":8.5452,"h_ell_m":515.0,"hpl_m":5,"vpl_m":5})" "\n");
+  const RunResult r = run(fenceArgs() + " --fixes " + fixes);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::istringstream in(r.out);
+  std::vector<nlohmann::json> lines;
+  for (std::string l; std::getline(in, l);) {
+    if (l.rfind('{', 0) == 0) lines.push_back(nlohmann::json::parse(l));  // stderr's lines start "skylane:"
+  }
+  EXPECT_NE(r.out.find("skylane: fence check: 3 fixes checked, 2 rejected"), std::string::npos) << r.out;
+  ASSERT_EQ(lines.size(), 5u) << r.out;
+  EXPECT_EQ(lines[0]["id"], "a");
+  EXPECT_EQ(lines[0]["verdict"], "inside");
+  EXPECT_EQ(lines[1]["event"], "rejected_input");
+  EXPECT_EQ(lines[1]["line"], 2);
+  EXPECT_NE(lines[1]["error"].get<std::string>().find("field '$.hpl_m': got '-1', expected a protection level"), std::string::npos);
+  EXPECT_EQ(lines[2]["event"], "rejected_input");
+  EXPECT_EQ(lines[2]["line"], 3);
+  // In the Christmas market circle while it is active (10:00–16:00 UTC), and not after.
+  EXPECT_EQ(lines[3]["id"], "c");
+  bool in_event = false;
+  for (const auto& c : lines[3]["checks"]) in_event = in_event || (c["subject"] == "EX-ZH-EVENT" && c["verdict"] == "outside");
+  EXPECT_TRUE(in_event) << lines[3].dump();
+  for (const auto& c : lines[4]["checks"]) EXPECT_NE(c["subject"], "EX-ZH-EVENT");
+}
+
+TEST(Cli, FenceCheckRefusesABadCorridorFileWithExitTwo) {
+  const std::string corridor = writeTemp("bad_corridor.json", R"({"path":[{"lat":47,"lon":8,"h_ell_m":500}],"vehicle":{"lateral_m":1,"longitudinal_m":1}})");
+  const RunResult r = run("fence check --corridor " + corridor + R"( --fix '{}')");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("bad_corridor.json: field '$.path'"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("at least 2 waypoints"), std::string::npos) << r.out;
+}
+
 }  // namespace
 }  // namespace skylane

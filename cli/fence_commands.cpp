@@ -1,0 +1,232 @@
+#include "cli/fence_commands.hpp"
+
+#include "airspace/validation.hpp"
+#include "cli/skymask_commands.hpp"
+#include "geofence/corridor_file.hpp"
+#include "maps/geoid.hpp"
+#include "maps/json_node.hpp"
+#include "maps/parse_error.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+namespace skylane::cli {
+namespace {
+
+using maps::ParseError;
+using nlohmann::json;
+
+struct FenceCheckOptions {
+  std::string corridor;
+  std::vector<std::string> zones;
+  std::string format = "auto";
+  std::string terrain;
+  std::string buildings;
+  std::optional<double> ground_amsl_m;
+  std::vector<std::string> authorise;
+  double horizon_m = 100.0;
+  double tolerance_m = 1e-6;
+  std::string fix;
+  std::string fixes;
+};
+
+json metres(double v) { return std::isfinite(v) ? json(std::round(v * 1e3) / 1e3) : json(nullptr); }
+
+/// A fix: {"time", "lat", "lon", "h_ell_m", "hpl_m", "vpl_m"} and optionally "id" and "until"
+/// (the end of a time interval). Errors name `source` (the option or "file:line").
+struct Fix {
+  json id;
+  maps::GpsTime t0, t1;
+  double lat_rad = 0, lon_rad = 0, h_ell_m = 0;
+  double hpl_m = 0, vpl_m = 0;
+};
+
+Fix parseFix(const json& doc, const std::string& source) {
+  const maps::JsonNode root{doc, "$", source};
+  if (!doc.is_object()) root.fail("a JSON object {\"time\", \"lat\", \"lon\", \"h_ell_m\", \"hpl_m\", \"vpl_m\"}");
+  for (const auto& [key, value] : doc.items()) {
+    if (key != "id" && key != "time" && key != "until" && key != "lat" && key != "lon" && key != "h_ell_m" &&
+        key != "hpl_m" && key != "vpl_m") {
+      throw ParseError(source, 0, "$." + key, "", "no such field (known: id, time, until, lat, lon, h_ell_m, hpl_m, vpl_m)");
+    }
+  }
+  const auto time = [&](const char* key) {
+    const maps::JsonNode n = root.at(key);
+    const auto t = maps::parseRfc3339(n.str());
+    if (!t) n.fail("an RFC 3339 date-time such as 2026-11-23T14:00:00Z");
+    return *t;
+  };
+  const auto nonNegative = [&](const char* key) {
+    const maps::JsonNode n = root.at(key);
+    const double v = n.number();
+    if (v < 0) n.fail("a protection level ≥ 0 m");
+    return v;
+  };
+  Fix f;
+  if (doc.contains("id")) f.id = doc.at("id");
+  f.t0 = time("time");
+  f.t1 = root.has("until") ? time("until") : f.t0;
+  if (f.t1 - f.t0 < 0) root.at("until").fail("a time not before \"time\"");
+  const maps::JsonNode lat = root.at("lat"), lon = root.at("lon");
+  if (std::abs(lat.number()) > 90) lat.fail("a latitude in [-90, 90] degrees");
+  if (std::abs(lon.number()) > 180) lon.fail("a longitude in [-180, 180] degrees");
+  f.lat_rad = maps::deg2rad(lat.number());
+  f.lon_rad = maps::deg2rad(lon.number());
+  f.h_ell_m = root.at("h_ell_m").number();
+  f.hpl_m = nonNegative("hpl_m");
+  f.vpl_m = nonNegative("vpl_m");
+  return f;
+}
+
+json checkFix(const Fix& f, const geofence::Fence& fence, const maps::PlaneFrame& frame) {
+  const Eigen::Vector2d p = frame.toPlane(f.lat_rad, f.lon_rad);
+  const geofence::TimedVolume v{f.t0, f.t1, {Eigen::Vector3d(p.x(), p.y(), f.h_ell_m), f.hpl_m, f.vpl_m}};
+  json out;
+  if (!f.id.is_null()) out["id"] = f.id;
+  out["time"] = maps::formatRfc3339(f.t0, 3);
+  if (f.t1 - f.t0 > 0) out["until"] = maps::formatRfc3339(f.t1, 3);
+  json verdict = fenceVerdictJson(fence.check(v), fence);
+  out.update(verdict);
+  return out;
+}
+
+void runFenceCheck(const FenceCheckOptions& o) {
+  if (o.fix.empty() == o.fixes.empty()) throw ParseError("--fix", 0, "--fix|--fixes", "", "exactly one of --fix JSON and --fixes FILE");
+  if (!(o.horizon_m >= 0 && std::isfinite(o.horizon_m))) {
+    throw ParseError("--horizon", 0, "--horizon", std::to_string(o.horizon_m), "a distance ≥ 0 m");
+  }
+  if (!(o.tolerance_m >= 0 && std::isfinite(o.tolerance_m))) {
+    throw ParseError("--tolerance", 0, "--tolerance", std::to_string(o.tolerance_m), "a distance ≥ 0 m");
+  }
+  const geofence::CorridorSpec spec = geofence::loadCorridorSpec(o.corridor);
+  geofence::CorridorBoxes boxes = geofence::buildBoxes(spec);
+  const auto format = airspace::parseZoneFormat(o.format);
+  if (!format) throw ParseError("--format", 0, "--format", o.format, "auto, ed269, ed318, geojson or qgc");
+  const maps::Terrain terrain = groundModel(o.terrain, o.ground_amsl_m);
+  const airspace::VerticalModel model{terrain, maps::Geoid::egm96()};
+  std::vector<airspace::Zone> zones;
+  for (const std::string& path : o.zones) {
+    std::vector<airspace::Zone> z = airspace::loadZones(path, *format);
+    zones.insert(zones.end(), std::make_move_iterator(z.begin()), std::make_move_iterator(z.end()));
+  }
+  std::vector<maps::Building> buildings;
+  if (!o.buildings.empty()) buildings = maps::loadBuildings(o.buildings, terrain);
+  std::vector<geofence::ScenePiece> pieces = geofence::zonePieces(zones, boxes.frame, model);
+  std::vector<geofence::ScenePiece> obstacles = geofence::obstaclePieces(buildings, boxes.frame);
+  pieces.insert(pieces.end(), obstacles.begin(), obstacles.end());
+  geofence::ZonePolicy policy;
+  policy.authorisations = spec.authorisations;
+  policy.authorisations.insert(o.authorise.begin(), o.authorise.end());
+  geofence::FenceOptions options;
+  options.horizon_m = o.horizon_m;
+  options.tolerance_m = o.tolerance_m;
+  for (const std::string& w : boxes.limits.warnings) std::cerr << "skylane: warning: " << o.corridor << ": " << w << "\n";
+  const geofence::Fence fence(std::move(boxes.level1), std::move(boxes.level2), std::move(zones), std::move(buildings),
+                              geofence::Scene(std::move(pieces)), policy, options);
+
+  if (!o.fix.empty()) {
+    json doc;
+    try {
+      doc = json::parse(o.fix);
+    } catch (const json::parse_error& e) {
+      throw ParseError("--fix", 0, "--fix", o.fix.substr(0, 60), std::string("JSON (") + e.what() + ")");
+    }
+    json out = checkFix(parseFix(doc, "--fix"), fence, boxes.frame);
+    if (!boxes.limits.warnings.empty()) out["warnings"] = boxes.limits.warnings;
+    std::cout << out.dump(2) << "\n";
+    return;
+  }
+  // A stream: one verdict line per fix; a bad line is reported (stdout and stderr), skipped,
+  // and the stream goes on.
+  std::ifstream file;
+  if (o.fixes != "-") {
+    file.open(o.fixes);
+    if (!file) throw ParseError(o.fixes, 0, "--fixes", o.fixes, "a readable JSON-lines file");
+  }
+  std::istream& in = o.fixes == "-" ? std::cin : file;
+  std::string text;
+  std::size_t line = 0, checked = 0, rejected = 0;
+  while (std::getline(in, text)) {
+    ++line;
+    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::string source = o.fixes + ":" + std::to_string(line);
+    try {
+      json doc;
+      try {
+        doc = json::parse(text);
+      } catch (const json::parse_error& e) {
+        throw ParseError(source, 0, "$", text.substr(0, 60), std::string("one JSON object per line (") + e.what() + ")");
+      }
+      json out = checkFix(parseFix(doc, source), fence, boxes.frame);
+      out["line"] = line;
+      std::cout << out.dump() << "\n";
+      ++checked;
+    } catch (const std::exception& e) {  // ParseError, or a fix the checker refuses
+      ++rejected;
+      std::cout << json{{"event", "rejected_input"}, {"line", line}, {"error", e.what()}}.dump() << "\n";
+      std::cerr << "skylane: skipped: " << e.what() << "\n";
+    }
+  }
+  std::cerr << "skylane: fence check: " << checked << " fix" << (checked == 1 ? "" : "es") << " checked, " << rejected
+            << " rejected\n";
+}
+
+}  // namespace
+
+json fenceVerdictJson(const geofence::FenceVerdict& v, const geofence::Fence& fence) {
+  json out;
+  out["verdict"] = geofence::verdictName(v.verdict);
+  out["violated"] = v.violated ? json(geofence::levelName(*v.violated)) : json(nullptr);
+  json checks = json::array();
+  for (const geofence::Check& c : v.checks) {
+    json j;
+    j["level"] = geofence::levelName(c.level);
+    j["verdict"] = geofence::verdictName(c.verdict);
+    j["subject"] = c.subject;
+    j["margin_h_m"] = metres(c.margin_h_m);
+    j["margin_v_m"] = metres(c.margin_v_m);
+    if (c.level == geofence::Level::kCorridor || c.level == geofence::Level::kAirspace) {
+      const geofence::AlertLimits& l = (c.level == geofence::Level::kCorridor ? fence.level1() : fence.level2()).limits();
+      j["hal_m"] = metres(l.hal_m);
+      j["val_m"] = metres(l.val_m);
+      j["across_joint"] = c.across_joint;
+    } else {
+      j["clearance_m"] = metres(*c.clearance_m);
+      j["exact"] = c.exact;
+      if (c.level == geofence::Level::kZone) {
+        const airspace::Zone& z = fence.zones()[c.index];
+        j["name"] = z.name;
+        j["restriction"] = std::string(airspace::restrictionName(z.restriction));
+        j["file"] = z.source;
+      }
+    }
+    checks.push_back(j);
+  }
+  out["checks"] = checks;
+  return out;
+}
+
+void addFenceCommands(CLI::App& app) {
+  CLI::App* fence = app.add_subcommand("fence", "Protection-volume checks against corridor, airspace boxes, zones and obstacles");
+  fence->require_subcommand(1);
+  auto o = std::make_shared<FenceCheckOptions>();
+  CLI::App* check = fence->add_subcommand(
+      "check", "Verdict for one fix (--fix) or each line of a JSON-lines file (--fixes; - for stdin)");
+  check->add_option("--corridor", o->corridor, "Corridor file (JSON: path, vehicle, k1, k2, ...; see README)")->required();
+  check->add_option("--zones", o->zones, "Zone files (ED-269, ED-318, GeoJSON, QGC .plan)");
+  check->add_option("--format", o->format, "Zone file format: auto, ed269, ed318, geojson, qgc");
+  check->add_option("--terrain", o->terrain, "Terrain raster for AGL limits and building bases (default: flat at 0 m AMSL)");
+  check->add_option("--ground-amsl", o->ground_amsl_m, "Flat ground at this altitude [m AMSL] when no --terrain is given");
+  check->add_option("--buildings", o->buildings, "Buildings and obstacles (GeoJSON)");
+  check->add_option("--authorise", o->authorise, "Zone identifier the flight is authorised for (repeatable)");
+  check->add_option("--horizon", o->horizon_m, "Report zones and obstacles within this clearance [m]");
+  check->add_option("--tolerance", o->tolerance_m, "Margins within this of 0 are indeterminate [m]");
+  check->add_option("--fix", o->fix, R"(One fix: {"time":"...Z","lat":..,"lon":..,"h_ell_m":..,"hpl_m":..,"vpl_m":..})");
+  check->add_option("--fixes", o->fixes, "JSON-lines file of fixes, or - for stdin");
+  check->callback([o] { runFenceCheck(*o); });
+}
+
+}  // namespace skylane::cli

@@ -1,0 +1,20 @@
+#pragma once
+/// \file
+/// \brief `skylane fence check`: the verdict of one fix or of a stream of fixes against a
+/// corridor file, zones and obstacles.
+
+#include "geofence/fence.hpp"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+namespace skylane::cli {
+
+/// \brief A fence verdict as JSON (also for the reports of later commands): overall verdict,
+/// violated level, and every check with its margins in metres (null for ±∞).
+[[nodiscard]] nlohmann::json fenceVerdictJson(const geofence::FenceVerdict& v, const geofence::Fence& fence);
+
+/// \brief Registers `fence` on `app`.
+void addFenceCommands(CLI::App& app);
+
+}  // namespace skylane::cli
