@@ -3,6 +3,7 @@
 #include "airspace/validation.hpp"
 #include "cli/skymask_commands.hpp"
 #include "geofence/corridor_file.hpp"
+#include "geofence/fix.hpp"
 #include "maps/geoid.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
@@ -35,53 +36,7 @@ struct FenceCheckOptions {
 
 json metres(double v) { return std::isfinite(v) ? json(std::round(v * 1e3) / 1e3) : json(nullptr); }
 
-/// A fix: {"time", "lat", "lon", "h_ell_m", "hpl_m", "vpl_m"} and optionally "id" and "until"
-/// (the end of a time interval). Errors name `source` (the option or "file:line").
-struct Fix {
-  json id;
-  maps::GpsTime t0, t1;
-  double lat_rad = 0, lon_rad = 0, h_ell_m = 0;
-  double hpl_m = 0, vpl_m = 0;
-};
-
-Fix parseFix(const json& doc, const std::string& source) {
-  const maps::JsonNode root{doc, "$", source};
-  if (!doc.is_object()) root.fail("a JSON object {\"time\", \"lat\", \"lon\", \"h_ell_m\", \"hpl_m\", \"vpl_m\"}");
-  for (const auto& [key, value] : doc.items()) {
-    if (key != "id" && key != "time" && key != "until" && key != "lat" && key != "lon" && key != "h_ell_m" &&
-        key != "hpl_m" && key != "vpl_m") {
-      throw ParseError(source, 0, "$." + key, "", "no such field (known: id, time, until, lat, lon, h_ell_m, hpl_m, vpl_m)");
-    }
-  }
-  const auto time = [&](const char* key) {
-    const maps::JsonNode n = root.at(key);
-    const auto t = maps::parseRfc3339(n.str());
-    if (!t) n.fail("an RFC 3339 date-time such as 2026-11-23T14:00:00Z");
-    return *t;
-  };
-  const auto nonNegative = [&](const char* key) {
-    const maps::JsonNode n = root.at(key);
-    const double v = n.number();
-    if (v < 0) n.fail("a protection level ≥ 0 m");
-    return v;
-  };
-  Fix f;
-  if (doc.contains("id")) f.id = doc.at("id");
-  f.t0 = time("time");
-  f.t1 = root.has("until") ? time("until") : f.t0;
-  if (f.t1 - f.t0 < 0) root.at("until").fail("a time not before \"time\"");
-  const maps::JsonNode lat = root.at("lat"), lon = root.at("lon");
-  if (std::abs(lat.number()) > 90) lat.fail("a latitude in [-90, 90] degrees");
-  if (std::abs(lon.number()) > 180) lon.fail("a longitude in [-180, 180] degrees");
-  f.lat_rad = maps::deg2rad(lat.number());
-  f.lon_rad = maps::deg2rad(lon.number());
-  f.h_ell_m = root.at("h_ell_m").number();
-  f.hpl_m = nonNegative("hpl_m");
-  f.vpl_m = nonNegative("vpl_m");
-  return f;
-}
-
-json checkFix(const Fix& f, const geofence::Fence& fence, const maps::PlaneFrame& frame) {
+json checkFix(const geofence::Fix& f, const geofence::Fence& fence, const maps::PlaneFrame& frame) {
   const Eigen::Vector2d p = frame.toPlane(f.lat_rad, f.lon_rad);
   const geofence::TimedVolume v{f.t0, f.t1, {Eigen::Vector3d(p.x(), p.y(), f.h_ell_m), f.hpl_m, f.vpl_m}};
   json out;
@@ -134,7 +89,7 @@ void runFenceCheck(const FenceCheckOptions& o) {
     } catch (const json::parse_error& e) {
       throw ParseError("--fix", 0, "--fix", o.fix.substr(0, 60), std::string("JSON (") + e.what() + ")");
     }
-    json out = checkFix(parseFix(doc, "--fix"), fence, boxes.frame);
+    json out = checkFix(geofence::parseFix(doc, "--fix"), fence, boxes.frame);
     if (!boxes.limits.warnings.empty()) out["warnings"] = boxes.limits.warnings;
     std::cout << out.dump(2) << "\n";
     return;
@@ -160,7 +115,7 @@ void runFenceCheck(const FenceCheckOptions& o) {
       } catch (const json::parse_error& e) {
         throw ParseError(source, 0, "$", text.substr(0, 60), std::string("one JSON object per line (") + e.what() + ")");
       }
-      json out = checkFix(parseFix(doc, source), fence, boxes.frame);
+      json out = checkFix(geofence::parseFix(doc, source), fence, boxes.frame);
       out["line"] = line;
       std::cout << out.dump() << "\n";
       ++checked;

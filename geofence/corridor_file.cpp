@@ -5,7 +5,6 @@
 #include "maps/text_file.hpp"
 
 #include <cmath>
-#include <initializer_list>
 #include <stdexcept>
 
 namespace skylane::geofence {
@@ -13,19 +12,6 @@ namespace {
 
 using maps::JsonNode;
 using maps::ParseError;
-
-/// Every member of the object must be one of `known`.
-void requireKnownFields(const JsonNode& n, std::initializer_list<const char*> known) {
-  if (!n.j.is_object()) n.fail("an object");
-  for (const auto& [key, value] : n.j.items()) {
-    bool ok = false;
-    for (const char* k : known) ok = ok || key == k;
-    if (ok) continue;
-    std::string list;
-    for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
-    throw ParseError(n.source, 0, n.path + "." + key, "", "no such field here (known: " + list + ")");
-  }
-}
 
 double latitude(const JsonNode& n) {
   const double v = n.number();
@@ -57,7 +43,7 @@ Dimension dimension(const JsonNode& n) {
 
 CorridorSpec parseCorridorSpec(const nlohmann::json& doc, const std::string& source) {
   const JsonNode root{doc, "$", source};
-  requireKnownFields(root, {"path", "origin", "vehicle", "k1", "k2", "override_ranges", "alert_mapping",
+  root.requireKnownFields({"path", "origin", "vehicle", "k1", "k2", "override_ranges", "alert_mapping",
                             "operating_limits", "authorisations"});
   CorridorSpec spec;
   spec.source = source;
@@ -65,17 +51,17 @@ CorridorSpec parseCorridorSpec(const nlohmann::json& doc, const std::string& sou
   if (path.array().size() < 2) path.fail("an array of at least 2 waypoints");
   for (std::size_t i = 0; i < path.j.size(); ++i) {
     const JsonNode w = path.item(i);
-    requireKnownFields(w, {"lat", "lon", "h_ell_m"});
+    w.requireKnownFields({"lat", "lon", "h_ell_m"});
     spec.path.push_back({latitude(w.at("lat")), longitude(w.at("lon")), w.at("h_ell_m").number()});
   }
   spec.origin = spec.path.front();
   if (root.has("origin")) {
     const JsonNode o = root.at("origin");
-    requireKnownFields(o, {"lat", "lon"});
+    o.requireKnownFields({"lat", "lon"});
     spec.origin = {latitude(o.at("lat")), longitude(o.at("lon")), 0.0};
   }
   const JsonNode v = root.at("vehicle");
-  requireKnownFields(v, {"lateral_m", "longitudinal_m", "height_m"});
+  v.requireKnownFields({"lateral_m", "longitudinal_m", "height_m"});
   spec.vehicle.lateral_m = positive(v.at("lateral_m"));
   spec.vehicle.longitudinal_m = positive(v.at("longitudinal_m"));
   if (v.has("height_m")) spec.vehicle.height_m = positive(v.at("height_m"));
@@ -84,13 +70,13 @@ CorridorSpec parseCorridorSpec(const nlohmann::json& doc, const std::string& sou
   if (root.has("override_ranges")) spec.levels.override_ranges = root.at("override_ranges").boolean();
   if (root.has("alert_mapping")) {
     const JsonNode m = root.at("alert_mapping");
-    requireKnownFields(m, {"horizontal", "vertical"});
+    m.requireKnownFields({"horizontal", "vertical"});
     if (m.has("horizontal")) spec.levels.mapping.horizontal = dimension(m.at("horizontal"));
     if (m.has("vertical")) spec.levels.mapping.vertical = dimension(m.at("vertical"));
   }
   if (root.has("operating_limits")) {
     const JsonNode o = root.at("operating_limits");
-    requireKnownFields(o, {"floor_h_ell_m", "ceiling_h_ell_m"});
+    o.requireKnownFields({"floor_h_ell_m", "ceiling_h_ell_m"});
     if (o.has("floor_h_ell_m")) spec.operating.floor_h_ell_m = o.at("floor_h_ell_m").number();
     if (o.has("ceiling_h_ell_m")) spec.operating.ceiling_h_ell_m = o.at("ceiling_h_ell_m").number();
     if (!(spec.operating.floor_h_ell_m < spec.operating.ceiling_h_ell_m)) {

@@ -20,6 +20,10 @@ namespace skylane::geofence {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+/// A turn to the right of up to this sine is accepted as convex: the exact convex pieces of
+/// airspace::convexPieces are rounded to doubles, which can bend a straight run by an ulp. FCL
+/// works on the vertices' hull, which then holds the piece (the safe side).
+constexpr double kConvexityTolerance = 1e-9;
 
 /// Signed horizontal distance from x to the piece's shape: positive outside (distance to the
 /// shape), negative inside (minus the distance to its boundary). A convex ring's interior
@@ -79,7 +83,7 @@ void validatePiece(std::size_t i, const ScenePiece& p) {
     const Eigen::Vector2d& c = q.ring[(k + 2) % q.ring.size()];
     if (!a.allFinite()) throw std::invalid_argument(pieceName(i, p) + ": non-finite vertex");
     const Eigen::Vector2d ab = b - a, bc = c - b;
-    if (ab.x() * bc.y() - ab.y() * bc.x() < 0) {
+    if (ab.x() * bc.y() - ab.y() * bc.x() < -kConvexityTolerance * ab.norm() * bc.norm()) {
       throw std::invalid_argument(pieceName(i, p) + ": the ring must be convex and counter-clockwise (vertex " +
                                   std::to_string((k + 1) % q.ring.size()) + " turns right)");
     }

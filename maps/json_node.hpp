@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <initializer_list>
 #include <string>
 
 namespace skylane::maps {
@@ -35,6 +36,19 @@ struct JsonNode {
   /// \brief Throws ParseError for this value.
   [[noreturn]] void fail(const std::string& expected) const {
     throw ParseError(source, 0, path, j.is_null() ? "null" : quoteJson(j), expected);
+  }
+  /// \brief An object whose members are all among `known` (an error naming the first other one
+  /// and listing the known ones).
+  void requireKnownFields(std::initializer_list<const char*> known) const {
+    if (!j.is_object()) fail("an object");
+    for (const auto& item : j.items()) {
+      bool ok = false;
+      for (const char* k : known) ok = ok || item.key() == k;
+      if (ok) continue;
+      std::string list;
+      for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+      throw ParseError(source, 0, path + "." + item.key(), "", "no such field here (known: " + list + ")");
+    }
   }
   /// \brief An object with a non-null member `key`.
   [[nodiscard]] bool has(const char* key) const { return j.is_object() && j.contains(key) && !j.at(key).is_null(); }

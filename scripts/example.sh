@@ -35,3 +35,11 @@ grep -E '"(zone|why)"' examples/out/zones_at.json
   --buildings examples/skymask/buildings.geojson --svg examples/out/skymask.svg > examples/out/skymask.json
 echo "--- sky mask among buildings (examples/out/skymask.json, plot examples/out/skymask.svg):"
 python3 -c 'import json; j=json.load(open("examples/out/skymask.json")); print(j["buildings"]["count"], "buildings; highest blocked elevation", j["max_blocked_elevation_deg"], "deg")'
+./build/skylane fence check --corridor examples/fence/corridor.json --zones examples/fence/zones_ed269.json \
+  --ground-amsl 408 --buildings examples/skymask/buildings.geojson --fixes examples/fence/fixes.jsonl \
+  > examples/out/fence.jsonl
+echo "--- fence check (examples/out/fence.jsonl):"
+python3 -c 'import json
+for l in open("examples/out/fence.jsonl"):
+    j = json.loads(l)
+    print(j.get("id", "line %d" % j["line"]), j.get("verdict", j.get("event")), j.get("violated") or "")'
