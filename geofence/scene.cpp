@@ -7,6 +7,7 @@
 #include <fcl/narrowphase/distance.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -20,6 +21,10 @@ namespace skylane::geofence {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+/// FCL's cylinder for the volume is at least this wide and tall [m], so that it never
+/// degenerates to a segment or a disk; the 1 mm it adds is well inside kExactBand_m, to which
+/// FCL's distance must match the closed form.
+constexpr double kFclMinSize_m = 1e-3;
 /// A turn to the right of up to this sine is accepted as convex: the exact convex pieces of
 /// airspace::convexPieces are rounded to doubles, which can bend a straight run by an ulp. FCL
 /// works on the vertices' hull, which then holds the piece (the safe side).
@@ -54,7 +59,19 @@ double signedVerticalDistance(const airspace::PlanarPrism& p, double z) {
   return std::max(p.floor_h_ell_m - z, z - p.ceiling_h_ell_m);
 }
 
-double clampHeight(double h) { return std::clamp(h, kSceneFloor_h_ell_m, kSceneCeiling_h_ell_m); }
+/// The piece's height interval as FCL gets it: finite limits as they are; an unlimited floor
+/// (ceiling) at the bottom (top) of the modelled band, or 1 km beyond the other limit when that
+/// lies outside the band — so within the band the shape is the piece.
+std::pair<double, double> fclHeights(const airspace::PlanarPrism& q) {
+  constexpr double kBeyond_m = 1000.0;
+  const double lo = std::isfinite(q.floor_h_ell_m)
+                        ? q.floor_h_ell_m
+                        : std::min(kSceneFloor_h_ell_m, std::isfinite(q.ceiling_h_ell_m) ? q.ceiling_h_ell_m - kBeyond_m : 0.0);
+  const double hi = std::isfinite(q.ceiling_h_ell_m)
+                        ? q.ceiling_h_ell_m
+                        : std::max(kSceneCeiling_h_ell_m, std::isfinite(q.floor_h_ell_m) ? q.floor_h_ell_m + kBeyond_m : 0.0);
+  return {lo, hi};
+}
 
 std::string pieceName(std::size_t i, const ScenePiece& p) {
   std::ostringstream s;
@@ -95,7 +112,7 @@ void validatePiece(std::size_t i, const ScenePiece& p) {
 /// The piece as an FCL shape placed at its centre: a cylinder for a disk; for a ring, the
 /// convex prism with its faces listed FCL's way (count, then vertex indices, outward winding).
 std::unique_ptr<fcl::CollisionObjectd> fclObject(const airspace::PlanarPrism& q) {
-  const double z_lo = clampHeight(q.floor_h_ell_m), z_hi = clampHeight(q.ceiling_h_ell_m);
+  const auto [z_lo, z_hi] = fclHeights(q);
   const double z_mid = 0.5 * (z_lo + z_hi), half = 0.5 * (z_hi - z_lo);
   if (q.ring.empty()) {
     auto shape = std::make_shared<fcl::Cylinderd>(q.radius_m, 2 * half);
@@ -215,7 +232,8 @@ std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizo
   // reused per thread (one allocation per thread, not per query); their AABBs are recomputed
   // after every change of size and place.
   thread_local QueryObjects q;
-  q.place(p, volume.hpl_m + horizon_m, volume.vpl_m + horizon_m, volume.hpl_m, volume.vpl_m);
+  q.place(p, volume.hpl_m + horizon_m, volume.vpl_m + horizon_m, std::max(volume.hpl_m, kFclMinSize_m),
+          std::max(volume.vpl_m, kFclMinSize_m));
   std::vector<std::size_t> candidates;
   const auto collect = [](fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) -> bool {
     const void* tag = o1->getUserData() ? o1->getUserData() : o2->getUserData();
@@ -232,29 +250,46 @@ std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizo
   });
   std::vector<SceneHit> hits;
   if (candidates.empty()) return hits;
-  const fcl::DistanceRequestd request;  // GJK through libccd, distance tolerance 1e-6
+  // FCL 0.7.0's two GJK solvers each stop metres off on some elongated pairs: libccd (its
+  // default) beside a piece kilometres tall (an unlimited ceiling), its own (GST_INDEP) for a
+  // thin tall volume (HPL ≪ VPL) — cases kept in tests/geofence/scene_test.cpp. So libccd
+  // goes first and the other is a second opinion; FCL's answer counts only where it agrees
+  // with the closed form, and the exact predicate settles the rest.
+  static const std::array<fcl::GJKSolverType, 2> kSolvers{fcl::GST_LIBCCD, fcl::GST_INDEP};
   const auto narrow = [&](std::size_t i, Separation s) {
     const airspace::PlanarPrism& prism = impl_->pieces[i].prism;
-    double d = std::numeric_limits<double>::quiet_NaN();
-    try {
-      fcl::DistanceResultd result;
-      fcl::distance(&q.body, impl_->objects[i].get(), request, result);
-      d = result.min_distance;
-    } catch (const std::exception&) {
-      s.fcl_failed = true;  // FCL's GJK/EPA can throw near contact: the exact predicate decides
-    }
+    // FCL decides when its distance agrees with the closed form (Separation) to kExactBand_m and
+    // both are clear of contact by more than the band, or when it reports contact and the
+    // margins put the volume deep inside; anything else — contact, a near miss, a disagreement,
+    // a failure — goes to the exact predicate. The clearance reported is the closed form.
     const double deciding_m = std::max(s.margin_h_m, s.margin_v_m);
-    if (!s.fcl_failed && d > kExactBand_m && deciding_m > 0) {
-      s.meets = false;  // FCL and the direct margins agree: clear
-      s.clearance_m = d;
-    } else if (!s.fcl_failed && d <= 0 && deciding_m < -kExactBand_m) {
-      s.meets = true;  // FCL reports contact and the margins put the volume deep inside
-      s.clearance_m = 0;
-    } else {
-      s.exact = true;
-      s.meets = airspace::cylinderMeetsPrism(p, volume.hpl_m, volume.vpl_m, prism);
-      s.clearance_m = s.meets ? 0.0 : std::hypot(std::max(s.margin_h_m, 0.0), std::max(s.margin_v_m, 0.0));
+    for (const fcl::GJKSolverType solver : kSolvers) {
+      fcl::DistanceRequestd request;
+      request.gjk_solver_type = solver;
+      double d = 0.0;
+      try {
+        fcl::DistanceResultd result;
+        fcl::distance(&q.body, impl_->objects[i].get(), request, result);
+        d = result.min_distance;
+      } catch (const std::exception&) {
+        s.fcl_failed = true;  // FCL's GJK/EPA can throw near contact
+        continue;
+      }
+      s.fcl_distance_m = d;
+      if (d > kExactBand_m && deciding_m > kExactBand_m && std::abs(d - s.clearance_m) <= kExactBand_m) {
+        s.meets = false;
+        return s;
+      }
+      if (d <= 0 && deciding_m < -kExactBand_m) {
+        s.meets = true;
+        s.clearance_m = 0;
+        return s;
+      }
+      if (std::abs(deciding_m) <= kExactBand_m) break;  // near contact: no solver can settle it
     }
+    s.exact = true;
+    s.meets = airspace::cylinderMeetsPrism(p, volume.hpl_m, volume.vpl_m, prism);
+    s.clearance_m = s.meets ? 0.0 : std::hypot(std::max(s.margin_h_m, 0.0), std::max(s.margin_v_m, 0.0));
     return s;
   };
   std::vector<std::pair<std::size_t, Separation>> group;

@@ -17,6 +17,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -26,16 +27,18 @@ namespace skylane::geofence {
 enum class PieceOwner { kZone, kObstacle };
 
 /// \brief Heights FCL works within [m, ellipsoidal]: an unlimited floor is cut at the bottom of
-/// this band and an unlimited ceiling at its top (FCL needs finite shapes). The band holds
-/// every surface on Earth (the Dead Sea shore is at about −400 m ellipsoidal) and every flight
-/// a U-space serves, so the cut changes no answer for a volume inside it; a volume reaching
-/// out of it is refused.
+/// this band (or 1 km below a ceiling that lies under it) and an unlimited ceiling at its top
+/// (or 1 km above a floor over it) — FCL needs finite shapes; finite limits stay as they are.
+/// The band holds every surface on Earth (the Dead Sea shore is at about −400 m ellipsoidal)
+/// and every flight a U-space serves, so the cut changes no answer for a volume inside it; a
+/// volume reaching out of it is refused.
 inline constexpr double kSceneFloor_h_ell_m = -2000.0;
 inline constexpr double kSceneCeiling_h_ell_m = 20000.0;
 
-/// \brief FCL's GJK distance is trusted above this [m]; at or below it (contact, penetration or
-/// a near miss) the exact predicate decides. GJK stops at a relative 1e-6 of the shapes' size
-/// (kilometres here): millimetres, so a centimetre leaves a wide berth.
+/// \brief FCL's GJK distance decides "clear" only above this [m] and only when it agrees with
+/// the closed form of Separation to within it; otherwise (contact, penetration, a near miss, a
+/// disagreement) the exact predicate decides. FCL's GJK stops at 1e-6 m when it converges; a
+/// centimetre leaves a wide berth (the volume's FCL cylinder is at least 1 mm in each size).
 inline constexpr double kExactBand_m = 0.01;
 
 /// \brief One convex piece of a zone or an obstacle: a convex counter-clockwise ring, or a
@@ -57,10 +60,12 @@ struct ScenePiece {
 struct Separation {
   double margin_h_m = 0.0;
   double margin_v_m = 0.0;
-  double clearance_m = 0.0;  ///< 3-D distance, 0 when meeting (FCL's GJK distance when trusted)
+  double clearance_m = 0.0;  ///< 3-D distance (the closed form above), 0 when meeting
   bool meets = false;        ///< the volume meets the piece (closed sets)
-  bool exact = false;        ///< decided by the exact predicate (near contact, or FCL failed)
+  bool exact = false;        ///< decided by the exact predicate (near contact, disagreement, FCL failed)
   bool fcl_failed = false;   ///< FCL threw; the exact predicate stood in
+  /// FCL's GJK distance from the last solver the narrow phase ran (≤ 0 in contact), else NaN.
+  double fcl_distance_m = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// \brief The margins of the volume from the piece, computed directly in the piece's frame
@@ -96,8 +101,8 @@ class Scene {
   ///
   /// Broad phase: the volume's cylinder grown by the horizon against the AABB tree. Then, per
   /// owner, the direct margins (separationMargins) rank its pieces; the narrow phase — FCL's
-  /// GJK distance, with the exact predicate at or below kExactBand_m, when FCL and the margins
-  /// disagree, or when FCL throws — runs on every piece the margins put within kExactBand_m of
+  /// GJK distance, with the exact predicate at or below kExactBand_m, when FCL and the closed
+  /// form disagree, or when FCL throws — runs on every piece the margins put within kExactBand_m of
   /// meeting (until one meets), else on the nearest piece. Pieces the margins put farther than
   /// the band cannot meet the volume (the margins' rounding is far below it) and are not
   /// nearer than the one evaluated. Thread-safe (const, no shared scratch).

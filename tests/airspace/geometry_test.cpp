@@ -2,11 +2,14 @@
 
 #include "maps/geodesy.hpp"
 #include "maps/plane_frame.hpp"
+#include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -336,6 +339,120 @@ TEST(ZoneGeometry, SegmentMeetsPrismClipsByHeightFirst) {
   EXPECT_FALSE(segmentMeetsPrism({-10, 0, 150}, {10, 0, 101}, disk));
   EXPECT_TRUE(segmentMeetsPrism({-10, 5, 100}, {10, 5, 100}, disk));  // tangent at the ceiling
   EXPECT_THROW((void)segmentMeetsPrism({NAN, 0, 0}, {0, 0, 0}, disk), std::invalid_argument);
+}
+
+
+// --- cylinder meets prism ----------------------------------------------------------------------------
+
+/// A named case of cylinderMeetsPrism: a vertical cylinder (centre, radius, half-height)
+/// against a prism, with the expected answer. Coordinates are small integers, so a case moved
+/// by a dyadic offset keeps its exact distances and touching stays touching; a one-ulp nudge
+/// of the centre is applied after the move (an ulp of 4 is lost when 1024 is added).
+struct CylinderCase {
+  const char* name;
+  PlanarPrism prism;
+  Eigen::Vector3d centre;
+  double radius_m;
+  double half_height_m;
+  bool meets;
+  bool nudge_east = false;  ///< move the centre one ulp east after the translation
+};
+
+PlanarPrism squarePrism(double floor_m, double ceiling_m) {
+  PlanarPrism p;
+  p.ring = {{0, 0}, {4, 0}, {4, 4}, {0, 4}};
+  p.floor_h_ell_m = floor_m;
+  p.ceiling_h_ell_m = ceiling_m;
+  return p;
+}
+
+PlanarPrism diskPrism(const Eigen::Vector2d& centre, double radius_m, double floor_m, double ceiling_m) {
+  PlanarPrism p;
+  p.centre = centre;
+  p.radius_m = radius_m;
+  p.floor_h_ell_m = floor_m;
+  p.ceiling_h_ell_m = ceiling_m;
+  return p;
+}
+
+/// The prism moved by `t` (heights too; ±∞ stays).
+PlanarPrism translated(PlanarPrism p, const Eigen::Vector3d& t) {
+  for (Eigen::Vector2d& v : p.ring) v += t.head<2>();
+  p.centre += t.head<2>();
+  p.floor_h_ell_m += t.z();
+  p.ceiling_h_ell_m += t.z();
+  return p;
+}
+
+TEST(CylinderMeetsPrism, TableOfTouchingAndNearMissesUnderDyadicTranslations) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  // One ulp below a value: the smallest possible miss.
+  const auto below = [](double v) { return std::nextafter(v, 0.0); };
+  const PlanarPrism box = squarePrism(10, 20);  // [0, 4]² × [10, 20]
+  const PlanarPrism disk = diskPrism({0, 0}, 3, 10, 20);
+  const CylinderCase cases[] = {
+      {"disjoint horizontally (6 m from the wall, radius 5)", box, {10, 2, 15}, 5, 1, false},
+      {"disjoint vertically (bottom 25 over a 20 m ceiling)", box, {2, 2, 30}, 5, 5, false},
+      {"disjoint vertically (top 9 under a 10 m floor)", box, {2, 2, 4}, 5, 5, false},
+      {"touching the east wall", box, {9, 2, 15}, 5, 1, true},
+      {"one ulp short of the east wall", box, {9, 2, 15}, below(5.0), 1, false},
+      {"touching the west wall from outside", box, {-3, 1, 15}, 3, 1, true},
+      {"touching the floor from below", box, {2, 2, 5}, 1, 5, true},
+      {"one ulp short of the floor", box, {2, 2, 5}, 1, below(5.0), false},
+      {"touching the ceiling from above", box, {2, 2, 25}, 1, 5, true},
+      {"one ulp short of the ceiling", box, {2, 2, 25}, 1, below(5.0), false},
+      {"touching the wall and the ceiling at once (edge contact)", box, {9, 2, 25}, 5, 5, true},
+      {"touching the vertex (4, 4) diagonally: (3, 4) away, radius 5", box, {7, 8, 15}, 5, 1, true},
+      {"one ulp short of the vertex", box, {7, 8, 15}, below(5.0), 1, false},
+      {"centre inside, zero size", box, {1, 3, 15}, 0, 0, true},
+      {"centre on the wall, zero size", box, {4, 2, 15}, 0, 0, true},
+      {"centre on the vertex, zero size", box, {4, 4, 20}, 0, 0, true},
+      {"zero-size point one ulp east of the wall", box, {4, 2, 15}, 0, 0, false, true},
+      {"radius 1 one ulp east of touching the wall", box, {5, 2, 15}, 1, 0, false, true},
+      {"volume swallowing the prism", box, {2, 2, 15}, 100, 100, true},
+      {"disk volume touching the disk prism: 10 = 3 + 7", disk, {6, 8, 15}, 7, 1, true},
+      {"disk volume one ulp short of the disk prism", disk, {6, 8, 15}, below(7.0), 1, false},
+      {"disk volume centre inside the disk prism", disk, {1, 1, 15}, 0, 0, true},
+      {"disk volume touching the disk prism's floor", disk, {0, 0, 8}, 1, 2, true},
+      {"unlimited floor: far below still meets", squarePrism(-kInf, 20), {2, 2, -1e6}, 1, 0, true},
+      {"unlimited floor: above the ceiling misses", squarePrism(-kInf, 20), {2, 2, 22}, 1, 1, false},
+      {"unlimited ceiling: far above still meets", squarePrism(10, kInf), {2, 2, 1e6}, 1, 0, true},
+      {"unlimited ceiling: below the floor misses", squarePrism(10, kInf), {2, 2, 8}, 1, 1, false},
+      {"unlimited both ways, touching the wall", squarePrism(-kInf, kInf), {9, 2, 0}, 5, 0, true},
+      {"unlimited both ways, one ulp short", squarePrism(-kInf, kInf), {9, 2, 0}, below(5.0), 0, false},
+      {"no heights at all (ceiling −∞)", squarePrism(-kInf, -kInf), {2, 2, 0}, 5, 5, false},
+  };
+  // Offsets exact in binary: every moved coordinate is still a double with no rounding.
+  const Eigen::Vector3d offsets[] = {{0, 0, 0}, {1024, -4096, 0}, {0.25, -0.75, 512}, {-3 * 1024.0, 2048.25, -1024},
+                                     {1048576.5, -1048576.25, 8192}};
+  for (const Eigen::Vector3d& t : offsets) {
+    std::ostringstream where;
+    where << "offset (" << t.x() << ", " << t.y() << ", " << t.z() << ")";
+    SCOPED_TRACE(where.str());
+    for (const CylinderCase& c : cases) {
+      SCOPED_TRACE(c.name);
+      Eigen::Vector3d centre = c.centre + t;
+      if (c.nudge_east) centre.x() = std::nextafter(centre.x(), INFINITY);
+      EXPECT_EQ(cylinderMeetsPrism(centre, c.radius_m, c.half_height_m, translated(c.prism, t)), c.meets);
+    }
+  }
+}
+
+TEST(CylinderMeetsPrism, InvalidSizesAndCentresThrowWithTheValues) {
+  const PlanarPrism box = squarePrism(10, 20);
+  const std::string negative_radius = test::messageOf<std::invalid_argument>(
+      [&] { (void)cylinderMeetsPrism({2, 2, 15}, -1.5, 2.0, box); });
+  EXPECT_NE(negative_radius.find("radius and half-height must be finite and ≥ 0, got -1.5 m, 2 m"), std::string::npos)
+      << negative_radius;
+  const std::string negative_height = test::messageOf<std::invalid_argument>(
+      [&] { (void)cylinderMeetsPrism({2, 2, 15}, 1.0, -3.0, box); });
+  EXPECT_NE(negative_height.find("got 1 m, -3 m"), std::string::npos) << negative_height;
+  const std::string infinite_radius = test::messageOf<std::invalid_argument>(
+      [&] { (void)cylinderMeetsPrism({2, 2, 15}, INFINITY, 1.0, box); });
+  EXPECT_NE(infinite_radius.find("got inf m"), std::string::npos) << infinite_radius;
+  const std::string nan_centre = test::messageOf<std::invalid_argument>(
+      [&] { (void)cylinderMeetsPrism({NAN, 2, 15}, 1.0, 1.0, box); });
+  EXPECT_NE(nan_centre.find("non-finite centre"), std::string::npos) << nan_centre;
 }
 
 }  // namespace
