@@ -96,6 +96,15 @@ LevelLimits alertLimits(const Vehicle& vehicle, const BoxLevels& levels) {
   return out;
 }
 
+void requireValid(const ProtectionVolume& volume) {
+  if (!volume.p_map.allFinite()) throw std::invalid_argument("protection volume position is not finite");
+  if (!(std::isfinite(volume.hpl_m) && volume.hpl_m >= 0 && std::isfinite(volume.vpl_m) && volume.vpl_m >= 0)) {
+    std::ostringstream s;
+    s << "protection levels must be finite and ≥ 0, got HPL " << volume.hpl_m << " m, VPL " << volume.vpl_m << " m";
+    throw std::invalid_argument(s.str());
+  }
+}
+
 const char* verdictName(Verdict v) {
   switch (v) {
     case Verdict::kInside: return "inside";
@@ -149,13 +158,8 @@ std::array<Eigen::Vector3d, 8> Corridor::segmentBoxCorners(std::size_t segment) 
 }
 
 Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_m) const {
+  requireValid(volume);
   const Eigen::Vector3d& c = volume.p_map;
-  if (!c.allFinite()) throw std::invalid_argument("protection volume position is not finite");
-  if (!(std::isfinite(volume.hpl_m) && volume.hpl_m >= 0 && std::isfinite(volume.vpl_m) && volume.vpl_m >= 0)) {
-    std::ostringstream s;
-    s << "protection levels must be finite and ≥ 0, got HPL " << volume.hpl_m << " m, VPL " << volume.vpl_m << " m";
-    throw std::invalid_argument(s.str());
-  }
   const double hpl = volume.hpl_m, vpl = volume.vpl_m, hal = limits_.hal_m, val = limits_.val_m;
   // The operating limits bound every piece.
   const double operating_margin_m =

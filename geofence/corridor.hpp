@@ -70,6 +70,10 @@ struct ProtectionVolume {
   double vpl_m = 0.0;
 };
 
+/// \brief Checks a volume at a public entry point.
+/// \throws std::invalid_argument for a non-finite position or a negative/non-finite PL.
+void requireValid(const ProtectionVolume& volume);
+
 /// \brief Three-valued verdict: indeterminate when the deciding margin is within the
 /// tolerance of zero (touching counts as neither inside nor outside).
 enum class Verdict { kInside, kOutside, kIndeterminate };

@@ -210,13 +210,8 @@ const std::vector<ScenePiece>& Scene::pieces() const { return impl_->pieces; }
 
 std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizon_m,
                                    const std::function<bool(PieceOwner, std::size_t)>& accept) const {
+  requireValid(volume);
   const Eigen::Vector3d& p = volume.p_map;
-  if (!p.allFinite()) throw std::invalid_argument("protection volume position is not finite");
-  if (!(std::isfinite(volume.hpl_m) && volume.hpl_m >= 0 && std::isfinite(volume.vpl_m) && volume.vpl_m >= 0)) {
-    std::ostringstream s;
-    s << "protection levels must be finite and ≥ 0, got HPL " << volume.hpl_m << " m, VPL " << volume.vpl_m << " m";
-    throw std::invalid_argument(s.str());
-  }
   if (!(std::isfinite(horizon_m) && horizon_m >= 0)) {
     throw std::invalid_argument("clearance horizon must be a finite number of metres ≥ 0, got " + std::to_string(horizon_m));
   }

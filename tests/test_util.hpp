@@ -12,6 +12,7 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace skylane::test {
 
@@ -34,6 +35,18 @@ inline std::string scratchPath(const std::string& name) {
   };
   static const Dir dir;
   return (dir.path / name).string();
+}
+
+/// Even–odd crossing test of a point against a ring, in doubles: an independent check for
+/// points not on the boundary.
+inline bool insideByCrossings(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& ring) {
+  bool in = false;
+  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
+    const Eigen::Vector2d& a = ring[i];
+    const Eigen::Vector2d& b = ring[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) in = !in;
+  }
+  return in;
 }
 
 /// Whole file as text.

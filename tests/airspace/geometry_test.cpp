@@ -44,17 +44,6 @@ double distanceToBoundary(const Eigen::Vector2d& p, const PlanarRing& ring) {
   return d;
 }
 
-/// Even–odd point-in-polygon in doubles, for points well away from the boundary.
-bool insideByCrossings(const Eigen::Vector2d& p, const PlanarRing& ring) {
-  bool in = false;
-  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
-    const Eigen::Vector2d& a = ring[i];
-    const Eigen::Vector2d& b = ring[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) in = !in;
-  }
-  return in;
-}
-
 bool isConvexCcw(const PlanarRing& ring) {
   for (std::size_t i = 0; i < ring.size(); ++i) {
     const Eigen::Vector2d& a = ring[i];
@@ -174,7 +163,7 @@ TEST(ZoneGeometry, BufferContainsEveryPointWithinTheDistanceAndNothingBeyondTheE
       const Eigen::Vector2d on_edge = ring[i] + (ring[(i + 1) % ring.size()] - ring[i]) * u(rng);
       const double a = 2 * kPi * u(rng), r = 0.99 * d * u(rng);
       const Eigen::Vector2d p = on_edge + r * Eigen::Vector2d(std::cos(a), std::sin(a));
-      EXPECT_TRUE(insideByCrossings(p, buffered)) << "trial " << trial << " point " << k;
+      EXPECT_TRUE(test::insideByCrossings(p, buffered)) << "trial " << trial << " point " << k;
     }
   }
 }
@@ -236,7 +225,7 @@ TEST(ZoneGeometry, ConvexPiecesLieInsideAndCoverTheRing) {
     // Random points of the ring lie in some piece.
     for (int k = 0; k < 200; ++k) {
       const Eigen::Vector2d p(-500 + 1000 * u(rng), -500 + 1000 * u(rng));
-      if (!insideByCrossings(p, ring)) continue;
+      if (!test::insideByCrossings(p, ring)) continue;
       bool covered = false;
       for (const PlanarRing& piece : pieces) covered = covered || segmentMeetsRing(p, p, piece);
       EXPECT_TRUE(covered) << "trial " << trial << " point (" << p.x() << ", " << p.y() << ")";

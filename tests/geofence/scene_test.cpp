@@ -66,23 +66,12 @@ double segmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const
   return std::abs(ab.x() * (p - a).y() - ab.y() * (p - a).x()) / ab.norm();
 }
 
-/// Even–odd crossing test (for points not on the boundary; on it the distance is 0 anyway).
-bool insideByCrossings(const Eigen::Vector2d& p, const PlanarRing& ring) {
-  bool in = false;
-  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
-    const Eigen::Vector2d& a = ring[i];
-    const Eigen::Vector2d& b = ring[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) in = !in;
-  }
-  return in;
-}
-
 /// Signed horizontal distance from p to the piece's shape (negative inside), edge by edge.
 double signedDistanceByEdges(const PlanarPrism& q, const Eigen::Vector2d& p) {
   if (q.ring.empty()) return (p - q.centre).norm() - q.radius_m;
   double d = kInf;
   for (std::size_t i = 0; i < q.ring.size(); ++i) d = std::min(d, segmentDistance(p, q.ring[i], q.ring[(i + 1) % q.ring.size()]));
-  return insideByCrossings(p, q.ring) ? -d : d;
+  return test::insideByCrossings(p, q.ring) ? -d : d;
 }
 
 /// Distance from p to the ring's boundary sampled every `step_m` along the edges: an upper
