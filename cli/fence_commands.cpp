@@ -1,6 +1,7 @@
 #include "cli/fence_commands.hpp"
 
 #include "airspace/validation.hpp"
+#include "cli/json_numbers.hpp"
 #include "cli/skymask_commands.hpp"
 #include "geofence/corridor_file.hpp"
 #include "geofence/fix.hpp"
@@ -33,8 +34,6 @@ struct FenceCheckOptions {
   std::string fix;
   std::string fixes;
 };
-
-json metres(double v) { return std::isfinite(v) ? json(std::round(v * 1e3) / 1e3) : json(nullptr); }
 
 json checkFix(const geofence::Fix& f, const geofence::Fence& fence, const maps::PlaneFrame& frame) {
   const Eigen::Vector2d p = frame.toPlane(f.lat_rad, f.lon_rad);
@@ -141,15 +140,15 @@ json fenceVerdictJson(const geofence::FenceVerdict& v, const geofence::Fence& fe
     j["level"] = geofence::levelName(c.level);
     j["verdict"] = geofence::verdictName(c.verdict);
     j["subject"] = c.subject;
-    j["margin_h_m"] = metres(c.margin_h_m);
-    j["margin_v_m"] = metres(c.margin_v_m);
+    j["margin_h_m"] = metresOrNull(c.margin_h_m);
+    j["margin_v_m"] = metresOrNull(c.margin_v_m);
     if (c.level == geofence::Level::kCorridor || c.level == geofence::Level::kAirspace) {
       const geofence::AlertLimits& l = (c.level == geofence::Level::kCorridor ? fence.level1() : fence.level2()).limits();
-      j["hal_m"] = metres(l.hal_m);
-      j["val_m"] = metres(l.val_m);
+      j["hal_m"] = metresOrNull(l.hal_m);
+      j["val_m"] = metresOrNull(l.val_m);
       j["across_joint"] = c.across_joint;
     } else {
-      j["clearance_m"] = metres(*c.clearance_m);
+      j["clearance_m"] = metresOrNull(*c.clearance_m);
       j["exact"] = c.exact;
       if (c.level == geofence::Level::kZone) {
         const airspace::Zone& z = fence.zones()[c.index];

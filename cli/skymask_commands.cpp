@@ -1,5 +1,6 @@
 #include "cli/skymask_commands.hpp"
 
+#include "cli/json_numbers.hpp"
 #include "cli/svg_plot.hpp"
 #include "maps/buildings.hpp"
 #include "maps/geoid.hpp"
@@ -31,8 +32,6 @@ struct SkyMaskCliOptions {
   std::optional<double> default_height_m;
   std::string svg;
 };
-
-double r3(double v) { return std::round(v * 1e3) / 1e3; }
 
 void runSkyMask(const SkyMaskCliOptions& o) {
   if (!(std::abs(o.lat_deg) <= 90.0)) throw ParseError("--lat", 0, "--lat", std::to_string(o.lat_deg), "a latitude in [-90, 90]");
@@ -72,8 +71,8 @@ void runSkyMask(const SkyMaskCliOptions& o) {
   const maps::SkyMask mask = skyMaskAt(place, o.buildings, ground, !o.terrain.empty() || o.ground_amsl_m.has_value(), opt, bopt, &count);
 
   json out;
-  out["position"] = {{"lat_deg", o.lat_deg}, {"lon_deg", o.lon_deg}, {"h_ell_m", r3(h_ell)},
-                     {"alt_amsl_m", r3(geoid.amslFromEllipsoidal_m(lat, lon, h_ell))}};
+  out["position"] = {{"lat_deg", o.lat_deg}, {"lon_deg", o.lon_deg}, {"h_ell_m", roundToMm(h_ell)},
+                     {"alt_amsl_m", roundToMm(geoid.amslFromEllipsoidal_m(lat, lon, h_ell))}};
   out["buildings"] = {{"file", o.buildings}, {"count", count}};
   out["terrain"] = ground.describe();
   out["terrain_horizon"] = !o.terrain.empty() || o.ground_amsl_m.has_value();
@@ -83,14 +82,14 @@ void runSkyMask(const SkyMaskCliOptions& o) {
   std::vector<double> blocked_deg;
   double highest = -90.0;
   for (int k = 0; k < mask.bins(); ++k) {
-    az.push_back(r3(k * o.bin_deg));
+    az.push_back(roundToMm(k * o.bin_deg));
     blocked_deg.push_back(maps::rad2deg(mask.binBlocked_rad(k)));
-    blocked.push_back(r3(blocked_deg.back()));
+    blocked.push_back(roundToMm(blocked_deg.back()));
     highest = std::max(highest, blocked_deg.back());
   }
   out["azimuth_from_deg"] = az;
   out["blocked_elevation_deg"] = blocked;
-  out["max_blocked_elevation_deg"] = r3(highest);
+  out["max_blocked_elevation_deg"] = roundToMm(highest);
   std::cout << out.dump() << "\n";
   if (!o.svg.empty()) {
     char title[160];

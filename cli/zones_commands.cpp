@@ -5,6 +5,7 @@
 #include "airspace/validation.hpp"
 #include "airspace/vertical.hpp"
 #include "airspace/zone_geometry.hpp"
+#include "cli/json_numbers.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/geoid.hpp"
 #include "maps/parse_error.hpp"
@@ -57,14 +58,12 @@ maps::Terrain loadTerrain(const std::string& path) {
   return path.empty() ? maps::Terrain::flat(0.0) : maps::Terrain::fromRaster(path);
 }
 
-double r3(double v) { return std::round(v * 1e3) / 1e3; }
-json height(double v) { return std::isfinite(v) ? json(r3(v)) : json(nullptr); }
 
 json limitJson(const airspace::VerticalLimit& l) {
   json j;
   j["as_given"] = l.as_given;
   j["reference"] = std::string(airspace::referenceName(l.reference));
-  j["value_m"] = l.unlimited ? json(nullptr) : json(r3(l.value_m));
+  j["value_m"] = l.unlimited ? json(nullptr) : json(roundToMm(l.value_m));
   j["unlimited"] = l.unlimited;
   return j;
 }
@@ -148,8 +147,8 @@ void runAt(const AtOptions& o) {
     h_ell = *ground + *o.height_agl_m;
   }
   json out;
-  out["position"] = {{"lat_deg", o.lat_deg}, {"lon_deg", o.lon_deg}, {"h_ell_m", r3(h_ell)},
-                     {"alt_amsl_m", r3(geoid.amslFromEllipsoidal_m(p.lat_rad, p.lon_rad, h_ell))}};
+  out["position"] = {{"lat_deg", o.lat_deg}, {"lon_deg", o.lon_deg}, {"h_ell_m", roundToMm(h_ell)},
+                     {"alt_amsl_m", roundToMm(geoid.amslFromEllipsoidal_m(p.lat_rad, p.lon_rad, h_ell))}};
   out["time"] = maps::formatRfc3339(*t);
   out["terrain"] = terrain.describe();
   json applies = json::array();
@@ -176,8 +175,8 @@ void runAt(const AtOptions& o) {
         j["horizontal"] = side == airspace::Side::kInside ? "inside" : "on the boundary";
         j["floor"] = limitJson(v.lower);
         j["ceiling"] = limitJson(v.upper);
-        j["floor_h_ell_m"] = floor ? height(*floor) : json("unknown terrain");
-        j["ceiling_h_ell_m"] = ceiling ? height(*ceiling) : json("unknown terrain");
+        j["floor_h_ell_m"] = floor ? metresOrNull(*floor) : json("unknown terrain");
+        j["ceiling_h_ell_m"] = ceiling ? metresOrNull(*ceiling) : json("unknown terrain");
         const bool unknown = !floor || !ceiling;
         const bool inside_v = !unknown && h_ell >= *floor && h_ell <= *ceiling;
         std::string why = std::string(j["horizontal"].get<std::string>()) + " the outline";
@@ -206,8 +205,8 @@ json resolvedRange(const airspace::VerticalLimit& l, bool ceiling, const airspac
                    const airspace::VerticalModel& model) {
   const auto r = airspace::limitRange(l, ceiling, o, model);
   if (!r) return json("unknown terrain");
-  return {{"h_ell_m", {height(r->h_ell_min_m), height(r->h_ell_max_m)}},
-          {"alt_amsl_m", {height(r->alt_amsl_min_m), height(r->alt_amsl_max_m)}}};
+  return {{"h_ell_m", {metresOrNull(r->h_ell_min_m), metresOrNull(r->h_ell_max_m)}},
+          {"alt_amsl_m", {metresOrNull(r->alt_amsl_min_m), metresOrNull(r->alt_amsl_max_m)}}};
 }
 
 json positionJson(const airspace::LatLon& p) {

@@ -32,6 +32,22 @@ Check boxCheck(Level level, const Corridor& box, const ProtectionVolume& v, doub
   return out;
 }
 
+/// Appends the convex pieces of a ring given in latitude/longitude [rad] (either winding), each
+/// with the template's heights, to `out`.
+template <class LatLonRange, class ToPlane>
+void appendRingPieces(const LatLonRange& ring_ll, ToPlane toPlane, const airspace::PlanarPrism& heights, PieceOwner owner,
+                      std::size_t owner_index, std::vector<ScenePiece>& out) {
+  airspace::PlanarRing ring;
+  ring.reserve(ring_ll.size());
+  for (const auto& p : ring_ll) ring.push_back(toPlane(p));
+  if (airspace::twiceSignedArea_m2(ring) < 0) std::reverse(ring.begin(), ring.end());
+  for (airspace::PlanarRing& piece : airspace::convexPieces(ring)) {
+    airspace::PlanarPrism q = heights;
+    q.ring = std::move(piece);
+    out.push_back({std::move(q), owner, owner_index});
+  }
+}
+
 }  // namespace
 
 const char* levelName(Level l) {
@@ -89,15 +105,8 @@ std::vector<ScenePiece> zonePieces(const std::vector<airspace::Zone>& zones, con
         pieces.push_back({prism, PieceOwner::kZone, zi});
         continue;
       }
-      airspace::PlanarRing ring;
-      ring.reserve(v.outline.ring.size());
-      for (const airspace::LatLon& p : v.outline.ring) ring.push_back(frame.toPlane(p.lat_rad, p.lon_rad));
-      if (airspace::twiceSignedArea_m2(ring) < 0) std::reverse(ring.begin(), ring.end());
-      for (airspace::PlanarRing& piece : airspace::convexPieces(ring)) {
-        airspace::PlanarPrism q = prism;
-        q.ring = std::move(piece);
-        pieces.push_back({std::move(q), PieceOwner::kZone, zi});
-      }
+      appendRingPieces(v.outline.ring, [&](const airspace::LatLon& p) { return frame.toPlane(p.lat_rad, p.lon_rad); },
+                       prism, PieceOwner::kZone, zi, pieces);
     }
   }
   return pieces;
@@ -107,17 +116,11 @@ std::vector<ScenePiece> obstaclePieces(const std::vector<maps::Building>& buildi
   std::vector<ScenePiece> pieces;
   for (std::size_t bi = 0; bi < buildings.size(); ++bi) {
     const maps::Building& b = buildings[bi];
-    airspace::PlanarRing ring;
-    ring.reserve(b.ring_lat_lon_rad.size());
-    for (const auto& [lat, lon] : b.ring_lat_lon_rad) ring.push_back(frame.toPlane(lat, lon));
-    if (airspace::twiceSignedArea_m2(ring) < 0) std::reverse(ring.begin(), ring.end());
-    for (airspace::PlanarRing& piece : airspace::convexPieces(ring)) {
-      airspace::PlanarPrism q;
-      q.ring = std::move(piece);
-      q.floor_h_ell_m = b.base_h_ell_m;
-      q.ceiling_h_ell_m = b.top_h_ell_m;
-      pieces.push_back({std::move(q), PieceOwner::kObstacle, bi});
-    }
+    airspace::PlanarPrism heights;
+    heights.floor_h_ell_m = b.base_h_ell_m;
+    heights.ceiling_h_ell_m = b.top_h_ell_m;
+    appendRingPieces(b.ring_lat_lon_rad, [&](const std::pair<double, double>& p) { return frame.toPlane(p.first, p.second); },
+                     heights, PieceOwner::kObstacle, bi, pieces);
   }
   return pieces;
 }
@@ -154,11 +157,8 @@ FenceVerdict Fence::check(const TimedVolume& v) const {
   out.checks.push_back(boxCheck(Level::kAirspace, level2_, v.volume, options_.tolerance_m));
 
   // Zones count when the policy says so and they are active in the interval; obstacles always.
-  const maps::GpsTime t1 = v.t1 - v.t0 > 0 ? v.t1 : v.t0;
   const auto accept = [&](PieceOwner owner, std::size_t i) {
-    if (owner == PieceOwner::kObstacle) return true;
-    return zone_counts_[i] && (t1 - v.t0 > 0 ? airspace::isActiveDuring(zones_[i], v.t0, t1)
-                                             : airspace::isActive(zones_[i], v.t0));
+    return owner == PieceOwner::kObstacle || (zone_counts_[i] && airspace::isActiveDuring(zones_[i], v.t0, v.t1));
   };
   const std::vector<SceneHit> hits = scene_.query(v.volume, options_.horizon_m, accept);
 

@@ -39,28 +39,12 @@ import re
 import sys
 from datetime import datetime
 
-CLIGHT = 299792458.0
-MU_GPS = 3.9860050E14
-OMGE = 7.2921151467E-5
-GPS_EPOCH = datetime(1980, 1, 6)
+from rtklib_eph import CLIGHT, GPS_EPOCH, cal2gps, eph2clk, eph2pos, fnum
+
 
 RE_RTKPOS = re.compile(r'^3 rtkpos  : time=(\S+ \S+) n=(\d+)')
 RE_OBS = re.compile(r'^ \(\s*\d+\) (\S+ \S+) G(\d\d) rcv\d\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)')
 RE_RS = re.compile(r'^4 (\S+ \S+) sat=\s*(\d+) rs=\s*(\S+)\s+(\S+)\s+(\S+) dts=\s*(\S+) var=\s*(\S+) svh=(\S+)')
-
-
-def cal2gps(s):
-    """'YYYY/MM/DD hh:mm:ss.ffff' -> (week, tow) using exact decimal parsing."""
-    d, t = s.split()
-    y, mo, dd = (int(v) for v in d.split('/'))
-    hh, mm, ss = t.split(':')
-    sec_int, _, frac = ss.partition('.')
-    base = datetime(y, mo, dd, int(hh), int(mm), int(sec_int))
-    delta = base - GPS_EPOCH
-    secs = delta.days * 86400 + delta.seconds
-    week = secs // 604800
-    tow = secs - week * 604800
-    return week, tow + (float('0.' + frac) if frac else 0.0)
 
 
 def parse_trace(path):
@@ -93,11 +77,6 @@ def parse_trace(path):
                     'x_s': m.group(3), 'y_s': m.group(4), 'z_s': m.group(5), 'dts_s': m.group(6),
                 }
     return epochs
-
-
-def fnum(s):
-    s = s.strip().replace('D', 'E').replace('d', 'e')
-    return float(s) if s else 0.0
 
 
 def parse_nav(path):
@@ -162,45 +141,6 @@ def seleph(ephs, prn, teph, wk0):
         if t <= tmin:
             j, tmin = q, t
     return j
-
-
-# NOTE: all times below are GPS seconds of week relative to the epoch's week
-# (wk0). Absolute GPS seconds (~8e8) must not carry fractions in a double
-# (ulp ~1.2e-7 s); eph toc/toe/ttr are integers, so (toc - wk0*604800) is exact.
-def eph2clk(t, q, wk0):
-    # verbatim RTKLIB 2.4.3 eph2clk(): t -= f0+f1*t+f2*t^2 twice (cumulative),
-    # then evaluate; the result equals af0+af1*t+af2*t^2 to <1e-17 s.
-    tt = t - (q['toc'] - wk0 * 604800)
-    for _ in range(2):
-        tt -= q['f0'] + q['f1'] * tt + q['f2'] * tt * tt
-    return q['f0'] + q['f1'] * tt + q['f2'] * tt * tt
-
-
-def eph2pos(t, q, wk0):
-    tk = t - (q['toe'] - wk0 * 604800)
-    A = q['A']; e = q['e']
-    M = q['M0'] + (math.sqrt(MU_GPS / (A * A * A)) + q['deln']) * tk
-    E, Ek, n = M, 0.0, 0
-    while abs(E - Ek) > 1e-13 and n < 30:
-        Ek = E
-        E -= (E - e * math.sin(E) - M) / (1.0 - e * math.cos(E))
-        n += 1
-    sinE, cosE = math.sin(E), math.cos(E)
-    u = math.atan2(math.sqrt(1.0 - e * e) * sinE, cosE - e) + q['omg']
-    r = A * (1.0 - e * cosE)
-    i = q['i0'] + q['idot'] * tk
-    sin2u, cos2u = math.sin(2 * u), math.cos(2 * u)
-    u += q['cus'] * sin2u + q['cuc'] * cos2u
-    r += q['crs'] * sin2u + q['crc'] * cos2u
-    i += q['cis'] * sin2u + q['cic'] * cos2u
-    x, y, cosi = r * math.cos(u), r * math.sin(u), math.cos(i)
-    O = q['OMG0'] + (q['OMGd'] - OMGE) * tk - OMGE * q['toes']
-    sinO, cosO = math.sin(O), math.cos(O)
-    rs = (x * cosO - y * cosi * sinO, x * sinO + y * cosi * cosO, y * math.sin(i))
-    tc = t - (q['toc'] - wk0 * 604800)
-    dts = q['f0'] + q['f1'] * tc + q['f2'] * tc * tc
-    dts -= 2.0 * math.sqrt(MU_GPS * A) * e * sinE / (CLIGHT * CLIGHT)
-    return rs, dts
 
 
 def main():

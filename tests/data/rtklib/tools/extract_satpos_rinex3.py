@@ -48,11 +48,8 @@ import re
 import sys
 from datetime import datetime
 
-CLIGHT = 299792458.0
-MU_GPS = 3.9860050E14
-MU_GAL = 3.986004418E14
-OMGE = 7.2921151467E-5         # RTKLIB OMGE (GPS) == OMGE_GAL
-GPS_EPOCH = datetime(1980, 1, 6)
+from rtklib_eph import CLIGHT, GPS_EPOCH, cal2gps, eph2clk, eph2pos, fnum
+
 MAXDTOE = 7200.0               # GPS: tmax = MAXDTOE + 1
 MAXDTOE_GAL_MIN = 10800.0      # 10800 or 14400 depending on the 2.4.3 patch; not binding here
 NSAT_GPS, NSAT_GLO = 32, 27    # RTKLIB sat numbering: G01=1, R01=33, E01=60
@@ -64,18 +61,6 @@ RE_RS = re.compile(r'^4 (\S+ \S+) sat=\s*(\d+) rs=\s*(\S+)\s+(\S+)\s+(\S+) dts=\
 
 def satno(sys_, prn):
     return prn if sys_ == 'G' else NSAT_GPS + NSAT_GLO + prn
-
-
-def cal2gps(s):
-    """'YYYY/MM/DD hh:mm:ss.ffff' -> (week, tow) with exact decimal parsing."""
-    d, t = s.split()
-    y, mo, dd = (int(v) for v in d.split('/'))
-    hh, mm, ss = t.split(':')
-    sec_int, _, frac = ss.partition('.')
-    delta = datetime(y, mo, dd, int(hh), int(mm), int(sec_int)) - GPS_EPOCH
-    secs = delta.days * 86400 + delta.seconds
-    week = secs // 604800
-    return week, secs - week * 604800 + (float('0.' + frac) if frac else 0.0)
 
 
 def parse_trace(path):
@@ -131,11 +116,6 @@ def parse_obs3(path):
                 vals[t] = float(f)
         out[(cur, ln[0], int(ln[1:3]))] = vals
     return out
-
-
-def fnum(s):
-    s = s.strip().replace('D', 'E').replace('d', 'e')
-    return float(s) if s else 0.0
 
 
 def gps_seconds(y, mo, d, h, mi, s):
@@ -231,43 +211,6 @@ def seleph(ephs, sys_, sat, teph_abs):
         if t <= tmin:
             j, tmin = q, t
     return j
-
-
-# All evaluation in seconds of week of the epoch (wk0): eph times are integers,
-# so (toc - wk0*604800) is exact and 1e-10 s resolution is kept.
-def eph2clk(t, q, wk0):
-    tt = t - (q['toc'] - wk0 * 604800)
-    for _ in range(2):
-        tt -= q['f0'] + q['f1'] * tt + q['f2'] * tt * tt
-    return q['f0'] + q['f1'] * tt + q['f2'] * tt * tt
-
-
-def eph2pos(t, q, wk0):
-    mu = MU_GAL if q['sys'] == 'E' else MU_GPS
-    tk = t - (q['toe'] - wk0 * 604800)
-    A, e = q['A'], q['e']
-    M = q['M0'] + (math.sqrt(mu / (A * A * A)) + q['deln']) * tk
-    E, Ek, n = M, 0.0, 0
-    while abs(E - Ek) > 1e-13 and n < 30:
-        Ek = E
-        E -= (E - e * math.sin(E) - M) / (1.0 - e * math.cos(E))
-        n += 1
-    sinE, cosE = math.sin(E), math.cos(E)
-    u = math.atan2(math.sqrt(1.0 - e * e) * sinE, cosE - e) + q['omg']
-    r = A * (1.0 - e * cosE)
-    i = q['i0'] + q['idot'] * tk
-    sin2u, cos2u = math.sin(2 * u), math.cos(2 * u)
-    u += q['cus'] * sin2u + q['cuc'] * cos2u
-    r += q['crs'] * sin2u + q['crc'] * cos2u
-    i += q['cis'] * sin2u + q['cic'] * cos2u
-    x, y, cosi = r * math.cos(u), r * math.sin(u), math.cos(i)
-    O = q['OMG0'] + (q['OMGd'] - OMGE) * tk - OMGE * q['toes']
-    sinO, cosO = math.sin(O), math.cos(O)
-    rs = (x * cosO - y * cosi * sinO, x * sinO + y * cosi * cosO, y * math.sin(i))
-    tc = t - (q['toc'] - wk0 * 604800)
-    dts = q['f0'] + q['f1'] * tc + q['f2'] * tc * tc
-    dts -= 2.0 * math.sqrt(mu * A) * e * sinE / (CLIGHT * CLIGHT)
-    return rs, dts
 
 
 def hms(tow):
