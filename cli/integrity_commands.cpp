@@ -1,5 +1,7 @@
 #include "cli/integrity_commands.hpp"
 
+#include "cli/progress.hpp"
+
 #include "cli/skymask_commands.hpp"
 #include "cli/svg_plot.hpp"
 #include "integrity/availability.hpp"
@@ -34,29 +36,6 @@ json satList(const std::vector<integrity::SatId>& sats) {
   for (const auto& s : sats) a.push_back(s.str());
   return a;
 }
-
-/// A progress bar on stderr, only when stderr is a terminal or forced.
-class Progress {
- public:
-  Progress(std::string what, bool force) : what_(std::move(what)), on_(force || isatty(STDERR_FILENO)) {}
-  void operator()(std::size_t done, std::size_t total) {
-    if (!on_ || total == 0) return;
-    const int permille = static_cast<int>(1000 * done / total);
-    if (permille == last_permille_ && done != total) return;  // redraw only when it moves
-    last_permille_ = permille;
-    const int width = 30;
-    const int filled = static_cast<int>(width * done / total);
-    std::fprintf(stderr, "\r%s [%.*s%*s] %zu/%zu", what_.c_str(), filled, "##############################",
-                 width - filled, "", done, total);
-    if (done == total) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
-  }
-
- private:
-  std::string what_;
-  bool on_;
-  int last_permille_ = -1;
-};
 
 json plJson(const integrity::RaimPl& pl, const integrity::Requirements& req, bool verbose,
             const std::vector<integrity::SatId>& sats) {

@@ -3,6 +3,7 @@
 
 #include "cli/fence_commands.hpp"
 #include "cli/integrity_commands.hpp"
+#include "cli/simulate_commands.hpp"
 #include "cli/skymask_commands.hpp"
 #include "cli/zones_commands.hpp"
 #include "integrity/gnss/parse_error.hpp"
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   skylane::cli::addZonesCommands(app);
   skylane::cli::addSkyMaskCommands(app);
   skylane::cli::addFenceCommands(app);
+  skylane::cli::addSimulateCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -218,4 +218,88 @@ std::string renderSkyPlotSvg(const std::string& title, const std::vector<double>
   return s.str();
 }
 
+std::string renderStanfordSvg(const std::string& title, const std::vector<StanfordPanel>& panels) {
+  const double side = 330, left = 70, top = 60, gap_x = 110, gap_y = 150, legend = 80;
+  const int columns = panels.size() > 1 ? 2 : 1;
+  const int rows = static_cast<int>((panels.size() + 1) / 2);
+  const double width = left + columns * (side + gap_x) + legend;
+  const double height = top + rows * (side + gap_y);
+  // A sequential palette (dark blue → yellow), indexed by log10(count) / log10(max count).
+  static const char* const kPalette[] = {"#30123b", "#4145ab", "#4675ed", "#39a2fc", "#1bcfd4",
+                                         "#24eca6", "#61fc6c", "#a4fc3b", "#d1e834", "#f3c63a", "#fe9b2d"};
+  constexpr int kColours = 11;
+  std::ostringstream s;
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  s << "<text x=\"" << width / 2 << "\" y=\"26\" text-anchor=\"middle\" font-size=\"15\">" << escape(title) << "</text>\n";
+  for (std::size_t k = 0; k < panels.size(); ++k) {
+    const StanfordPanel& p = panels[k];
+    const double ox = left + static_cast<double>(k % 2) * (side + gap_x);
+    const double oy = top + static_cast<double>(k / 2) * (side + gap_y);
+    const double scale = side / p.max_m;
+    auto X = [&](double v) { return ox + std::min(v, p.max_m) * scale; };
+    auto Y = [&](double v) { return oy + side - std::min(v, p.max_m) * scale; };
+    s << "<text x=\"" << ox + side / 2 << "\" y=\"" << oy - 10 << "\" text-anchor=\"middle\" font-size=\"13\">"
+      << escape(p.title) << "</text>\n";
+    s << "<rect x=\"" << ox << "\" y=\"" << oy << "\" width=\"" << side << "\" height=\"" << side
+      << "\" fill=\"#f4f4f4\" stroke=\"black\"/>\n";
+    std::uint64_t peak = 0;
+    for (std::uint64_t c : p.counts) peak = std::max(peak, c);
+    const double cell = side / std::max(1, p.bins);
+    for (int r = 0; r < p.bins; ++r) {
+      for (int c = 0; c < p.bins; ++c) {
+        const std::uint64_t n = p.counts[static_cast<std::size_t>(r) * static_cast<std::size_t>(p.bins) + static_cast<std::size_t>(c)];
+        if (n == 0) continue;
+        const double f = peak > 1 ? std::log10(static_cast<double>(n)) / std::log10(static_cast<double>(peak)) : 1.0;
+        const int idx = std::clamp(static_cast<int>(f * (kColours - 1) + 0.5), 0, kColours - 1);
+        s << "<rect x=\"" << fmt(ox + c * cell) << "\" y=\"" << fmt(oy + side - (r + 1) * cell) << "\" width=\""
+          << fmt(cell + 0.3) << "\" height=\"" << fmt(cell + 0.3) << "\" fill=\"" << kPalette[idx] << "\"/>\n";
+      }
+    }
+    // Regions: diagonal error = PL, alert limit on both axes.
+    const double al = p.alert_limit_m;
+    s << "<line x1=\"" << X(0) << "\" y1=\"" << Y(0) << "\" x2=\"" << X(p.max_m) << "\" y2=\"" << Y(p.max_m)
+      << "\" stroke=\"black\"/>\n";
+    s << "<line x1=\"" << X(al) << "\" y1=\"" << Y(0) << "\" x2=\"" << X(al) << "\" y2=\"" << Y(p.max_m)
+      << "\" stroke=\"#c00000\" stroke-dasharray=\"5,3\"/>\n";
+    s << "<line x1=\"" << X(0) << "\" y1=\"" << Y(al) << "\" x2=\"" << X(p.max_m) << "\" y2=\"" << Y(al)
+      << "\" stroke=\"#c00000\" stroke-dasharray=\"5,3\"/>\n";
+    auto label = [&](double ex, double pl, const char* text) {
+      s << "<text x=\"" << fmt(X(ex)) << "\" y=\"" << fmt(Y(pl)) << "\" text-anchor=\"middle\" fill=\"#303030\">"
+        << text << "</text>\n";
+    };
+    label(al * 0.3, al * 0.75, "Normal");
+    label(al * 0.75, al * 0.3, "MI");
+    label(al + (p.max_m - al) * 0.5, al * 0.5, "HMI");
+    label(al * 0.5, al + (p.max_m - al) * 0.6, "Unavailable");
+    // Axes.
+    const double step = niceStep(p.max_m, 5);
+    for (double v = 0; v <= p.max_m + 1e-9; v += step) {
+      s << "<text x=\"" << fmt(X(v)) << "\" y=\"" << oy + side + 15 << "\" text-anchor=\"middle\">" << fmt(v) << "</text>\n";
+      s << "<text x=\"" << ox - 6 << "\" y=\"" << fmt(Y(v) + 4) << "\" text-anchor=\"end\">" << fmt(v) << "</text>\n";
+    }
+    s << "<text x=\"" << ox + side / 2 << "\" y=\"" << oy + side + 32 << "\" text-anchor=\"middle\">"
+      << escape(p.error_label) << "</text>\n";
+    s << "<text transform=\"translate(" << ox - 42 << "," << oy + side / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
+      << escape(p.pl_label) << "</text>\n";
+    double fy = oy + side + 52;
+    for (const std::string& line : p.footer) {
+      s << "<text x=\"" << ox << "\" y=\"" << fy << "\" font-size=\"11\">" << escape(line) << "</text>\n";
+      fy += 15;
+    }
+  }
+  // Colour scale.
+  const double lx = width - legend + 20;
+  s << "<text x=\"" << lx << "\" y=\"" << top - 8 << "\">epochs</text>\n";
+  for (int i = 0; i < kColours; ++i) {
+    s << "<rect x=\"" << lx << "\" y=\"" << top + (kColours - 1 - i) * 18 << "\" width=\"16\" height=\"18\" fill=\""
+      << kPalette[i] << "\"/>\n";
+  }
+  s << "<text x=\"" << lx + 20 << "\" y=\"" << top + 12 << "\">max</text>\n";
+  s << "<text x=\"" << lx + 20 << "\" y=\"" << top + kColours * 18 - 4 << "\">1</text>\n";
+  s << "<text x=\"" << lx << "\" y=\"" << top + kColours * 18 + 16 << "\" font-size=\"10\">log scale</text>\n";
+  s << "</svg>\n";
+  return s.str();
+}
+
 }  // namespace skylane::cli

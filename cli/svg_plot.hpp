@@ -2,6 +2,7 @@
 /// \file
 /// \brief A small SVG time-series plotter (no dependency): stacked panels sharing the time axis.
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -43,5 +44,22 @@ struct MapCell {
 /// `bin_deg` is the bins' width, bin k covering [k·bin_deg, (k+1)·bin_deg).
 [[nodiscard]] std::string renderSkyPlotSvg(const std::string& title, const std::vector<double>& blocked_deg, double bin_deg,
                                            const std::string& footer);
+
+/// \brief One Stanford diagram: a 2-D histogram of position error (x) against protection level (y).
+struct StanfordPanel {
+  std::string title;
+  std::string error_label;  ///< e.g. "HPE [m]"
+  std::string pl_label;     ///< e.g. "HPL [m]"
+  double alert_limit_m = 0;
+  double max_m = 0;  ///< both axes 0…max_m
+  int bins = 0;
+  std::vector<std::uint64_t> counts;  ///< bins × bins, row = PL bin, column = error bin
+  std::vector<std::string> footer;    ///< region counts, one line each
+};
+
+/// \brief Stanford diagrams side by side (two per row): cells coloured by log10(count), the
+/// diagonal error = PL, the alert limit on both axes and the regions named (normal, MI, HMI,
+/// unavailable), as drawn by Stanford's WAAS lab.
+[[nodiscard]] std::string renderStanfordSvg(const std::string& title, const std::vector<StanfordPanel>& panels);
 
 }  // namespace skylane::cli

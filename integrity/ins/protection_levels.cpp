@@ -1,0 +1,173 @@
+#include "integrity/ins/protection_levels.hpp"
+
+#include "integrity/stats.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace skylane::integrity::ins {
+
+namespace {
+
+/// Position-and-clock columns of H (n × 4).
+Eigen::MatrixXd positionClockColumns(const GnssUpdateRecord& rec) {
+  Eigen::MatrixXd Hpc(rec.H.rows(), 4);
+  Hpc.leftCols<3>() = rec.H.middleCols<3>(kPos);
+  Hpc.col(3) = rec.H.col(kClock);
+  return Hpc;
+}
+
+/// Q⁻¹(p/2) for a two-sided bound; 0 when the mode's risk needs no bound.
+double twoSidedK(double p) { return p >= 1.0 ? 0.0 : normalTailInverse(p / 2.0); }
+
+}  // namespace
+
+double imuInnovationStatistic(const GnssUpdateRecord& rec) {
+  if (!rec.ok || rec.H.rows() < 4) return -1.0;
+  const Eigen::MatrixXd Hpc = positionClockColumns(rec);
+  const Eigen::LLT<Eigen::MatrixXd> S_llt(rec.S);
+  const Eigen::MatrixXd SiH = S_llt.solve(Hpc);
+  const Eigen::Matrix4d info = Hpc.transpose() * SiH;  // (G S Gᵀ)⁻¹ = H_pcᵀ S⁻¹ H_pc
+  const Eigen::Vector4d b = info.ldlt().solve(SiH.transpose() * rec.innovation);  // G ν
+  return b.dot(info * b);
+}
+
+FaultModePls faultModeProtectionLevels(const GnssUpdateRecord& rec, const FaultModeConfig& cfg) {
+  FaultModePls out;
+  const int n = static_cast<int>(rec.H.rows());
+  if (!rec.ok || n < 5) {
+    out.reason = "fewer than 5 satellites: the LSR test cannot protect the GS mode";
+    return out;
+  }
+  const Eigen::MatrixXd Hpc = positionClockColumns(rec);
+  // G = (H_pcᵀ S⁻¹ H_pc)⁻¹ H_pcᵀ S⁻¹; A = G_p − K_p (ENU rows).
+  const Eigen::LLT<Eigen::MatrixXd> S_llt(rec.S);
+  const Eigen::MatrixXd SiH = S_llt.solve(Hpc);
+  const Eigen::Matrix4d info = Hpc.transpose() * SiH;
+  const Eigen::FullPivLU<Eigen::Matrix4d> info_lu(info);
+  if (!info_lu.isInvertible()) {
+    out.reason = "degenerate geometry";
+    return out;
+  }
+  const Eigen::MatrixXd G = info_lu.solve(SiH.transpose());  // 4 × n
+  const Eigen::MatrixXd Gp = rec.R_enu_ecef * G.topRows<3>();
+  const Eigen::MatrixXd Kp = rec.R_enu_ecef * rec.K.middleRows<3>(kPos);
+  const Eigen::MatrixXd A = Gp - Kp;
+  const Eigen::Vector3d a_nu = A * rec.innovation;
+  const Eigen::Matrix3d cov_ff = rec.P_pos_enu;
+  const Eigen::Matrix3d cov_i = rec.P_pos_enu + A * rec.S * A.transpose();
+  const Eigen::MatrixXd M_i = rec.M_pos_enu - A * rec.N_innov;
+  const Eigen::Vector3d bias_ff = rec.M_pos_enu.cwiseAbs() * rec.bias_bnom;
+  const Eigen::Vector3d bias_i = M_i.cwiseAbs() * rec.bias_bnom;
+
+  // LSR test on the same measurements: residual matrix S_res = I − H (Hᵀ W H)⁻¹ Hᵀ W.
+  const Eigen::VectorXd w = rec.sigma.cwiseAbs2().cwiseInverse();
+  const Eigen::Matrix4d lsr_info = Hpc.transpose() * w.asDiagonal() * Hpc;
+  const Eigen::MatrixXd S_res = Eigen::MatrixXd::Identity(n, n) - Hpc * lsr_info.ldlt().solve(Hpc.transpose() * w.asDiagonal());
+  const int dof = n - 4;
+  // characteristic slope per axis and satellite: |G_p,qm| σ_m / √s_mm
+  Eigen::Matrix3Xd slope(3, n);
+  for (int m = 0; m < n; ++m) {
+    const double smm = std::max(S_res(m, m), 1e-12);
+    slope.col(m) = Gp.col(m).cwiseAbs() * (rec.sigma(m) / std::sqrt(smm));
+  }
+  const Eigen::Vector3d max_slope = slope.rowwise().maxCoeff();
+
+  const RiskAllocation alloc_h = allocateRisk(n, DetectionClass::kIntegrated, false, cfg.risk);
+  const RiskAllocation alloc_v = allocateRisk(n, DetectionClass::kIntegrated, true, cfg.risk);
+  out.bias_estimate_up_m = a_nu.z();
+  out.available = true;
+  out.hpl_m = 0.0;
+  out.vpl_m = 0.0;
+  for (int i = 0; i < kNumInsFaultModes; ++i) {
+    const auto mode = static_cast<InsFaultMode>(i);
+    ModePl& pl = out.modes[i];
+    const ModeBudget& bh = alloc_h.of(mode);
+    const ModeBudget& bv = alloc_v.of(mode);
+    pl.needs_pl = bh.considered && (bh.needs_pl || bv.needs_pl);
+    if (!pl.needs_pl) continue;
+    for (int q = 0; q < 3; ++q) {
+      const double p = q < 2 ? bh.conditional / 2.0 : bv.conditional;
+      const double k = twoSidedK(p);
+      if (mode == InsFaultMode::kFaultFree) {
+        pl.axis_m[q] = k * std::sqrt(cov_ff(q, q)) + bias_ff(q);
+        continue;
+      }
+      double v = std::abs(a_nu(q)) + k * std::sqrt(cov_i(q, q)) + bias_i(q);
+      if ((mode == InsFaultMode::kGnssSingle || mode == InsFaultMode::kGnssSingleImu) && p < 1.0) {
+        v += max_slope(q) * raimThresholds(dof, cfg.pfa_gnss, p).p_bias;
+      }
+      pl.axis_m[q] = v;
+    }
+    pl.hpl_m = std::hypot(pl.axis_m[0], pl.axis_m[1]);
+    pl.vpl_m = pl.axis_m[2];
+    if (pl.hpl_m > out.hpl_m) {
+      out.hpl_m = pl.hpl_m;
+      out.deciding_h = mode;
+    }
+    if (pl.vpl_m > out.vpl_m) {
+      out.vpl_m = pl.vpl_m;
+      out.deciding_v = mode;
+    }
+  }
+  return out;
+}
+
+double seed000Lambda(int grade_index) {
+  switch (grade_index) {
+    case 0: return 1.0 / 12.0;
+    case 1: return 5.0 / 12.0;
+    case 2: return 9.0 / 12.0;
+    default: throw std::invalid_argument("seed 000: IMU grade index must be 0, 1 or 2");
+  }
+}
+
+Seed000Monitor::Seed000Monitor(const Seed000Config& cfg) : cfg_(cfg) {
+  if (cfg_.window < 1) throw std::invalid_argument("seed 000: the averaging window must be ≥ 1 epoch");
+  if (!(cfg_.lambda > 0.0 && cfg_.lambda < 1.0)) throw std::invalid_argument("seed 000: λ must lie in (0, 1)");
+}
+
+Seed000Pl Seed000Monitor::push(const GnssUpdateRecord& rec, const RaimPl& raim) {
+  Seed000Pl out;
+  if (!rec.ok) return out;
+  const Eigen::Vector3d& c = rec.correction_enu;
+  corrections_.emplace_back(std::hypot(c.x(), c.y()), std::abs(c.z()), 0.0);
+  if (raim.available) mu_.emplace_back(raim.max_hslope * raim.thresholds.p_bias, raim.max_vslope * raim.thresholds.p_bias);
+  while (static_cast<int>(corrections_.size()) > cfg_.window) corrections_.pop_front();
+  while (static_cast<int>(mu_.size()) > cfg_.window) mu_.pop_front();
+  if (!raim.available || mu_.empty()) return out;
+
+  Eigen::Vector3d mean_corr = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& v : corrections_) mean_corr += v;
+  mean_corr /= static_cast<double>(corrections_.size());
+  Eigen::Vector2d mean_mu = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& v : mu_) mean_mu += v;
+  mean_mu /= static_cast<double>(mu_.size());
+
+  const Eigen::Matrix3d& P = rec.P_pos_enu;
+  const double sigma_h = std::sqrt(P(0, 0) + P(1, 1));
+  const double sigma_v = std::sqrt(P(2, 2));
+  const Eigen::MatrixXd Kp = rec.R_enu_ecef * rec.K.middleRows<3>(kPos);
+  const Eigen::Matrix3d cov_fault = Kp * rec.S * Kp.transpose();
+  const double sigma_fault_h = std::sqrt(cov_fault(0, 0) + cov_fault(1, 1));
+  const double sigma_fault_v = std::sqrt(cov_fault(2, 2));
+
+  const double lam = cfg_.lambda;
+  out.hpl_nominal_m = normalTailInverse(lam * cfg_.share[0] * cfg_.phmi_h) * sigma_h;
+  out.vpl_nominal_m = normalTailInverse(lam * cfg_.share[0] * cfg_.phmi_v) * sigma_v;
+  out.hpl_imu_fault_m = normalTailInverse(lam * cfg_.share[1] * cfg_.phmi_h) * sigma_fault_h + mean_corr.x();
+  out.vpl_imu_fault_m = normalTailInverse(lam * cfg_.share[1] * cfg_.phmi_v) * sigma_fault_v + mean_corr.y();
+  out.hpl_gnss_fault_m = mean_mu.x() + normalTailInverse(cfg_.share[2] * cfg_.phmi_h / 2.0) * sigma_h;
+  out.vpl_gnss_fault_m = mean_mu.y() + normalTailInverse(cfg_.share[2] * cfg_.phmi_v / 2.0) * sigma_v;
+  out.hpl_m = std::max({out.hpl_nominal_m, out.hpl_imu_fault_m, out.hpl_gnss_fault_m});
+  out.vpl_m = std::max({out.vpl_nominal_m, out.vpl_imu_fault_m, out.vpl_gnss_fault_m});
+  out.available = true;
+  return out;
+}
+
+}  // namespace skylane::integrity::ins

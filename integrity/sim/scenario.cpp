@@ -1,0 +1,236 @@
+#include "integrity/sim/scenario.hpp"
+
+#include "maps/json_node.hpp"
+#include "maps/parse_error.hpp"
+#include "maps/text_file.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+
+namespace skylane::integrity::sim {
+
+using maps::JsonNode;
+
+namespace {
+
+double positive(const JsonNode& n) {
+  const double v = n.number();
+  if (!(v > 0.0)) n.fail("a number > 0");
+  return v;
+}
+
+double nonNegative(const JsonNode& n) {
+  const double v = n.number();
+  if (!(v >= 0.0)) n.fail("a number ≥ 0");
+  return v;
+}
+
+int axisOf(const JsonNode& n) {
+  const std::string a = n.str();
+  if (a == "forward" || a == "x") return 0;
+  if (a == "left" || a == "y") return 1;
+  if (a == "up" || a == "z") return 2;
+  n.fail("a body axis: \"forward\"/\"x\", \"left\"/\"y\" or \"up\"/\"z\"");
+}
+
+FaultSpec parseFault(const JsonNode& f) {
+  f.requireKnownFields({"type", "sats", "axis", "start_s", "end_s", "ramp", "bias_m", "bias_sigma", "bias_mps2",
+                        "bias_g", "bias_radps", "bias_dps"});
+  FaultSpec out;
+  const JsonNode type = f.at("type");
+  const std::string t = type.str();
+  out.t_start_s = nonNegative(f.at("start_s"));
+  out.t_end_s = f.at("end_s").number();
+  if (!(out.t_end_s > out.t_start_s)) f.at("end_s").fail("a time after start_s");
+  if (f.has("ramp")) out.ramp = f.at("ramp").boolean();
+  auto one = [&f](std::initializer_list<const char*> keys) -> JsonNode {
+    for (const char* k : keys) {
+      if (f.has(k)) return f.at(k);
+    }
+    std::string list;
+    for (const char* k : keys) list += (list.empty() ? "" : " or ") + std::string(k);
+    f.fail("an object with " + list);
+  };
+  if (t == "satellite") {
+    out.target = FaultTarget::kSatellite;
+    const JsonNode sats = f.at("sats");
+    if (sats.array().empty()) sats.fail("a non-empty array of satellite ids such as \"G19\"");
+    for (std::size_t i = 0; i < sats.j.size(); ++i) {
+      const JsonNode s = sats.item(i);
+      const auto id = parseSatId(s.str());
+      if (!id) s.fail("a satellite id such as \"G19\" or \"E11\"");
+      out.sats.push_back(*id);
+    }
+    const JsonNode m = one({"bias_m", "bias_sigma"});
+    out.in_sigma = f.has("bias_sigma");
+    out.magnitude = m.number();
+  } else if (t == "accelerometer") {
+    out.target = FaultTarget::kAccelerometer;
+    out.axis = axisOf(f.at("axis"));
+    const JsonNode m = one({"bias_mps2", "bias_g"});
+    out.magnitude = m.number() * (f.has("bias_g") ? 9.80665 : 1.0);
+  } else if (t == "gyro") {
+    out.target = FaultTarget::kGyro;
+    out.axis = axisOf(f.at("axis"));
+    const JsonNode m = one({"bias_radps", "bias_dps"});
+    out.magnitude = m.number() * (f.has("bias_dps") ? M_PI / 180.0 : 1.0);
+  } else if (t == "outage") {
+    out.target = FaultTarget::kGnssOutage;
+    out.magnitude = 1.0;
+    out.ramp = false;
+  } else {
+    type.fail("\"satellite\", \"accelerometer\", \"gyro\" or \"outage\"");
+  }
+  return out;
+}
+
+}  // namespace
+
+void matchFilterToSensors(Scenario& s) {
+  ins::EkfConfig& e = s.navigator.ekf;
+  const ImuSpec& imu = s.sensors.imu;
+  e.accel_noise_mps_rts = imu.accel_noise_mps_rts;
+  e.gyro_noise_rad_rts = imu.gyro_noise_rad_rts;
+  e.accel_bias_rw_mps2_rts = imu.accel_bias_rw_mps2_rts;
+  e.gyro_bias_rw_radps_rts = imu.gyro_bias_rw_radps_rts;
+  e.accel_bias_mps2 = imu.accel_bias_mps2;
+  e.gyro_bias_radps = imu.gyro_bias_radps;
+  e.clock_h0 = s.sensors.clock_h0;
+  e.clock_hm2 = s.sensors.clock_hm2;
+  e.baro_noise_m = s.sensors.baro_noise_m;
+  e.baro_bias_m = s.sensors.baro_bias_m;
+  e.baro_bias_rw_m_rts = s.sensors.baro_bias_rw_m_rts;
+  e.heading_noise_rad = s.sensors.heading_noise_rad;
+  s.navigator.model = s.sensors.model;
+  s.navigator.elevation_mask_rad = s.sensors.elevation_mask_rad;
+  s.navigator.seed000.lambda = ins::seed000Lambda(static_cast<int>(s.grade));
+  s.navigator.seed000.phmi_h = s.navigator.fault_modes.risk.i_req * (1.0 - s.navigator.fault_modes.risk.vertical_share);
+  s.navigator.seed000.phmi_v = s.navigator.fault_modes.risk.i_req * s.navigator.fault_modes.risk.vertical_share;
+  s.navigator.araim.requirements.hal_m = s.hal_m;
+  s.navigator.araim.requirements.val_m = s.val_m;
+}
+
+Scenario parseScenario(const nlohmann::json& doc, const std::string& source, const std::string& base_dir) {
+  const JsonNode root{doc, "$", source};
+  root.requireKnownFields({"origin", "start", "orbits", "trajectory", "imu", "gnss", "baro", "magnetometer", "faults",
+                           "integrity", "seed"});
+  Scenario s;
+  s.source = source;
+  {
+    const JsonNode o = root.at("origin");
+    o.requireKnownFields({"lat_deg", "lon_deg", "h_ell_m"});
+    const double lat = o.at("lat_deg").number(), lon = o.at("lon_deg").number();
+    if (std::abs(lat) > 89.0) o.at("lat_deg").fail("a latitude within ±89°");
+    if (std::abs(lon) > 180.0) o.at("lon_deg").fail("a longitude within ±180°");
+    s.origin = {maps::deg2rad(lat), maps::deg2rad(lon), o.at("h_ell_m").number()};
+  }
+  {
+    const JsonNode t = root.at("start");
+    const auto parsed = maps::parseRfc3339(t.str());
+    if (!parsed) t.fail("an RFC 3339 UTC time such as \"2020-01-01T10:00:00Z\"");
+    s.start = *parsed;
+  }
+  {
+    const JsonNode o = root.at("orbits");
+    if (o.array().empty()) o.fail("a non-empty array of almanac or RINEX navigation file names");
+    for (std::size_t i = 0; i < o.j.size(); ++i) {
+      std::filesystem::path p(o.item(i).str());
+      if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
+      s.orbit_files.push_back(p.lexically_normal().string());
+    }
+  }
+  {
+    const JsonNode t = root.at("trajectory");
+    t.requireKnownFields({"lawnmower", "waypoints", "turn_radius_m"});
+    if (t.has("turn_radius_m")) s.turn_radius_m = positive(t.at("turn_radius_m"));
+    if (t.has("lawnmower") == t.has("waypoints")) t.fail("an object with exactly one of lawnmower or waypoints");
+    if (t.has("lawnmower")) {
+      const JsonNode l = t.at("lawnmower");
+      l.requireKnownFields({"lines", "line_length_m", "spacing_m", "height_m", "speed_mps", "heading_deg"});
+      const double lines = l.at("lines").number();
+      if (!(lines >= 1 && lines <= 1000 && lines == std::floor(lines))) l.at("lines").fail("a whole number 1…1000");
+      s.waypoints = lawnmower(static_cast<int>(lines), positive(l.at("line_length_m")), positive(l.at("spacing_m")),
+                              l.at("height_m").number(), positive(l.at("speed_mps")),
+                              l.has("heading_deg") ? maps::deg2rad(l.at("heading_deg").number()) : 0.0);
+    } else {
+      const JsonNode w = t.at("waypoints");
+      if (w.array().size() < 2) w.fail("an array of at least 2 waypoints");
+      for (std::size_t i = 0; i < w.j.size(); ++i) {
+        const JsonNode p = w.item(i);
+        p.requireKnownFields({"e_m", "n_m", "u_m", "speed_mps"});
+        Waypoint wp;
+        wp.p_enu_m = {p.at("e_m").number(), p.at("n_m").number(), p.at("u_m").number()};
+        wp.speed_mps = i == 0 && !p.has("speed_mps") ? 1.0 : positive(p.at("speed_mps"));
+        s.waypoints.push_back(wp);
+      }
+    }
+  }
+  if (root.has("imu")) {
+    const JsonNode i = root.at("imu");
+    i.requireKnownFields({"grade", "rate_hz"});
+    if (i.has("grade")) {
+      const auto g = parseImuGrade(i.at("grade").str());
+      if (!g) i.at("grade").fail("\"aviation\", \"tactical\" or \"consumer\"");
+      s.grade = *g;
+    }
+    s.sensors.imu = imuSpec(s.grade);
+    if (i.has("rate_hz")) s.sensors.imu.rate_hz = positive(i.at("rate_hz"));
+  }
+  if (root.has("gnss")) {
+    const JsonNode g = root.at("gnss");
+    g.requireKnownFields({"rate_hz", "elevation_mask_deg", "user_model"});
+    if (g.has("rate_hz")) s.sensors.gnss_rate_hz = positive(g.at("rate_hz"));
+    if (g.has("elevation_mask_deg")) s.sensors.elevation_mask_rad = maps::deg2rad(nonNegative(g.at("elevation_mask_deg")));
+    if (g.has("user_model")) {
+      const std::string m = g.at("user_model").str();
+      if (m == "dual_frequency") s.sensors.model.setUserModel(UserErrorModel::kDualFrequency);
+      else if (m == "single_frequency") s.sensors.model.setUserModel(UserErrorModel::kSingleFrequency);
+      else g.at("user_model").fail("\"dual_frequency\" or \"single_frequency\"");
+    }
+  }
+  if (root.has("baro")) s.navigator.use_baro = root.at("baro").boolean();
+  if (root.has("magnetometer")) s.navigator.use_heading = root.at("magnetometer").boolean();
+  if (root.has("faults")) {
+    const JsonNode f = root.at("faults");
+    for (std::size_t i = 0; i < f.array().size(); ++i) s.faults.push_back(parseFault(f.item(i)));
+  }
+  if (root.has("integrity")) {
+    const JsonNode n = root.at("integrity");
+    n.requireKnownFields({"hal_m", "val_m", "i_req", "p_sat", "p_imu", "pfa_gnss", "pfa_imu", "araim"});
+    if (n.has("hal_m")) s.hal_m = positive(n.at("hal_m"));
+    if (n.has("val_m")) s.val_m = positive(n.at("val_m"));
+    auto prob = [](const JsonNode& p) {
+      const double v = p.number();
+      if (!(v > 0.0 && v < 1.0)) p.fail("a probability in (0, 1)");
+      return v;
+    };
+    if (n.has("i_req")) s.navigator.fault_modes.risk.i_req = prob(n.at("i_req"));
+    if (n.has("p_sat")) s.navigator.fault_modes.risk.p_sat = prob(n.at("p_sat"));
+    if (n.has("p_imu")) s.navigator.fault_modes.risk.p_imu = prob(n.at("p_imu"));
+    if (n.has("pfa_gnss")) s.navigator.fault_modes.pfa_gnss = prob(n.at("pfa_gnss"));
+    if (n.has("pfa_imu")) s.navigator.pfa_imu = prob(n.at("pfa_imu"));
+    if (n.has("araim")) s.navigator.compute_araim = n.at("araim").boolean();
+  }
+  if (root.has("seed")) {
+    const JsonNode sd = root.at("seed");
+    const double v = sd.number();
+    if (!(v >= 0 && v < 9.007199254740992e15 && v == std::floor(v))) sd.fail("a whole number ≥ 0");
+    s.seed = static_cast<std::uint64_t>(v);
+  }
+  // The trajectory is checked here so that a bad one is reported against this file.
+  try {
+    (void)Trajectory(s.origin, s.waypoints, s.turn_radius_m);
+  } catch (const std::invalid_argument& e) {
+    root.at("trajectory").fail(std::string("a flyable trajectory (") + e.what() + ")");
+  }
+  matchFilterToSensors(s);
+  return s;
+}
+
+Scenario loadScenario(const std::string& path) {
+  const std::filesystem::path p(path);
+  return parseScenario(maps::readJsonFile(path), path, p.parent_path().string());
+}
+
+}  // namespace skylane::integrity::sim

@@ -1,0 +1,96 @@
+#pragma once
+/// \file
+/// \brief Truth trajectories for the GNSS/INS simulation: a polyline of waypoints flown at set
+/// ground speeds, corners rounded into circular arcs, with attitude from the velocity (heading,
+/// flight-path angle) and a coordinated-turn bank angle; and seed 001's survey ("lawnmower")
+/// pattern.
+///
+/// Frames: positions are in the local ENU frame of the trajectory's origin (a Cartesian frame:
+/// its ECEF image is an affine map, so ECEF velocity and acceleration are the same rotation of
+/// the ENU ones). The body frame is forward-left-up (FLU); attitude is given against the local
+/// ENU frame *at the vehicle* (so a magnetometer or a level sensor sees what it would).
+
+#include "maps/geodesy.hpp"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace skylane::integrity::sim {
+
+/// \brief A waypoint in the origin's ENU frame and the ground speed of the leg that ends there.
+struct Waypoint {
+  Eigen::Vector3d p_enu_m = Eigen::Vector3d::Zero();
+  double speed_mps = 10.0;  ///< speed along the leg *into* this waypoint (the first one's is unused)
+};
+
+/// \brief The true kinematic state at one instant.
+struct TruthState {
+  double t_s = 0.0;
+  Eigen::Vector3d p_enu_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v_enu_mps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d a_enu_mps2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p_ecef_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v_ecef_mps = Eigen::Vector3d::Zero();
+  maps::Geodetic geodetic;
+  double heading_rad = 0.0;  ///< clockwise from north
+  double pitch_rad = 0.0;    ///< nose up positive (flight-path angle)
+  double roll_rad = 0.0;     ///< right wing down positive (coordinated-turn bank)
+  Eigen::Matrix3d C_enu_body = Eigen::Matrix3d::Identity();   ///< body (FLU) → local ENU at the vehicle
+  Eigen::Matrix3d C_ecef_body = Eigen::Matrix3d::Identity();  ///< body (FLU) → ECEF
+};
+
+/// \brief Body (FLU) → ENU for heading ψ, pitch θ, roll φ: Rz(π/2 − ψ)·Ry(−θ)·Rx(φ).
+[[nodiscard]] Eigen::Matrix3d bodyToEnu(double heading_rad, double pitch_rad, double roll_rad);
+
+/// \brief A flyable path through waypoints.
+class Trajectory {
+ public:
+  /// \brief Builds the path. Corners are rounded with the largest arc (up to `turn_radius_m`)
+  /// that fits half of each adjacent leg; the speed changes linearly along each leg.
+  /// \throws std::invalid_argument for fewer than two waypoints, a non-positive speed or radius,
+  /// repeated waypoints, or a leg steeper than 60°.
+  Trajectory(const maps::Geodetic& origin, std::vector<Waypoint> waypoints, double turn_radius_m);
+
+  /// \brief Flight time from the first to the last waypoint [s].
+  [[nodiscard]] double duration_s() const { return duration_s_; }
+  /// \brief The truth at time t ∈ [0, duration] (clamped).
+  [[nodiscard]] TruthState at(double t_s) const;
+  /// \brief The origin's local frame.
+  [[nodiscard]] const maps::LocalFrame& frame() const { return frame_; }
+  /// \brief The origin's ENU → ECEF rotation.
+  [[nodiscard]] const Eigen::Matrix3d& rotationEnuToEcef() const { return R_ecef_enu_; }
+
+ private:
+  /// One piece of the horizontal path: a straight line or a circular arc, with its vertical
+  /// profile linear in arc length.
+  struct Piece {
+    bool arc = false;
+    double s0 = 0.0, length = 0.0;    // start arc length and length [m] (horizontal)
+    Eigen::Vector2d start = Eigen::Vector2d::Zero();
+    Eigen::Vector2d dir = Eigen::Vector2d::Zero();     // line: unit direction
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();  // arc: centre
+    double radius = 0.0, phase0 = 0.0, turn = 0.0;     // arc: signed sweep (+ counter-clockwise)
+  };
+  struct Leg {  // waypoint i → i+1 in horizontal arc length, with speed ramp and climb
+    double s0 = 0.0, s1 = 0.0, h0 = 0.0, h1 = 0.0, v0 = 0.0, v1 = 0.0, t0 = 0.0, t1 = 0.0;
+  };
+
+  void horizontal(double s, Eigen::Vector2d& p, Eigen::Vector2d& tangent, double& curvature) const;
+  [[nodiscard]] double arcLengthAt(double t_s, double& speed, double& accel, const Leg*& leg) const;
+
+  maps::LocalFrame frame_;
+  Eigen::Matrix3d R_ecef_enu_;
+  Eigen::Vector3d p_origin_ecef_;
+  std::vector<Piece> pieces_;
+  std::vector<Leg> legs_;
+  double duration_s_ = 0.0;
+};
+
+/// \brief Seed 001's survey pattern: `lines` parallel lines of length `line_length_m`, spaced
+/// `spacing_m`, flown back and forth at `height_m` above the origin and `speed_mps`, starting at
+/// the origin heading along `heading_rad`.
+[[nodiscard]] std::vector<Waypoint> lawnmower(int lines, double line_length_m, double spacing_m, double height_m,
+                                              double speed_mps, double heading_rad);
+
+}  // namespace skylane::integrity::sim
