@@ -74,7 +74,11 @@ AraimFdeResult araimFde(const Geometry& g, const Eigen::VectorXd& y, const Error
   // Exclusion: candidates are the monitored modes, fewest satellites first.
   double best_wsse = std::numeric_limits<double>::infinity();
   std::size_t best_size = std::numeric_limits<std::size_t>::max();
-  for (const SubsetSolution& cand : out.pl.subsets) {
+  // The candidates are taken out of out.pl first: out.pl is overwritten by a valid exclusion
+  // inside the loop (iterating it in place read freed memory — found by ASan in session 5).
+  std::vector<SubsetSolution> candidates = std::move(out.pl.subsets);
+  out.pl.subsets.clear();
+  for (const SubsetSolution& cand : candidates) {
     if (cand.removed.size() > best_size) break;  // a smaller valid exclusion was found already
     const Geometry gk = subGeometry(g, cand.removed);
     const Eigen::VectorXd yk = subVector(y, cand.removed);
@@ -92,6 +96,7 @@ AraimFdeResult araimFde(const Geometry& g, const Eigen::VectorXd& y, const Error
     out.fault_excluded = true;
   }
   if (!out.fault_excluded) {
+    out.pl.subsets = std::move(candidates);
     out.pl.available = false;
     out.pl.reason = "fault detected and not excluded";
   }

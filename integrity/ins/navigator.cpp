@@ -1,5 +1,6 @@
 #include "integrity/ins/navigator.hpp"
 
+#include "integrity/araim/fde.hpp"
 #include "integrity/raim/wls.hpp"
 #include "integrity/stats.hpp"
 
@@ -60,13 +61,12 @@ NavigatorEpoch Navigator::epoch(double t_s, const std::vector<PseudorangeInput>&
     out.raim.vpl_m = fde.pl.vpl_m;
   }
   if (cfg_.compute_araim) {
-    const WlsSolution all = solveWls(g.G, g.sigma_int);
-    if (all.ok) {
-      const AraimResult ar = araimProtectionLevels(g, cfg_.model, cfg_.araim);
-      out.araim.available = ar.pl_computed;
-      out.araim.r_ecef_m = r_pred + R_enu_ecef.transpose() * (all.S * prefit).head<3>();
-      out.araim.hpl_m = ar.hpl_m;
-      out.araim.vpl_m = ar.vpl_m;
+    const AraimFdeResult ar = araimFde(g, prefit, cfg_.model, cfg_.araim);
+    if (ar.solution_ok) {
+      out.araim.available = ar.pl.pl_computed && !(ar.fault_detected && !ar.fault_excluded);
+      out.araim.r_ecef_m = r_pred + R_enu_ecef.transpose() * ar.dx.head<3>();
+      out.araim.hpl_m = ar.pl.hpl_m;
+      out.araim.vpl_m = ar.pl.vpl_m;
     }
   }
 

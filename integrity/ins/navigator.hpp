@@ -77,7 +77,7 @@ struct NavigatorEpoch {
   Eigen::Vector3d ekf_r_ecef_m = Eigen::Vector3d::Zero();
   Seed000Pl seed000;           ///< bounds the filter position
   SnapshotSolution raim;       ///< after FDE
-  SnapshotSolution araim;      ///< all in view
+  SnapshotSolution araim;      ///< after ARAIM solution-separation FDE
 };
 
 /// \brief The integrated navigator.

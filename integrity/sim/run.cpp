@@ -103,8 +103,14 @@ RunResult runScenario(const Scenario& s, const OrbitSource& orbits, std::uint64_
     const bool usable = !ep.outage;
     r.methods[static_cast<int>(Method::kSeed001)] =
         sampleOf(usable && ep.seed001_available, ep.r_ecef_m, truth.p_ecef_m, R, ep.seed001_hpl_m, ep.seed001_vpl_m);
-    r.methods[static_cast<int>(Method::kSeed000)] = sampleOf(usable && ep.seed000.available, ep.ekf_r_ecef_m,
-                                                             truth.p_ecef_m, R, ep.seed000.hpl_m, ep.seed000.vpl_m);
+    // Seed 000 names no IMU fault detector; it runs inside the same flow as seed 001 (LSR FDE,
+    // innovation test, GNSS alone with RAIM when the IMU is declared faulty), so that the two
+    // differ only in their protection-level formulas.
+    r.methods[static_cast<int>(Method::kSeed000)] =
+        ep.degraded ? sampleOf(usable && ep.raim.available, ep.raim.r_ecef_m, truth.p_ecef_m, R, ep.raim.hpl_m,
+                               ep.raim.vpl_m)
+                    : sampleOf(usable && ep.seed000.available, ep.ekf_r_ecef_m, truth.p_ecef_m, R, ep.seed000.hpl_m,
+                               ep.seed000.vpl_m);
     r.methods[static_cast<int>(Method::kRaim)] =
         sampleOf(usable && ep.raim.available, ep.raim.r_ecef_m, truth.p_ecef_m, R, ep.raim.hpl_m, ep.raim.vpl_m);
     r.methods[static_cast<int>(Method::kAraim)] =

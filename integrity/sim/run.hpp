@@ -19,9 +19,9 @@ namespace skylane::integrity::sim {
 /// \brief The methods compared.
 enum class Method {
   kSeed001,  ///< seed 001 fault-mode PLs on the system output (filter, or GNSS alone when degraded)
-  kSeed000,  ///< seed 000's three hypotheses on the filter position
+  kSeed000,  ///< seed 000's three hypotheses on the filter position (GNSS alone with RAIM when degraded)
   kRaim,     ///< snapshot RAIM after FDE on its own position
-  kAraim,    ///< snapshot ARAIM (MHSS) on the all-in-view position
+  kAraim,    ///< snapshot ARAIM (MHSS) after solution-separation FDE on its own position
 };
 inline constexpr int kNumMethods = 4;
 /// \brief "seed001", "seed000", "raim", "araim".
