@@ -47,7 +47,8 @@ struct JsonNode {
       if (ok) continue;
       std::string list;
       for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
-      throw ParseError(source, 0, path + "." + item.key(), "", "no such field here (known: " + list + ")");
+      throw ParseError(source, 0, path + "." + item.key(), quoteJson(item.value()),
+                       "no such field here (an unknown field; known: " + list + ")");
     }
   }
   /// \brief An object with a non-null member `key`.
