@@ -8,6 +8,7 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace {
@@ -26,8 +27,11 @@ EpochSetup twentySatellites() {
   orbits.addAlmanac(loadAlmanac(std::string(SKYLANE_TEST_DATA) + "/gnss/alm_gal_ed259.txt"));
   EpochSetup s;
   s.truth.r_ecef_m = skylane::maps::geodeticToEcef({0.8269, 0.1491, 520.0});
-  const GpsTime t{1930, 3600.0};  // an hour after the almanacs' t_oa
-  auto vis = orbits.visible(s.truth.r_ecef_m, t, 0.0);
+  // The first instant of the almanacs' day with at least 20 satellites above 5°.
+  std::vector<VisibleSatellite> vis;
+  for (double sow = 0.0; sow < 86400.0 && vis.size() < 20; sow += 600.0) {
+    vis = orbits.visible(s.truth.r_ecef_m, GpsTime{1930, sow}, 5.0 * M_PI / 180.0);
+  }
   if (vis.size() < 20) throw std::runtime_error("fewer than 20 satellites in view for the benchmark");
   vis.resize(20);
   for (const VisibleSatellite& v : vis) s.ranges.push_back({v.sat, v.p_ecef, v.range_m + 30.0});

@@ -101,35 +101,27 @@ void InsEkf::applyCorrection(const StateVector& dx) {
   baro_bias_m_ += dx(kBaro);
 }
 
-void InsEkf::update(const Eigen::MatrixXd& H, const Eigen::VectorXd& nu, const Eigen::MatrixXd& R,
-                    Eigen::MatrixXd* K_out) {
-  // Fold any pending propagation in first so that P belongs to now.
-  propagateCovariance();
-  const Eigen::MatrixXd PHt = P_ * H.transpose();
-  const Eigen::MatrixXd S = H * PHt + R;
-  const Eigen::LLT<Eigen::MatrixXd> llt(S);
-  if (llt.info() != Eigen::Success) throw std::runtime_error("ins ekf: innovation covariance not positive definite");
-  const Eigen::MatrixXd K = llt.solve(PHt.transpose()).transpose();
-  const StateVector dx = K * nu;
-  const StateMatrix IKH = StateMatrix::Identity() - K * H;
-  P_ = IKH * P_ * IKH.transpose() + K * R * K.transpose();  // Joseph form
+void InsEkf::updateScalar(const Eigen::Matrix<double, 1, kNumStates>& h, double nu, double r) {
+  propagateCovariance();  // fold any pending propagation in first so that P belongs to now
+  const StateVector PHt = P_ * h.transpose();
+  const double s = h.dot(PHt) + r;
+  if (!(s > 0.0)) throw std::runtime_error("ins ekf: innovation variance not positive");
+  const StateVector K = PHt / s;
+  // Joseph form expanded for a scalar measurement: (I − K h) P (I − K h)ᵀ + K r Kᵀ
+  // = P − K PHtᵀ − PHt Kᵀ + s K Kᵀ (O(n²) instead of two n³ products).
+  P_ += s * K * K.transpose() - K * PHt.transpose() - PHt * K.transpose();
   P_ = 0.5 * (P_ + P_.transpose()).eval();
-  for (auto& [sat, m] : sensitivity_) m = IKH * m;
-  applyCorrection(dx);
-  if (K_out != nullptr) *K_out = K;
+  for (auto& [sat, m] : sensitivity_) m -= K * h.dot(m);  // M ← (I − K h) M
+  applyCorrection(K * nu);
 }
 
 void InsEkf::updateBaro(double h_m) {
   const maps::Geodetic g = maps::ecefToGeodetic(nav_.r_ecef_m);
   const Eigen::Matrix3d R_enu_ecef = maps::rotationEcefToEnu(g.lat_rad, g.lon_rad);
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, kNumStates);
-  H.block<1, 3>(0, kPos) = R_enu_ecef.row(2);
-  H(0, kBaro) = 1.0;
-  Eigen::VectorXd nu(1);
-  nu(0) = h_m - (g.h_ell_m + baro_bias_m_);
-  Eigen::MatrixXd R(1, 1);
-  R(0, 0) = cfg_.baro_noise_m * cfg_.baro_noise_m;
-  update(H, nu, R, nullptr);
+  Eigen::Matrix<double, 1, kNumStates> h = Eigen::Matrix<double, 1, kNumStates>::Zero();
+  h.segment<3>(kPos) = R_enu_ecef.row(2);
+  h(kBaro) = 1.0;
+  updateScalar(h, h_m - (g.h_ell_m + baro_bias_m_), cfg_.baro_noise_m * cfg_.baro_noise_m);
 }
 
 double InsEkf::heading_rad() const {
@@ -147,13 +139,10 @@ void InsEkf::updateHeading(double heading_rad) {
   if (h2 < 1e-6) return;  // nose vertical: heading undefined
   // ψ = atan2(f_E, f_N); δf = φ × f = −[f×]φ (ECEF), so ∂ψ/∂φ = (f_N, −f_E, 0)/(f_E² + f_N²) · R · (−[f×]).
   const Eigen::RowVector3d dpsi_df = Eigen::RowVector3d(f.y(), -f.x(), 0.0) / h2;
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, kNumStates);
-  H.block<1, 3>(0, kAtt) = dpsi_df * R_enu_ecef * (-skew(f_ecef));
-  Eigen::VectorXd nu(1);
-  nu(0) = std::remainder(heading_rad - std::atan2(f.x(), f.y()), 2.0 * M_PI);
-  Eigen::MatrixXd R(1, 1);
-  R(0, 0) = cfg_.heading_noise_rad * cfg_.heading_noise_rad;
-  update(H, nu, R, nullptr);
+  Eigen::Matrix<double, 1, kNumStates> h = Eigen::Matrix<double, 1, kNumStates>::Zero();
+  h.segment<3>(kAtt) = dpsi_df * R_enu_ecef * (-skew(f_ecef));
+  updateScalar(h, std::remainder(heading_rad - std::atan2(f.x(), f.y()), 2.0 * M_PI),
+               cfg_.heading_noise_rad * cfg_.heading_noise_rad);
 }
 
 double InsEkf::predictedRange_m(const Eigen::Vector3d& sat_ecef_m) const {
@@ -194,22 +183,33 @@ GnssUpdateRecord InsEkf::updateGnss(const std::vector<RangeInput>& ranges) {
     }
     ++col;
   }
-  const Eigen::MatrixXd R = rec.sigma.cwiseAbs2().asDiagonal();
-  rec.S = H * P_ * H.transpose() + R;
+  // S = H P Hᵀ + R = L Lᵀ; with W = L⁻¹ H P: K = (L⁻ᵀ W)ᵀ and K S Kᵀ = Wᵀ W, so the
+  // posterior P − K S Kᵀ (= P − K H P for the optimal gain) is formed symmetric.
+  const Eigen::MatrixXd HP = H * P_;
+  rec.S = HP * H.transpose();
+  rec.S.diagonal() += rec.sigma.cwiseAbs2();
+  const Eigen::LLT<Eigen::MatrixXd> llt(rec.S);
+  if (llt.info() != Eigen::Success) throw std::runtime_error("ins ekf: innovation covariance not positive definite");
+  const Eigen::MatrixXd W = llt.matrixL().solve(HP);
+  rec.K = llt.matrixU().solve(W).transpose();
+  P_.noalias() -= W.transpose() * W;
+  P_ = 0.5 * (P_ + P_.transpose()).eval();
   rec.innovation = nu;
   rec.H = H;
-  update(H, nu, R, &rec.K);
-  // M⁺ = (I − K H) M⁻ − K E: update() already applied (I − K H); add the direct term.
+  Eigen::MatrixXd Hpc(n, 4);
+  Hpc.leftCols<3>() = H.middleCols<3>(kPos);
+  Hpc.col(3) = H.col(kClock);
+  rec.S_inv_Hpc = llt.solve(Hpc);
+  // M⁺ = (I − K H) M⁻ − K E = M⁻ − K N with N = H M⁻ + E.
+  rec.N_innov = H * M_prior + E;
+  const Eigen::MatrixXd KN = rec.K * rec.N_innov;
   col = 0;
-  for (auto& [sat, m] : sensitivity_) {
-    m -= rec.K * E.col(col);
-    ++col;
-  }
+  for (auto& [sat, m] : sensitivity_) m -= KN.col(col++);
+  applyCorrection(rec.K * nu);
   const maps::Geodetic g = maps::ecefToGeodetic(nav_.r_ecef_m);
   rec.R_enu_ecef = maps::rotationEcefToEnu(g.lat_rad, g.lon_rad);
   rec.P_pos_enu = rec.R_enu_ecef * P_.block<3, 3>(kPos, kPos) * rec.R_enu_ecef.transpose();
   rec.correction_enu = rec.R_enu_ecef * (rec.K * nu).segment<3>(kPos);
-  rec.N_innov = H * M_prior + E;
   rec.M_pos_enu.resize(3, static_cast<Eigen::Index>(sensitivity_.size()));
   col = 0;
   for (const auto& [sat, m] : sensitivity_) rec.M_pos_enu.col(col++) = rec.R_enu_ecef * m.segment<3>(kPos);

@@ -73,6 +73,7 @@ struct GnssUpdateRecord {
   Eigen::VectorXd sigma;                 ///< σ_int per measurement
   Eigen::VectorXd innovation;            ///< ν (before the update)
   Eigen::MatrixXd S;                     ///< innovation covariance H P⁻ Hᵀ + R
+  Eigen::MatrixXd S_inv_Hpc;             ///< S⁻¹ H_pc (n × 4; H_pc = position and clock columns of H)
   Eigen::MatrixXd H;                     ///< n × 18
   Eigen::MatrixXd K;                     ///< 18 × n
   Eigen::Matrix3d R_enu_ecef = Eigen::Matrix3d::Identity();
@@ -114,8 +115,8 @@ class InsEkf {
 
  private:
   void propagateCovariance();
-  /// Scalar or vector update with Joseph form; applies the correction and resets δx.
-  void update(const Eigen::MatrixXd& H, const Eigen::VectorXd& nu, const Eigen::MatrixXd& R, Eigen::MatrixXd* K_out);
+  /// Scalar update (Joseph form, expanded); applies the correction and resets δx.
+  void updateScalar(const Eigen::Matrix<double, 1, kNumStates>& h, double nu, double r);
   void applyCorrection(const StateVector& dx);
 
   EkfConfig cfg_;

@@ -7,6 +7,7 @@
 #include "maps/geodesy.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 namespace skylane::integrity::ins {
@@ -36,7 +37,9 @@ NavigatorEpoch Navigator::epoch(double t_s, const std::vector<PseudorangeInput>&
   looks.reserve(ranges.size());
   Eigen::VectorXd prefit(static_cast<Eigen::Index>(ranges.size()));
   for (std::size_t i = 0; i < ranges.size(); ++i) {
-    looks.push_back({ranges[i].sat, maps::lookAngles(r_pred, ranges[i].sat_ecef_m)});
+    // Look angles in the local frame at the prediction (one geodetic conversion for all).
+    const Eigen::Vector3d los = R_enu_ecef * (ranges[i].sat_ecef_m - r_pred).normalized();
+    looks.push_back({ranges[i].sat, {std::atan2(los.x(), los.y()), std::asin(std::clamp(los.z(), -1.0, 1.0))}});
     prefit(static_cast<Eigen::Index>(i)) = ranges[i].pseudorange_m - ekf_.predictedRange_m(ranges[i].sat_ecef_m);
   }
   const Geometry g = buildGeometry(looks, cfg_.model, cfg_.model.iono_tau_vert_m.value_or(9.0));
@@ -92,7 +95,10 @@ NavigatorEpoch Navigator::epoch(double t_s, const std::vector<PseudorangeInput>&
   }
   if (!imu_stats_.empty()) {
     out.imu_statistic = std::accumulate(imu_stats_.begin(), imu_stats_.end(), 0.0);
-    out.imu_threshold = chiSquareUpperQuantile(4 * static_cast<int>(imu_stats_.size()), cfg_.pfa_imu);
+    const int dof = 4 * static_cast<int>(imu_stats_.size());
+    auto [it, fresh] = imu_thresholds_.try_emplace(dof, 0.0);
+    if (fresh) it->second = chiSquareUpperQuantile(dof, cfg_.pfa_imu);
+    out.imu_threshold = it->second;
     out.imu_fault_detected = out.imu_statistic > out.imu_threshold;
   }
   if (out.imu_fault_detected) {

@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 
 #include <deque>
+#include <map>
 #include <optional>
 #include <vector>
 
@@ -100,7 +101,7 @@ class Navigator {
   InsEkf ekf_;
   Seed000Monitor seed000_;
   std::deque<double> imu_stats_;
-  double imu_threshold_ = 0.0;
+  std::map<int, double> imu_thresholds_;  ///< χ² thresholds by degrees of freedom
   bool degraded_ = false;
   double consistent_since_s_ = 0.0;
 };

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <map>
 #include <string>
+#include <tuple>
 
 namespace skylane::integrity {
 
@@ -39,6 +41,9 @@ double multiFaultPrior(int k, double p) {
   return sum;
 }
 
+RiskAllocation computeAllocation(int num_sats, DetectionClass detection, bool vertical,
+                                 const RiskAllocationConfig& cfg);
+
 }  // namespace
 
 std::array<double, kNumInsFaultModes> faultModePriors(int num_sats, DetectionClass detection,
@@ -72,6 +77,22 @@ std::array<double, kNumInsFaultModes> faultModePriors(int num_sats, DetectionCla
 }
 
 RiskAllocation allocateRisk(int num_sats, DetectionClass detection, bool vertical, const RiskAllocationConfig& cfg) {
+  // Remembered per thread: a navigator asks for the same few allocations every epoch.
+  using Key = std::tuple<int, int, bool, double, double, double, double, double, bool>;
+  thread_local std::map<Key, RiskAllocation> cache;
+  const Key key{num_sats, static_cast<int>(detection), vertical, cfg.i_req, cfg.vertical_share, cfg.p_sat, cfg.p_imu,
+                cfg.negligible_fraction, cfg.include_gm_imu};
+  if (const auto it = cache.find(key); it != cache.end()) return it->second;
+  RiskAllocation out = computeAllocation(num_sats, detection, vertical, cfg);
+  if (cache.size() > 1024) cache.clear();
+  cache.emplace(key, out);
+  return out;
+}
+
+namespace {
+
+RiskAllocation computeAllocation(int num_sats, DetectionClass detection, bool vertical,
+                                 const RiskAllocationConfig& cfg) {
   if (!(cfg.i_req > 0.0 && cfg.i_req < 1.0) || !(cfg.vertical_share > 0.0 && cfg.vertical_share < 1.0) ||
       !(cfg.negligible_fraction > 0.0 && cfg.negligible_fraction < 1.0)) {
     throw std::invalid_argument("risk allocation: i_req, vertical_share and negligible_fraction must lie in (0, 1)");
@@ -113,5 +134,7 @@ RiskAllocation allocateRisk(int num_sats, DetectionClass detection, bool vertica
   }
   return out;
 }
+
+}  // namespace
 
 }  // namespace skylane::integrity
