@@ -43,3 +43,8 @@ python3 -c 'import json
 for l in open("examples/out/fence.jsonl"):
     j = json.loads(l)
     print(j.get("id", "line %d" % j["line"]), j.get("verdict", j.get("event")), j.get("violated") or "")'
+echo "--- GNSS/INS simulation, seed 001's experiments (examples/out/simulate/<scenario>/: epochs.csv,"
+echo "    errors_and_pls.svg, stanford_horizontal.svg, stanford_vertical.svg):"
+for s in no_fault accel_fault sat_10sigma sat_20sigma combined; do
+  ./build/skylane simulate examples/simulate/seed001_$s.json --out examples/out/simulate/$s | grep -v '^skylane: simulate: wrote'
+done
