@@ -141,12 +141,15 @@ std::string curvesSvg(const integrity::sim::RunResult& run, const integrity::sim
     std::vector<Series> pls;
     for (const Line& l : lines) pls.push_back({l.label, l.colour, {}, false, false});
     Series ekf_err{"error (filter)", "#1f77b4", {}, true, false};
+    Series raim_err{"error (snapshot)", "#2ca02c", {}, true, false};
     for (const auto& e : run.epochs) {
       if (dir == 0) t.push_back(e.t_s);
       const auto& sys = e.methods[static_cast<int>(Method::kSeed001)];
       err.y.push_back(dir == 0 ? sys.hpe_m : sys.vpe_m);
       const auto& f = e.methods[static_cast<int>(Method::kSeed000)];
       ekf_err.y.push_back(dir == 0 ? f.hpe_m : f.vpe_m);
+      const auto& sn = e.methods[static_cast<int>(Method::kRaim)];
+      raim_err.y.push_back(dir == 0 ? sn.hpe_m : sn.vpe_m);
       al.y.push_back(dir == 0 ? s.hal_m : s.val_m);
       for (std::size_t k = 0; k < pls.size(); ++k) {
         const auto& m = e.methods[static_cast<int>(lines[k].method)];
@@ -155,8 +158,31 @@ std::string curvesSvg(const integrity::sim::RunResult& run, const integrity::sim
     }
     p.series.push_back(err);
     p.series.push_back(ekf_err);
+    p.series.push_back(raim_err);
     for (Series& se : pls) p.series.push_back(std::move(se));
     p.series.push_back(al);
+  }
+  // Seed 001's fault modes (its Figs. 6–11): each mode's PL against the system error.
+  const char* const mode_names[4] = {"FF", "GS", "I", "GSI"};
+  const char* const mode_colours[4] = {"#2ca02c", "#d62728", "#1f77b4", "#9467bd"};
+  for (int dir = 0; dir < 2; ++dir) {
+    Panel p;
+    p.y_label = dir == 0 ? "seed 001 modes, H [m]" : "seed 001 modes, V [m]";
+    p.height_px = 200;
+    Series err{"error (system)", "#000000", {}, false, false};
+    std::vector<Series> modes;
+    for (int k = 0; k < 4; ++k) modes.push_back({std::string(mode_names[k]) + (dir == 0 ? " HPL" : " VPL"), mode_colours[k], {}, k == 0, false});
+    for (const auto& e : run.epochs) {
+      const auto& sys = e.methods[static_cast<int>(Method::kSeed001)];
+      err.y.push_back(dir == 0 ? sys.hpe_m : sys.vpe_m);
+      for (int k = 0; k < 4; ++k) {
+        const double v = dir == 0 ? e.mode_hpl_m[static_cast<std::size_t>(k)] : e.mode_vpl_m[static_cast<std::size_t>(k)];
+        modes[static_cast<std::size_t>(k)].y.push_back(e.degraded || v <= 0.0 ? nan : v);
+      }
+    }
+    p.series.push_back(err);
+    for (Series& m : modes) p.series.push_back(std::move(m));
+    panels.push_back(p);
   }
   Panel imu;
   imu.y_label = "IMU test";

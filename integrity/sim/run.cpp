@@ -3,6 +3,7 @@
 #include "integrity/gnss/almanac.hpp"
 #include "integrity/gnss/rinex_nav.hpp"
 
+#include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
 
 #include <algorithm>
@@ -29,9 +30,13 @@ std::string_view methodName(Method m) {
 
 OrbitSource loadOrbits(const Scenario& s) {
   OrbitSource orbits;
-  for (const std::string& f : s.orbit_files) {
+  for (std::size_t i = 0; i < s.orbit_files.size(); ++i) {
+    const std::string& f = s.orbit_files[i];
     std::ifstream in(f);
-    if (!in) throw std::runtime_error(f + ": cannot open the orbit file (named in " + s.source + ", field orbits)");
+    if (!in) {
+      throw maps::ParseError(s.source, 0, "$.orbits[" + std::to_string(i) + "]", f,
+                             "a readable YUMA/SEM almanac or RINEX navigation file");
+    }
     std::string first;
     std::getline(in, first);
     if (first.find("RINEX VERSION") != std::string::npos) {
@@ -40,7 +45,7 @@ OrbitSource loadOrbits(const Scenario& s) {
       orbits.addAlmanac(loadAlmanac(f));
     }
   }
-  if (orbits.empty()) throw std::runtime_error(s.source + ": the orbit files hold no satellites");
+  if (orbits.empty()) throw maps::ParseError(s.source, 0, "$.orbits", "", "files that hold at least one satellite");
   return orbits;
 }
 

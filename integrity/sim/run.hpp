@@ -61,7 +61,7 @@ struct RunResult {
 };
 
 /// \brief The scenario's orbit files loaded (almanacs by content, RINEX navigation by name).
-/// \throws std::runtime_error / maps::ParseError naming the file.
+/// \throws maps::ParseError naming the scenario's field and the file.
 [[nodiscard]] OrbitSource loadOrbits(const Scenario& s);
 
 /// \brief Flies the scenario once with the given seed.

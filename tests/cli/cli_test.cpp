@@ -366,5 +366,48 @@ TEST(Cli, FenceCheckRefusesABadCorridorFileWithExitTwo) {
   EXPECT_NE(r.out.find("at least 2 waypoints"), std::string::npos) << r.out;
 }
 
+TEST(Cli, SimulateWritesTheEpochsCurvesAndStanfordDiagrams) {
+  const std::string out = test::scratchPath("sim_out");
+  const RunResult r = run("simulate " + std::string(SKYLANE_TEST_DATA) +
+                          "/../../examples/simulate/seed001_sat_20sigma.json --out " + out);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("752 s of flight, 751 GNSS epochs"), std::string::npos) << r.out;
+  for (const char* m : {"seed001", "seed000", "raim", "araim"}) {
+    EXPECT_NE(r.out.find(std::string("  ") + m), std::string::npos) << m;
+  }
+  EXPECT_EQ(r.out.find("NOT bounded"), std::string::npos) << r.out;
+  std::ifstream csv(out + "/epochs.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header.rfind("t_s,truth_e_m,truth_n_m,truth_u_m,", 0), 0u) << header;
+  int rows = 0, excluded_g19 = 0;
+  for (std::string line; std::getline(csv, line); ++rows) excluded_g19 += line.find(",G19,") != std::string::npos ? 1 : 0;
+  EXPECT_EQ(rows, 751);
+  EXPECT_EQ(excluded_g19, 50);  // 200–250 s: the LSR test excludes the 20σ₀ satellite
+  for (const char* svg : {"errors_and_pls.svg", "stanford_horizontal.svg", "stanford_vertical.svg"}) {
+    std::ifstream f(out + "/" + svg);
+    const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("<svg"), std::string::npos) << svg;
+  }
+}
+
+TEST(Cli, SimulateRefusesABadScenarioWithExitTwo) {
+  const std::string base = R"({"origin":{"lat_deg":47,"lon_deg":8,"h_ell_m":500},"start":"2020-01-01T07:00:00Z",)"
+                           R"("trajectory":{"lawnmower":{"lines":2,"line_length_m":100,"spacing_m":50,"height_m":10,"speed_mps":5}},)";
+  const std::string unknown = writeTemp("scenario_unknown.json", base + R"("orbits":["x.txt"],"wings":2})");
+  RunResult r = run("simulate " + unknown);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("scenario_unknown.json: field '$.wings'"), std::string::npos) << r.out;
+  const std::string missing = writeTemp("scenario_orbits.json", base + R"("orbits":["no_such_almanac.txt"]})");
+  r = run("simulate " + missing);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("field '$.orbits[0]'"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("no_such_almanac.txt"), std::string::npos) << r.out;
+  const std::string fault = writeTemp("scenario_fault.json", base + R"("orbits":["x.txt"],"faults":[{"type":"satellite","sats":["Q7"],"start_s":1,"end_s":2,"bias_m":3}]})");
+  r = run("simulate " + fault);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("$.faults[0].sats[0]"), std::string::npos) << r.out;
+}
+
 }  // namespace
 }  // namespace skylane
