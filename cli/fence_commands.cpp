@@ -5,6 +5,7 @@
 #include "cli/skymask_commands.hpp"
 #include "geofence/corridor_file.hpp"
 #include "geofence/fix.hpp"
+#include "geofence/obstruction_files.hpp"
 #include "maps/geoid.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
@@ -60,17 +61,6 @@ void runFenceCheck(const FenceCheckOptions& o) {
   const auto format = airspace::parseZoneFormat(o.format);
   if (!format) throw ParseError("--format", 0, "--format", o.format, "auto, ed269, ed318, geojson or qgc");
   const maps::Terrain terrain = groundModel(o.terrain, o.ground_amsl_m);
-  const airspace::VerticalModel model{terrain, maps::Geoid::egm96()};
-  std::vector<airspace::Zone> zones;
-  for (const std::string& path : o.zones) {
-    std::vector<airspace::Zone> z = airspace::loadZones(path, *format);
-    zones.insert(zones.end(), std::make_move_iterator(z.begin()), std::make_move_iterator(z.end()));
-  }
-  std::vector<maps::Building> buildings;
-  if (!o.buildings.empty()) buildings = maps::loadBuildings(o.buildings, terrain);
-  std::vector<geofence::ScenePiece> pieces = geofence::zonePieces(zones, boxes.frame, model);
-  std::vector<geofence::ScenePiece> obstacles = geofence::obstaclePieces(buildings, boxes.frame);
-  pieces.insert(pieces.end(), obstacles.begin(), obstacles.end());
   geofence::ZonePolicy policy;
   policy.authorisations = spec.authorisations;
   policy.authorisations.insert(o.authorise.begin(), o.authorise.end());
@@ -78,8 +68,9 @@ void runFenceCheck(const FenceCheckOptions& o) {
   options.horizon_m = o.horizon_m;
   options.tolerance_m = o.tolerance_m;
   for (const std::string& w : boxes.limits.warnings) std::cerr << "skylane: warning: " << o.corridor << ": " << w << "\n";
-  const geofence::Fence fence(std::move(boxes.level1), std::move(boxes.level2), std::move(zones), std::move(buildings),
-                              geofence::Scene(std::move(pieces)), policy, options);
+  const geofence::Fence fence(std::move(boxes.level1), std::move(boxes.level2),
+                              geofence::loadObstructions({o.zones, *format, o.buildings}, boxes.frame, terrain,
+                                                         std::move(policy), options));
 
   if (!o.fix.empty()) {
     json doc;

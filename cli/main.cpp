@@ -1,6 +1,7 @@
 /// \file
 /// \brief The `skylane` command: parse, call, print; errors → one line on stderr, exit 2.
 
+#include "cli/approve_commands.hpp"
 #include "cli/fence_commands.hpp"
 #include "cli/integrity_commands.hpp"
 #include "cli/simulate_commands.hpp"
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
   skylane::cli::addSkyMaskCommands(app);
   skylane::cli::addFenceCommands(app);
   skylane::cli::addSimulateCommands(app);
+  skylane::cli::addApproveCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

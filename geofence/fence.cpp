@@ -125,11 +125,9 @@ std::vector<ScenePiece> obstaclePieces(const std::vector<maps::Building>& buildi
   return pieces;
 }
 
-Fence::Fence(Corridor level1, Corridor level2, std::vector<airspace::Zone> zones, std::vector<maps::Building> buildings,
-             Scene scene, ZonePolicy policy, FenceOptions options)
-    : level1_(std::move(level1)),
-      level2_(std::move(level2)),
-      zones_(std::move(zones)),
+Obstructions::Obstructions(std::vector<airspace::Zone> zones, std::vector<maps::Building> buildings, Scene scene,
+                           ZonePolicy policy, FenceOptions options)
+    : zones_(std::move(zones)),
       buildings_(std::move(buildings)),
       scene_(std::move(scene)),
       policy_(std::move(policy)),
@@ -151,16 +149,12 @@ Fence::Fence(Corridor level1, Corridor level2, std::vector<airspace::Zone> zones
   for (const airspace::Zone& z : zones_) zone_counts_.push_back(counts(z, policy_));
 }
 
-FenceVerdict Fence::check(const TimedVolume& v) const {
-  FenceVerdict out;
-  out.checks.push_back(boxCheck(Level::kCorridor, level1_, v.volume, options_.tolerance_m));
-  out.checks.push_back(boxCheck(Level::kAirspace, level2_, v.volume, options_.tolerance_m));
-
+std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) const {
   // Zones count when the policy says so and they are active in the interval; obstacles always.
   const auto accept = [&](PieceOwner owner, std::size_t i) {
     return owner == PieceOwner::kObstacle || (zone_counts_[i] && airspace::isActiveDuring(zones_[i], v.t0, v.t1));
   };
-  const std::vector<SceneHit> hits = scene_.query(v.volume, options_.horizon_m, accept);
+  const std::vector<SceneHit> hits = scene_.query(v.volume, horizon_m, accept);
 
   // One check per zone or obstacle, from the piece that decides it.
   std::vector<Check> near;
@@ -186,7 +180,33 @@ FenceVerdict Fence::check(const TimedVolume& v) const {
     if (severity(a.verdict) != severity(b.verdict)) return severity(a.verdict) > severity(b.verdict);
     return *a.clearance_m < *b.clearance_m;
   });
-  out.checks.insert(out.checks.end(), near.begin(), near.end());
+  return near;
+}
+
+std::vector<Check> Obstructions::check(const TimedVolume& v) const { return check(v, options_.horizon_m); }
+
+std::optional<Check> Obstructions::firstConflict(const TimedVolume& v) const {
+  for (Check& c : check(v, 0.0)) {
+    if (c.verdict != Verdict::kInside) return std::move(c);
+  }
+  return std::nullopt;
+}
+
+Fence::Fence(Corridor level1, Corridor level2, std::vector<airspace::Zone> zones, std::vector<maps::Building> buildings,
+             Scene scene, ZonePolicy policy, FenceOptions options)
+    : Fence(std::move(level1), std::move(level2),
+            Obstructions(std::move(zones), std::move(buildings), std::move(scene), std::move(policy), options)) {}
+
+Fence::Fence(Corridor level1, Corridor level2, Obstructions obstructions)
+    : level1_(std::move(level1)), level2_(std::move(level2)), obstructions_(std::move(obstructions)) {}
+
+FenceVerdict Fence::check(const TimedVolume& v) const {
+  FenceVerdict out;
+  const double tol = obstructions_.options().tolerance_m;
+  out.checks.push_back(boxCheck(Level::kCorridor, level1_, v.volume, tol));
+  out.checks.push_back(boxCheck(Level::kAirspace, level2_, v.volume, tol));
+  std::vector<Check> near = obstructions_.check(v);
+  out.checks.insert(out.checks.end(), std::make_move_iterator(near.begin()), std::make_move_iterator(near.end()));
 
   for (int wanted : {2, 1}) {
     for (std::size_t i = 0; i < out.checks.size() && !out.deciding; ++i) {

@@ -106,6 +106,41 @@ struct TimedVolume {
   ProtectionVolume volume;
 };
 
+/// \brief What a volume must stay clear of: the zones (those the policy counts, when active)
+/// and the obstacles of a scene. Shared by the fence (a protection volume) and the route
+/// planner (the vehicle inflated to its first-level box).
+class Obstructions {
+ public:
+  /// \brief `zones` and `buildings` give names and activity to the scene's pieces (a piece's
+  /// owner_index indexes them).
+  /// \throws std::invalid_argument for a bad tolerance or horizon, or a piece naming a zone or
+  /// obstacle that is not there.
+  Obstructions(std::vector<airspace::Zone> zones, std::vector<maps::Building> buildings, Scene scene,
+               ZonePolicy policy = {}, FenceOptions options = {});
+  /// \brief One check per zone or obstacle within the options' horizon (zones first, the worst
+  /// verdict first, then the nearest); zones count when active at some instant of [t0, t1).
+  [[nodiscard]] std::vector<Check> check(const TimedVolume& v) const;
+  /// \brief The same within `horizon_m`.
+  [[nodiscard]] std::vector<Check> check(const TimedVolume& v, double horizon_m) const;
+  /// \brief The worst zone or obstacle the volume meets or may meet (indeterminate), if any.
+  [[nodiscard]] std::optional<Check> firstConflict(const TimedVolume& v) const;
+
+  [[nodiscard]] const std::vector<airspace::Zone>& zones() const { return zones_; }
+  [[nodiscard]] const std::vector<maps::Building>& buildings() const { return buildings_; }
+  [[nodiscard]] const ZonePolicy& policy() const { return policy_; }
+  [[nodiscard]] const FenceOptions& options() const { return options_; }
+  /// \brief Whether zone i counts under the policy (its activity aside).
+  [[nodiscard]] bool zoneCounts(std::size_t i) const { return zone_counts_.at(i); }
+
+ private:
+  std::vector<airspace::Zone> zones_;
+  std::vector<maps::Building> buildings_;
+  std::vector<bool> zone_counts_;
+  Scene scene_;
+  ZonePolicy policy_;
+  FenceOptions options_;
+};
+
 /// \brief Both box levels, the zones and the obstacles, checked together.
 class Fence {
  public:
@@ -113,26 +148,23 @@ class Fence {
   /// owner_index indexes them).
   Fence(Corridor level1, Corridor level2, std::vector<airspace::Zone> zones, std::vector<maps::Building> buildings,
         Scene scene, ZonePolicy policy = {}, FenceOptions options = {});
+  /// \brief The box levels around prepared obstructions.
+  Fence(Corridor level1, Corridor level2, Obstructions obstructions);
 
   /// \brief Checks one volume against every level; zones count when active at some instant of
   /// [t0, t1) (at t0 when t1 ≤ t0) and counted by the policy.
   [[nodiscard]] FenceVerdict check(const TimedVolume& v) const;
-
   /// \brief Checks each sample of a trajectory (predicted or flown).
   [[nodiscard]] std::vector<FenceVerdict> check(const std::vector<TimedVolume>& samples) const;
 
   [[nodiscard]] const Corridor& level1() const { return level1_; }
   [[nodiscard]] const Corridor& level2() const { return level2_; }
-  [[nodiscard]] const std::vector<airspace::Zone>& zones() const { return zones_; }
+  [[nodiscard]] const std::vector<airspace::Zone>& zones() const { return obstructions_.zones(); }
+  [[nodiscard]] const Obstructions& obstructions() const { return obstructions_; }
 
  private:
   Corridor level1_, level2_;
-  std::vector<airspace::Zone> zones_;
-  std::vector<maps::Building> buildings_;
-  std::vector<bool> zone_counts_;
-  Scene scene_;
-  ZonePolicy policy_;
-  FenceOptions options_;
+  Obstructions obstructions_;
 };
 
 }  // namespace skylane::geofence

@@ -22,27 +22,31 @@ Dops computeDops(const Geometry& g) {
   return d;
 }
 
-std::vector<PredictSample> predictIntegrity(const OrbitSource& orbits, const PredictRequest& req, IntegrityMethod method,
-                                            const std::function<void(std::size_t, std::size_t)>& progress) {
+PredictSample predictAt(const OrbitSource& orbits, const PredictRequest& req, const GpsTime& t, IntegrityMethod method) {
   const Eigen::Vector3d p_user = maps::geodeticToEcef(req.place);
   const double tau = req.model.iono_tau_vert_m.value_or(ionoTauVert_m(geomagneticLatitude(req.place)));
+  PredictSample s;
+  s.t = t;
+  for (const VisibleSatellite& v : orbits.visible(p_user, s.t, req.mask_rad)) {
+    if (req.sky_mask && !req.sky_mask->isVisible(v.look)) {
+      ++s.blocked;
+      continue;
+    }
+    s.sats.push_back({v.sat, v.look});
+  }
+  const Geometry g = buildGeometry(s.sats, req.model, tau);
+  s.dops = computeDops(g);
+  s.pl = protectionLevels(g, method, req.model, req.raim, req.araim);
+  return s;
+}
+
+std::vector<PredictSample> predictIntegrity(const OrbitSource& orbits, const PredictRequest& req, IntegrityMethod method,
+                                            const std::function<void(std::size_t, std::size_t)>& progress) {
   const auto n = static_cast<std::size_t>(std::floor(req.duration_s / req.step_s + 1e-9)) + 1;
   std::vector<PredictSample> out;
   out.reserve(n);
   for (std::size_t k = 0; k < n; ++k) {
-    PredictSample s;
-    s.t = req.start.plus(static_cast<double>(k) * req.step_s);
-    for (const VisibleSatellite& v : orbits.visible(p_user, s.t, req.mask_rad)) {
-      if (req.sky_mask && !req.sky_mask->isVisible(v.look)) {
-        ++s.blocked;
-        continue;
-      }
-      s.sats.push_back({v.sat, v.look});
-    }
-    const Geometry g = buildGeometry(s.sats, req.model, tau);
-    s.dops = computeDops(g);
-    s.pl = protectionLevels(g, method, req.model, req.raim, req.araim);
-    out.push_back(std::move(s));
+    out.push_back(predictAt(orbits, req, req.start.plus(static_cast<double>(k) * req.step_s), method));
     if (progress && (k % 16 == 0 || k + 1 == n)) progress(k + 1, n);
   }
   return out;

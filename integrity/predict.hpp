@@ -49,6 +49,11 @@ struct PredictSample {
 /// \brief DOPs of the geometry's G (unit weights).
 [[nodiscard]] Dops computeDops(const Geometry& g);
 
+/// \brief One epoch at `req.place` and time t (req.start, duration and step are not used):
+/// satellites above the mask and outside the sky mask, DOPs and PLs.
+[[nodiscard]] PredictSample predictAt(const OrbitSource& orbits, const PredictRequest& req, const GpsTime& t,
+                                      IntegrityMethod method);
+
 /// \brief PLs at every step from start to start + duration (inclusive).
 [[nodiscard]] std::vector<PredictSample> predictIntegrity(const OrbitSource& orbits, const PredictRequest& req,
                                                           IntegrityMethod method,

@@ -1,0 +1,128 @@
+#pragma once
+/// \file
+/// \brief Preflight route approval (`skylane approve`): plan a route around the zones active
+/// when the vehicle gets there, wrap it in the corridor (level 1) and airspace (level 2) boxes,
+/// predict HPL/VPL along it at each point's arrival time, check every sample with the fence,
+/// and approve it or reject it with reasons.
+///
+/// Steps, per departure time (the fixed one, or each step of the window in turn):
+/// 1. Plan in the mission's map frame (x, y of the azimuthal-equidistant plane at the start,
+///    z = ellipsoidal height) with OMPL. A state is valid when its height above the terrain is
+///    within [min_agl, max_agl] (and below max_amsl) and the vehicle, inflated to its level-1
+///    box (a cylinder of radius HAL₁ and half-height VAL₁) or, where larger, to 1.2 × the
+///    protection levels predicted there (a grid at cruise height, mid-flight; the margin allows
+///    for their change over the flight), is clear of the buildings and of
+///    every counted zone active at some instant the vehicle could be there: from the earliest
+///    departure plus the straight-line flight time to the state, to the latest departure plus
+///    twice the direct route's flight time plus 2 min (so zones that expire before the vehicle
+///    can arrive, or start after it must have landed, are ignored). The integrity cost is
+///    w·φ(r), r = max(HPL/HAL₂, VPL/VAL₂) predicted on a grid at cruise height (sky mask from
+///    buildings and terrain at each cell), φ(r) = (r/(1 − r))² for r < 0.99 and 10⁴ beyond
+///    (an unavailable PL counts as r = ∞).
+/// 2. Time the route (ETA per point: horizontal distance at cruise speed, height change at
+///    climb speed, whichever takes longer) and build both box levels along it.
+/// 3. Every `sample_s` seconds of flight: the position, its sky mask, the predicted PLs with the
+///    mission's method, and the fence check of the protection volume at that time.
+/// 4. Approved when every sample has a PL and its protection volume is inside level 2 and clear
+///    of the zones and the obstacles. Level-1 exceedances (HPL > HAL₁ or VPL > VAL₁) are counted
+///    and reported: in flight they trigger a monitoring rerun, not a rejection.
+/// 5. Otherwise the violating places are penalised (no state within a protection level of a
+///    violation, plus the level-1 box, is valid) and the route replanned, up to `max_replans`
+///    times; then the next departure of the window. A rejection names where, when and why, and
+///    (for a fixed departure) the earliest departure within 24 h at which the same route passes.
+
+#include "planner/mission.hpp"
+
+#include "geofence/corridor.hpp"
+#include "geofence/fence.hpp"
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace skylane::planner {
+
+/// \brief One route point.
+struct RoutePoint {
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();  ///< map frame x, y [m] and ellipsoidal height [m]
+  double lat_rad = 0.0, lon_rad = 0.0, h_ell_m = 0.0, alt_amsl_m = 0.0;
+  double eta_s = 0.0;  ///< seconds after departure
+};
+
+/// \brief One prediction sample along the route.
+struct PredictedSample {
+  double t_s = 0.0;  ///< after departure
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+  double lat_rad = 0.0, lon_rad = 0.0, h_ell_m = 0.0;
+  bool pl_available = false;
+  double hpl_m = 0.0, vpl_m = 0.0;
+  int satellites = 0;
+  int blocked = 0;  ///< satellites above the mask hidden by buildings or terrain
+  geofence::FenceVerdict fence;
+};
+
+/// \brief Why a route was refused.
+struct Reason {
+  std::string kind;     ///< "zone", "obstacle", "airspace", "integrity", "planning"
+  std::string subject;  ///< zone identifier, building, "HPL"/"VPL", planner status
+  std::string message;  ///< one sentence a person can act on
+  std::optional<double> t_s;  ///< after departure
+  std::optional<double> lat_rad, lon_rad, h_ell_m;
+  std::optional<double> value_m, limit_m;  ///< e.g. HPL and HAL₂, or the overlap with a zone
+};
+
+/// \brief The nearest approach to a zone over the flight.
+struct ZoneApproach {
+  std::string identifier;
+  std::string restriction;
+  bool counted = false;       ///< the policy counts it (PROHIBITED, or not authorised)
+  double min_clearance_m = 0.0;  ///< of the protection volume; 0 when met
+};
+
+/// \brief Planner statistics of the accepted (or last) attempt.
+struct PlannerStats {
+  std::string algorithm;
+  std::string status;
+  bool straight_line = false;
+  double planning_time_s = 0.0;
+  double length_m = 0.0;
+  int attempts = 0;          ///< plans made in all
+  int departures_tried = 0;
+};
+
+/// \brief The outcome of an approval.
+struct ApprovalReport {
+  bool approved = false;
+  std::vector<Reason> reasons;
+  maps::GpsTime departure;
+  std::vector<RoutePoint> route;
+  geofence::LevelLimits limits;
+  std::vector<PredictedSample> predicted;
+  std::vector<ZoneApproach> zones;
+  PlannerStats planner;
+  int level1_exceedances = 0;  ///< samples with HPL > HAL₁ or VPL > VAL₁
+  std::optional<maps::GpsTime> earliest_passing_departure;
+  double elapsed_s = 0.0;
+};
+
+/// \brief Loads the mission's files once and approves (or rejects) it.
+class Approver {
+ public:
+  /// \throws maps::ParseError naming the file and field of a bad input.
+  explicit Approver(Mission mission);
+  ~Approver();
+  Approver(const Approver&) = delete;
+  Approver& operator=(const Approver&) = delete;
+
+  /// \brief Runs the whole approval; `progress(message)` is called at each step.
+  [[nodiscard]] ApprovalReport approve(const std::function<void(const std::string&)>& progress = {});
+
+  [[nodiscard]] const Mission& mission() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace skylane::planner

@@ -1,0 +1,75 @@
+#pragma once
+/// \file
+/// \brief The mission file of `skylane approve`: vehicle, box factors, start and goal (or
+/// waypoints), altitude limits, departure time or window, the airspace and map files, the
+/// orbit files and integrity method, and the planner's settings (schema in the README,
+/// "Mission file"). Unknown and missing fields are errors naming them.
+
+#include "geofence/corridor.hpp"
+#include "integrity/gnss/error_model.hpp"
+#include "integrity/pl_summary.hpp"
+#include "maps/geodesy.hpp"
+#include "maps/time.hpp"
+#include "planner/route_planner.hpp"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace skylane::planner {
+
+/// \brief A place of the mission (latitude, longitude in radians).
+struct MissionPoint {
+  double lat_rad = 0.0;
+  double lon_rad = 0.0;
+};
+
+/// \brief Everything a mission file says (paths resolved against the file's folder).
+struct Mission {
+  std::string source;
+  std::string name;
+  geofence::Vehicle vehicle;
+  double cruise_speed_mps = 10.0;
+  double climb_speed_mps = 3.0;
+  geofence::BoxLevels levels;
+  /// \brief Start, the waypoints to visit in order, and the goal.
+  std::vector<MissionPoint> points;
+  double cruise_agl_m = 60.0;
+  double min_agl_m = 30.0;
+  double max_agl_m = 120.0;
+  std::optional<double> max_amsl_m;
+  maps::GpsTime departure_earliest;
+  maps::GpsTime departure_latest;  ///< = earliest for a fixed departure
+  double departure_step_s = 600.0;
+  std::vector<std::string> zone_files;
+  std::string zone_format = "auto";
+  std::string terrain_file;  ///< empty: flat ground at ground_amsl_m
+  double ground_amsl_m = 0.0;
+  std::string buildings_file;
+  std::set<std::string> authorisations;
+  std::vector<std::string> orbit_files;
+  integrity::IntegrityMethod method = integrity::IntegrityMethod::kRaim;
+  double mask_deg = 5.0;
+  integrity::ErrorModel model;
+  double sample_s = 1.0;       ///< prediction step along the route
+  double cost_weight = 1.0;    ///< weight of the integrity cost against path length
+  double cost_cell_m = 50.0;   ///< grid of the integrity cost field
+  PlannerKind planner = PlannerKind::kRrtStar;
+  double time_limit_s = 1.0;
+  std::uint64_t seed = 1;
+  double resolution_m = 2.0;
+  bool simplify = true;
+  double margin_m = 300.0;     ///< the search box reaches this far beyond start, waypoints and goal
+  int max_replans = 2;         ///< per departure, after a violation
+};
+
+/// \brief Parses a mission document; relative file names are resolved against `base_dir`.
+/// \throws maps::ParseError naming the source, the field and what was expected.
+[[nodiscard]] Mission parseMission(const nlohmann::json& doc, const std::string& source, const std::string& base_dir);
+/// \brief readJsonFile + parseMission.
+[[nodiscard]] Mission loadMission(const std::string& path);
+
+}  // namespace skylane::planner

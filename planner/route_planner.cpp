@@ -1,0 +1,197 @@
+#include "planner/route_planner.hpp"
+
+#include <ompl/base/Planner.h>
+#include <ompl/base/objectives/PathLengthOptimizationObjective.h>
+#include <ompl/base/objectives/StateCostIntegralObjective.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/geometric/PathGeometric.h>
+#include <ompl/geometric/PathSimplifier.h>
+#include <ompl/geometric/SimpleSetup.h>
+#include <ompl/geometric/planners/informedtrees/BITstar.h>
+#include <ompl/geometric/planners/prm/PRMstar.h>
+#include <ompl/geometric/planners/rrt/InformedRRTstar.h>
+#include <ompl/geometric/planners/rrt/RRTstar.h>
+#include <ompl/util/Console.h>
+#include <ompl/util/RandomNumbers.h>
+#include <ompl/util/Time.h>
+
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <stdexcept>
+
+namespace skylane::planner {
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+std::string_view plannerName(PlannerKind k) {
+  switch (k) {
+    case PlannerKind::kRrtStar: return "rrtstar";
+    case PlannerKind::kInformedRrtStar: return "informed_rrtstar";
+    case PlannerKind::kBitStar: return "bitstar";
+    case PlannerKind::kPrmStar: return "prmstar";
+  }
+  return "?";
+}
+
+std::optional<PlannerKind> parsePlannerKind(std::string_view name) {
+  for (PlannerKind k : {PlannerKind::kRrtStar, PlannerKind::kInformedRrtStar, PlannerKind::kBitStar, PlannerKind::kPrmStar}) {
+    if (plannerName(k) == name) return k;
+  }
+  return std::nullopt;
+}
+
+std::string_view pathStatusName(PathStatus s) {
+  switch (s) {
+    case PathStatus::kExact: return "exact";
+    case PathStatus::kApproximate: return "approximate";
+    case PathStatus::kNoSolution: return "no_solution";
+    case PathStatus::kInvalidStart: return "invalid_start";
+    case PathStatus::kInvalidGoal: return "invalid_goal";
+  }
+  return "?";
+}
+
+double polylineLength(const std::vector<Eigen::Vector3d>& points) {
+  double len = 0.0;
+  for (std::size_t i = 1; i < points.size(); ++i) len += (points[i] - points[i - 1]).norm();
+  return len;
+}
+
+namespace {
+
+Eigen::Vector3d toVector(const ob::State* s) {
+  const auto* r = s->as<ob::RealVectorStateSpace::StateType>();
+  return {r->values[0], r->values[1], r->values[2]};
+}
+
+/// ∫ (1 + extra_cost) ds along the path; Euclidean distance is an admissible heuristic.
+class IntegrityCostObjective : public ob::StateCostIntegralObjective {
+ public:
+  IntegrityCostObjective(const ob::SpaceInformationPtr& si, std::function<double(const Eigen::Vector3d&)> extra)
+      : ob::StateCostIntegralObjective(si, true), extra_(std::move(extra)) {
+    description_ = "path length + integrity cost";
+  }
+  ob::Cost stateCost(const ob::State* s) const override { return ob::Cost(1.0 + extra_(toVector(s))); }
+  ob::Cost motionCostHeuristic(const ob::State* s1, const ob::State* s2) const override {
+    return ob::Cost(si_->distance(s1, s2));
+  }
+
+ private:
+  std::function<double(const Eigen::Vector3d&)> extra_;
+};
+
+/// OMPL's seed generator is process-wide; one query at a time re-seeds it so that a seed gives
+/// the same route whatever ran before (OMPL logs an error when re-seeding after first use; its
+/// generator is re-seeded all the same — see ompl/util/RandomNumbers.cpp).
+std::mutex& omplMutex() {
+  static std::mutex m;
+  return m;
+}
+
+bool motionValid(const PathProblem& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const double len = (b - a).norm();
+  const int steps = std::max(1, static_cast<int>(std::ceil(len / p.resolution_m)));
+  for (int i = 0; i <= steps; ++i) {
+    if (!p.is_valid(a + (b - a) * (static_cast<double>(i) / steps))) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+PathResult planPath(const PathProblem& p) {
+  if (!p.is_valid) throw std::invalid_argument("planPath: a state validity predicate is required");
+  if (!(p.resolution_m > 0.0) || !std::isfinite(p.resolution_m)) {
+    throw std::invalid_argument("planPath: the motion resolution must be a positive number of metres");
+  }
+  if (!((p.upper_enu_m - p.lower_enu_m).minCoeff() > 0.0)) {
+    throw std::invalid_argument("planPath: the search box is empty (upper ≤ lower on some axis)");
+  }
+  if (!(p.time_limit_s > 0.0)) throw std::invalid_argument("planPath: the time limit must be > 0 s");
+  PathResult out;
+  out.planner = std::string(plannerName(p.planner));
+  auto inside = [&](const Eigen::Vector3d& x) {
+    return (x.array() >= p.lower_enu_m.array()).all() && (x.array() <= p.upper_enu_m.array()).all();
+  };
+  if (!inside(p.start_enu_m) || !p.is_valid(p.start_enu_m)) {
+    out.status = PathStatus::kInvalidStart;
+    return out;
+  }
+  if (!inside(p.goal_enu_m) || !p.is_valid(p.goal_enu_m)) {
+    out.status = PathStatus::kInvalidGoal;
+    return out;
+  }
+  if (!p.extra_cost && motionValid(p, p.start_enu_m, p.goal_enu_m)) {
+    out.status = PathStatus::kExact;
+    out.points = {p.start_enu_m, p.goal_enu_m};
+    out.length_m = out.cost = polylineLength(out.points);
+    out.straight_line = true;
+    return out;
+  }
+
+  const std::lock_guard<std::mutex> lock(omplMutex());
+  ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
+  ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(p.seed % 4294967291ULL + 1));
+
+  auto space = std::make_shared<ob::RealVectorStateSpace>(3);
+  ob::RealVectorBounds bounds(3);
+  for (int i = 0; i < 3; ++i) {
+    bounds.setLow(i, p.lower_enu_m[i]);
+    bounds.setHigh(i, p.upper_enu_m[i]);
+  }
+  space->setBounds(bounds);
+  og::SimpleSetup ss(space);
+  ss.setStateValidityChecker([&p](const ob::State* s) { return p.is_valid(toVector(s)); });
+  // Motions are checked every resolution_m metres: OMPL takes it as a fraction of the extent.
+  ss.getSpaceInformation()->setStateValidityCheckingResolution(
+      std::min(1.0, p.resolution_m / space->getMaximumExtent()));
+  ob::ScopedState<> start(space), goal(space);
+  for (int i = 0; i < 3; ++i) {
+    start[i] = p.start_enu_m[i];
+    goal[i] = p.goal_enu_m[i];
+  }
+  ss.setStartAndGoalStates(start, goal, 1e-6);
+  const ob::SpaceInformationPtr si = ss.getSpaceInformation();
+  ob::OptimizationObjectivePtr objective;
+  if (p.extra_cost) {
+    objective = std::make_shared<IntegrityCostObjective>(si, p.extra_cost);
+  } else {
+    objective = std::make_shared<ob::PathLengthOptimizationObjective>(si);
+  }
+  const double straight = (p.goal_enu_m - p.start_enu_m).norm();
+  objective->setCostThreshold(ob::Cost(p.good_enough_factor > 1.0 ? p.good_enough_factor * straight : 0.0));
+  ss.setOptimizationObjective(objective);
+  ob::PlannerPtr planner;
+  switch (p.planner) {
+    case PlannerKind::kRrtStar: planner = std::make_shared<og::RRTstar>(si); break;
+    case PlannerKind::kInformedRrtStar: planner = std::make_shared<og::InformedRRTstar>(si); break;
+    case PlannerKind::kBitStar: planner = std::make_shared<og::BITstar>(si); break;
+    case PlannerKind::kPrmStar: planner = std::make_shared<og::PRMstar>(si); break;
+  }
+  ss.setPlanner(planner);
+  ss.setup();
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const ob::PlannerStatus status = ss.solve(p.time_limit_s);
+  out.planning_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (status != ob::PlannerStatus::EXACT_SOLUTION && status != ob::PlannerStatus::APPROXIMATE_SOLUTION) {
+    out.status = PathStatus::kNoSolution;
+    return out;
+  }
+  out.status = status == ob::PlannerStatus::EXACT_SOLUTION ? PathStatus::kExact : PathStatus::kApproximate;
+  og::PathGeometric& path = ss.getSolutionPath();
+  if (p.simplify) {
+    const auto t1 = std::chrono::steady_clock::now();
+    og::PathSimplifier simplifier(si, ob::GoalPtr(), objective);
+    simplifier.simplifyMax(path);
+    out.simplify_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  }
+  for (std::size_t i = 0; i < path.getStateCount(); ++i) out.points.push_back(toVector(path.getState(i)));
+  out.length_m = polylineLength(out.points);
+  out.cost = path.cost(objective).value();
+  return out;
+}
+
+}  // namespace skylane::planner

@@ -1,0 +1,81 @@
+#pragma once
+/// \file
+/// \brief Geometric route planning in the local ENU frame with OMPL (I. A. Şucan, M. Moll and
+/// L. E. Kavraki, "The Open Motion Planning Library", IEEE Robotics & Automation Magazine 19(4),
+/// 2012, doi:10.1109/MRA.2012.2205651). OMPL stays inside route_planner.cpp.
+///
+/// The state space is R³ bounded by the operating limits. A state is valid when the caller's
+/// predicate says so (the vehicle inflated to its first-level box clear of the zones and
+/// obstacles, above the terrain); a motion is checked every `resolution_m` metres (not OMPL's
+/// default fraction of the space's extent). The objective is the path integral of
+/// 1 + extra_cost(p) (StateCostIntegralObjective with interpolation): path length when the
+/// extra cost is zero, longer paths preferred where the predicted protection level nears the
+/// alert limit. Simplification keeps validity: OMPL's PathSimplifier only accepts shortcuts
+/// whose motions are valid.
+///
+/// Planners: RRT* (Karaman & Frazzoli, IJRR 30(7), 2011), Informed RRT* (Gammell, Srinivasa &
+/// Barfoot, IROS 2014), BIT* (Gammell, Srinivasa & Barfoot, ICRA 2015), PRM* (Karaman &
+/// Frazzoli 2011). A seed makes a run reproducible.
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace skylane::planner {
+
+/// \brief The OMPL planners offered.
+enum class PlannerKind { kRrtStar, kInformedRrtStar, kBitStar, kPrmStar };
+
+/// \brief "rrtstar", "informed_rrtstar", "bitstar", "prmstar".
+[[nodiscard]] std::string_view plannerName(PlannerKind k);
+/// \brief Parses a planner name; std::nullopt when unknown.
+[[nodiscard]] std::optional<PlannerKind> parsePlannerKind(std::string_view name);
+
+/// \brief One planning query.
+struct PathProblem {
+  Eigen::Vector3d lower_enu_m = Eigen::Vector3d::Zero();  ///< bounds of the search box
+  Eigen::Vector3d upper_enu_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d start_enu_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d goal_enu_m = Eigen::Vector3d::Zero();
+  std::function<bool(const Eigen::Vector3d&)> is_valid;   ///< required
+  std::function<double(const Eigen::Vector3d&)> extra_cost;  ///< ≥ 0 per metre; empty = path length
+  double resolution_m = 2.0;   ///< motion checking step
+  double time_limit_s = 1.0;
+  std::uint64_t seed = 1;
+  PlannerKind planner = PlannerKind::kRrtStar;
+  bool simplify = true;
+  /// \brief Stop as soon as a path is found whose cost is within this factor of the straight
+  /// line's length (1 = run to the time limit unless the straight line itself is valid).
+  double good_enough_factor = 1.0;
+};
+
+/// \brief How the query ended (OMPL's PlannerStatus, in skylane's words).
+enum class PathStatus { kExact, kApproximate, kNoSolution, kInvalidStart, kInvalidGoal };
+/// \brief "exact", "approximate", "no_solution", "invalid_start", "invalid_goal".
+[[nodiscard]] std::string_view pathStatusName(PathStatus s);
+
+/// \brief The result.
+struct PathResult {
+  PathStatus status = PathStatus::kNoSolution;
+  std::vector<Eigen::Vector3d> points;  ///< start … goal (exact), or start … nearest (approximate)
+  double length_m = 0.0;
+  double cost = 0.0;                    ///< objective value (= length when no extra cost)
+  double planning_time_s = 0.0;
+  double simplify_time_s = 0.0;
+  std::string planner;
+  bool straight_line = false;           ///< the direct segment was valid and taken without search
+};
+
+/// \brief Plans one path. The straight segment is tried first (it is optimal when valid).
+/// \throws std::invalid_argument for empty bounds, a missing predicate or a bad resolution.
+[[nodiscard]] PathResult planPath(const PathProblem& problem);
+
+/// \brief Length of a polyline [m].
+[[nodiscard]] double polylineLength(const std::vector<Eigen::Vector3d>& points);
+
+}  // namespace skylane::planner

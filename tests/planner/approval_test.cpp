@@ -1,0 +1,293 @@
+// Route planning and preflight approval (issue 7): OMPL paths in the mission frame, zones in
+// space and time, rejections with reasons, reproducibility, and corridors that never meet an
+// active prohibited zone (checked independently of the geofence).
+#include "planner/approval.hpp"
+#include "planner/route_planner.hpp"
+
+#include "geofence/fence.hpp"
+#include "maps/parse_error.hpp"
+#include "tests/test_util.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+
+namespace skylane::planner {
+namespace {
+
+using nlohmann::json;
+
+// --- planPath on its own ---------------------------------------------------------------------
+
+PathProblem openBox() {
+  PathProblem p;
+  p.lower_enu_m = Eigen::Vector3d(-100, -300, 0);
+  p.upper_enu_m = Eigen::Vector3d(1100, 300, 100);
+  p.start_enu_m = Eigen::Vector3d(0, 0, 50);
+  p.goal_enu_m = Eigen::Vector3d(1000, 0, 50);
+  p.resolution_m = 1.0;
+  p.time_limit_s = 0.5;
+  return p;
+}
+
+/// A vertical cylinder of radius 150 m across the straight line.
+bool outsidePillar(const Eigen::Vector3d& x) { return (x.head<2>() - Eigen::Vector2d(500, 0)).norm() > 150.0; }
+
+TEST(PlannerPath, StraightLineWhenNothingIsInTheWay) {
+  PathProblem p = openBox();
+  p.is_valid = [](const Eigen::Vector3d&) { return true; };
+  const PathResult r = planPath(p);
+  EXPECT_EQ(r.status, PathStatus::kExact);
+  EXPECT_TRUE(r.straight_line);
+  ASSERT_EQ(r.points.size(), 2u);
+  EXPECT_NEAR(r.length_m, 1000.0, 1e-9);
+}
+
+TEST(PlannerPath, EveryPlannerBendsAroundAnObstacleAndEveryMotionStaysValid) {
+  for (PlannerKind k : {PlannerKind::kRrtStar, PlannerKind::kInformedRrtStar, PlannerKind::kBitStar, PlannerKind::kPrmStar}) {
+    PathProblem p = openBox();
+    p.is_valid = outsidePillar;
+    p.planner = k;
+    const PathResult r = planPath(p);
+    ASSERT_EQ(r.status, PathStatus::kExact) << plannerName(k);
+    EXPECT_FALSE(r.straight_line);
+    EXPECT_GE(r.points.size(), 3u) << plannerName(k);
+    // The shortest way round: two tangents and an arc, 2·√(500² − 150²) + 150·(π − 2·acos(150/500))·… ≥ 1000.
+    const double tangent = std::sqrt(500.0 * 500.0 - 150.0 * 150.0);
+    const double arc = 150.0 * (M_PI - 2.0 * std::acos(150.0 / 500.0));
+    const double shortest = 2.0 * tangent + arc;
+    EXPECT_GE(r.length_m, shortest - 1e-6) << plannerName(k);
+    EXPECT_LE(r.length_m, 1.25 * shortest) << plannerName(k);
+    EXPECT_TRUE(test::nearVec(r.points.front(), p.start_enu_m, 1e-9));
+    EXPECT_TRUE(test::nearVec(r.points.back(), p.goal_enu_m, 1e-6));
+    // Simplification never breaks validity: every 0.25 m of the final path is valid.
+    for (std::size_t i = 1; i < r.points.size(); ++i) {
+      const Eigen::Vector3d a = r.points[i - 1], b = r.points[i];
+      const int n = static_cast<int>(std::ceil((b - a).norm() / 0.25));
+      for (int s = 0; s <= n; ++s) {
+        EXPECT_TRUE(outsidePillar(a + (b - a) * (static_cast<double>(s) / n))) << plannerName(k) << " segment " << i;
+      }
+    }
+  }
+}
+
+TEST(PlannerPath, SameSeedSameRouteWithinOneProcess) {
+  PathProblem p = openBox();
+  p.is_valid = outsidePillar;
+  p.seed = 42;
+  const PathResult a = planPath(p);
+  const PathResult other = [&] {
+    PathProblem q = p;
+    q.seed = 43;
+    return planPath(q);
+  }();
+  const PathResult b = planPath(p);
+  ASSERT_EQ(a.points.size(), b.points.size());
+  for (std::size_t i = 0; i < a.points.size(); ++i) EXPECT_EQ(a.points[i], b.points[i]) << i;
+  EXPECT_EQ(other.status, PathStatus::kExact);
+}
+
+TEST(PlannerPath, InvalidStartOrGoalIsSaid) {
+  PathProblem p = openBox();
+  p.is_valid = outsidePillar;
+  p.goal_enu_m = Eigen::Vector3d(500, 0, 50);
+  EXPECT_EQ(planPath(p).status, PathStatus::kInvalidGoal);
+  p.start_enu_m = Eigen::Vector3d(500, 10, 50);
+  EXPECT_EQ(planPath(p).status, PathStatus::kInvalidStart);
+  p.resolution_m = 0;
+  EXPECT_THROW((void)planPath(p), std::invalid_argument);
+}
+
+// --- approval -------------------------------------------------------------------------------
+
+constexpr double kLat0 = 47.3712, kLon0 = 8.5320;
+
+json circleZone(const std::string& id, double lat, double lon, double radius_m, const json& applicability) {
+  return {{"identifier", id}, {"country", "CHE"}, {"name", id}, {"type", "COMMON"}, {"restriction", "PROHIBITED"},
+          {"reason", {"OTHER"}}, {"applicability", applicability},
+          {"geometry",
+           {{{"uomDimensions", "M"}, {"lowerLimit", 0}, {"lowerVerticalReference", "AGL"}, {"upperLimit", 300},
+             {"upperVerticalReference", "AGL"},
+             {"horizontalProjection", {{"type", "Circle"}, {"center", {lon, lat}}, {"radius", radius_m}}}}}}};
+}
+
+json permanent() { return json::array({{{"permanent", "YES"}}}); }
+json during(const std::string& from, const std::string& to) {
+  return json::array({{{"permanent", "NO"}, {"startDateTime", from}, {"endDateTime", to}}});
+}
+
+/// A mission from (kLat0, kLon0) 1.5 km east, departing 2020-01-01T14:00Z, with these zones.
+Mission missionWith(const std::vector<json>& zones, const std::string& name, double goal_dlon = 0.0198) {
+  json z{{"formatVersion", "1.0.0"}, {"UASZoneList", zones}};
+  const std::string zone_file = test::scratchPath(name + "_zones.json");
+  std::ofstream(zone_file) << z.dump();
+  json m{{"name", name},
+         {"vehicle", {{"lateral_m", 1.2}, {"longitudinal_m", 1.0}, {"cruise_speed_mps", 12}}},
+         {"k1", 1.2},
+         {"k2", 150},
+         {"start", {{"lat", kLat0}, {"lon", kLon0}}},
+         {"goal", {{"lat", kLat0}, {"lon", kLon0 + goal_dlon}}},
+         {"departure", "2020-01-01T14:00:00Z"},
+         {"zones", {zone_file}},
+         {"ground_amsl_m", 408},
+         {"orbits", {test::dataPath("gnss/alm01jan2020.txt")}},
+         {"integrity", {{"cost_weight", 0.0}}},
+         {"planner", {{"time_limit_s", 0.3}, {"seed", 3}}}};
+  return parseMission(m, name + ".json", ".");
+}
+
+double minDistanceToCentre(const ApprovalReport& r, const Eigen::Vector2d& centre) {
+  double best = 1e300;
+  for (const PredictedSample& s : r.predicted) best = std::min(best, (s.xyz.head<2>() - centre).norm());
+  return best;
+}
+
+TEST(Approval, ClearRouteIsApprovedAsTheStraightLine) {
+  Approver a(missionWith({}, "clear"));
+  const ApprovalReport r = a.approve();
+  ASSERT_TRUE(r.approved) << (r.reasons.empty() ? "" : r.reasons.front().message);
+  EXPECT_TRUE(r.planner.straight_line);
+  ASSERT_EQ(r.route.size(), 2u);
+  // 1.5 km at 12 m/s: ETA at the goal from the route's own length.
+  EXPECT_NEAR(r.route.back().eta_s, r.planner.length_m / 12.0, 1e-6);
+  EXPECT_NEAR(r.planner.length_m, 1498.0, 5.0);
+  // One sample per second plus the end, each with a PL inside level 2.
+  EXPECT_EQ(r.predicted.size(), static_cast<std::size_t>(std::floor(r.route.back().eta_s)) + 2);
+  for (const PredictedSample& s : r.predicted) {
+    EXPECT_TRUE(s.pl_available);
+    EXPECT_LE(s.hpl_m, r.limits.level2.hal_m);
+  }
+  EXPECT_NEAR(r.limits.level1.hal_m, 1.44, 1e-12);  // k₁ · lateral
+  EXPECT_NEAR(r.limits.level2.val_m, 150.0, 1e-12);  // k₂ · longitudinal
+}
+
+TEST(Approval, GoalInsideAProhibitedZoneIsRejectedWithItsIdentifier) {
+  const double goal_lon = kLon0 + 0.0198;
+  Approver a(missionWith({circleZone("EX-TEST-GOAL", kLat0, goal_lon, 100, permanent())}, "goal_in_zone"));
+  const ApprovalReport r = a.approve();
+  EXPECT_FALSE(r.approved);
+  ASSERT_FALSE(r.reasons.empty());
+  EXPECT_EQ(r.reasons.front().kind, "zone");
+  EXPECT_EQ(r.reasons.front().subject, "EX-TEST-GOAL");
+  EXPECT_NE(r.reasons.front().message.find("goal"), std::string::npos) << r.reasons.front().message;
+}
+
+TEST(Approval, RouteBendsAroundAProhibitedZoneOnTheDirectLine) {
+  const double mid_lon = kLon0 + 0.0099;
+  Approver a(missionWith({circleZone("EX-TEST-MID", kLat0, mid_lon, 150, permanent())}, "bend"));
+  const ApprovalReport r = a.approve();
+  ASSERT_TRUE(r.approved) << (r.reasons.empty() ? "" : r.reasons.front().message);
+  EXPECT_FALSE(r.planner.straight_line);
+  EXPECT_GT(r.route.size(), 2u);
+  EXPECT_GT(r.planner.length_m, 1498.0 + 10.0);
+  ASSERT_FALSE(r.zones.empty());
+  EXPECT_EQ(r.zones.front().identifier, "EX-TEST-MID");
+  EXPECT_GT(r.zones.front().min_clearance_m, 0.0);
+}
+
+TEST(Approval, ZoneActiveAtArrivalIsAvoidedAndOneExpiredBeforeArrivalIsNot) {
+  const double mid_lon = kLon0 + 0.0099;
+  // Active from 14:00:30Z: the vehicle reaches it about a minute after departure.
+  Approver active(missionWith({circleZone("EX-TEST-LATER", kLat0, mid_lon, 150,
+                                          during("2020-01-01T14:00:30Z", "2020-01-01T15:00:00Z"))},
+                              "active_at_arrival"));
+  const ApprovalReport ra = active.approve();
+  ASSERT_TRUE(ra.approved);
+  EXPECT_FALSE(ra.planner.straight_line);
+  const maps::PlaneFrame frame(maps::deg2rad(kLat0), maps::deg2rad(kLon0));
+  const Eigen::Vector2d centre = frame.toPlane(maps::deg2rad(kLat0), maps::deg2rad(mid_lon));
+  EXPECT_GT(minDistanceToCentre(ra, centre), 150.0);
+  // Over at 13:50Z, before departure: the straight line is flown through its old outline.
+  Approver expired(missionWith({circleZone("EX-TEST-EARLIER", kLat0, mid_lon, 150,
+                                           during("2020-01-01T12:00:00Z", "2020-01-01T13:50:00Z"))},
+                               "expired"));
+  const ApprovalReport re = expired.approve();
+  ASSERT_TRUE(re.approved);
+  EXPECT_TRUE(re.planner.straight_line);
+  EXPECT_LT(minDistanceToCentre(re, centre), 10.0);
+}
+
+TEST(Approval, SameSeedSameRoute) {
+  const double mid_lon = kLon0 + 0.0099;
+  const std::vector<json> zones{circleZone("EX-TEST-MID", kLat0 + 0.0005, mid_lon, 150, permanent())};
+  Approver a(missionWith(zones, "seed_a"));
+  Approver b(missionWith(zones, "seed_b"));
+  const ApprovalReport ra = a.approve(), rb = b.approve();
+  ASSERT_EQ(ra.route.size(), rb.route.size());
+  for (std::size_t i = 0; i < ra.route.size(); ++i) EXPECT_EQ(ra.route[i].xyz, rb.route[i].xyz) << i;
+}
+
+// Random airspaces: an approved route's level-1 corridor (the vehicle box along it) never meets
+// a zone active while it is flown. Checked every metre against the circles' own centre and
+// radius in the mission plane — an independent computation, not the fence's scene.
+TEST(Approval, ApprovedCorridorsNeverMeetAnActiveProhibitedZone) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int approved = 0;
+  for (int scene = 0; scene < 8; ++scene) {
+    std::vector<json> zones;
+    for (int k = 0; k < 6; ++k) {
+      const double lat = kLat0 + (u(rng) - 0.5) * 0.006;
+      const double lon = kLon0 + 0.003 + u(rng) * 0.014;
+      zones.push_back(circleZone("Z" + std::to_string(scene) + "-" + std::to_string(k), lat, lon, 40 + 80 * u(rng), permanent()));
+    }
+    const std::string name = "random_" + std::to_string(scene);
+    Mission m = missionWith(zones, name);
+    m.time_limit_s = 0.3;
+    Approver a(m);
+    const ApprovalReport r = a.approve();
+    if (!r.approved) continue;
+    ++approved;
+    // Walk the corridor against the zones as written in the file.
+    const maps::PlaneFrame frame(maps::deg2rad(kLat0), maps::deg2rad(kLon0));
+    for (std::size_t i = 1; i < r.route.size(); ++i) {
+      const Eigen::Vector3d p0 = r.route[i - 1].xyz, p1 = r.route[i].xyz;
+      const int n = static_cast<int>(std::ceil((p1 - p0).norm()));
+      for (int s = 0; s <= n; ++s) {
+        const double f = static_cast<double>(s) / n;
+        const Eigen::Vector3d p = p0 + (p1 - p0) * f;
+        for (const json& z : zones) {
+          const auto& c = z["geometry"][0]["horizontalProjection"]["center"];
+          const Eigen::Vector2d centre = frame.toPlane(maps::deg2rad(c[1].get<double>()), maps::deg2rad(c[0].get<double>()));
+          const double radius = z["geometry"][0]["horizontalProjection"]["radius"].get<double>();
+          EXPECT_GT((p.head<2>() - centre).norm(), radius + r.limits.level1.hal_m - 0.01)
+              << name << " segment " << i << " zone " << z["identifier"];
+        }
+      }
+    }
+  }
+  EXPECT_GE(approved, 5);
+}
+
+TEST(Mission, ErrorsNameTheField) {
+  const json good{{"vehicle", {{"lateral_m", 1}, {"longitudinal_m", 1}, {"cruise_speed_mps", 10}}},
+                  {"start", {{"lat", 47}, {"lon", 8}}},
+                  {"goal", {{"lat", 47.01}, {"lon", 8}}},
+                  {"departure", "2020-01-01T14:00:00Z"},
+                  {"orbits", {"a.txt"}}};
+  EXPECT_NO_THROW((void)parseMission(good, "m.json", "."));
+  struct Case {
+    std::function<void(json&)> edit;
+    std::string expected;
+  };
+  const std::vector<Case> cases{
+      {[](json& j) { j["wings"] = 2; }, "$.wings"},
+      {[](json& j) { j.erase("goal"); }, "$.goal"},
+      {[](json& j) { j["planner"] = {{"algorithm", "astar"}}; }, "rrtstar"},
+      {[](json& j) { j["departure"] = "tomorrow"; }, "RFC 3339"},
+      {[](json& j) { j["altitude"] = {{"cruise_agl_m", 200}}; }, "cruise_agl_m ≤ max_agl_m"},
+      {[](json& j) { j["vehicle"]["cruise_speed_mps"] = 0; }, "$.vehicle.cruise_speed_mps"},
+  };
+  for (const Case& c : cases) {
+    json j = good;
+    c.edit(j);
+    const std::string msg = test::messageOf<maps::ParseError>([&] { (void)parseMission(j, "m.json", "."); });
+    EXPECT_NE(msg.find(c.expected), std::string::npos) << msg;
+    EXPECT_EQ(msg.rfind("m.json", 0), 0u) << msg;
+  }
+}
+
+}  // namespace
+}  // namespace skylane::planner
