@@ -3,12 +3,15 @@
 #include "cli/json_numbers.hpp"
 #include "cli/svg_plot.hpp"
 #include "cli/zones_commands.hpp"
+#include "maps/file_digest.hpp"
 #include "planner/approval.hpp"
+#include "planner/report_formats.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -104,7 +107,107 @@ json reportJson(const planner::ApprovalReport& r, const planner::Mission& m) {
                   {"departures_tried", r.planner.departures_tried},
                   {"seed", m.seed}};
   j["elapsed_s"] = std::round(r.elapsed_s * 1e3) / 1e3;
+  // The inputs' digests: the approval can be audited and replayed against exactly these files.
+  json inputs = json::array();
+  auto add = [&inputs](const std::string& role, const std::string& path) {
+    if (!path.empty()) inputs.push_back({{"role", role}, {"file", path}, {"sha256", maps::fileSha256Hex(path)}});
+  };
+  add("mission", m.source);
+  for (const std::string& f : m.zone_files) add("zones", f);
+  add("buildings", m.buildings_file);
+  add("terrain", m.terrain_file);
+  for (const std::string& f : m.orbit_files) add("orbits", f);
+  j["inputs"] = inputs;
+  j["software"] = {{"name", "skylane"}, {"planner_seed", m.seed}};
   return j;
+}
+
+std::vector<std::pair<double, double>> toPlane(const maps::PlaneFrame& frame, const std::vector<Eigen::Vector2d>& xy) {
+  std::vector<std::pair<double, double>> out;
+  for (const Eigen::Vector2d& v : xy) out.emplace_back(v.x(), v.y());
+  (void)frame;
+  return out;
+}
+
+std::string mapSvg(const planner::ApprovalReport& r, const planner::Approver& a) {
+  const maps::PlaneFrame& frame = a.frame();
+  std::vector<MapShape> shapes;
+  const geofence::Obstructions& ob = a.obstructions();
+  for (std::size_t i = 0; i < ob.zones().size(); ++i) {
+    const airspace::Zone& z = ob.zones()[i];
+    const bool counted = ob.zoneCounts(i);
+    const bool timed = std::any_of(z.applicability.begin(), z.applicability.end(), [](const airspace::Applicability& ap) {
+      return !ap.permanent || ap.start || ap.end || !ap.schedule.empty();
+    });
+    for (const airspace::Volume& v : z.volumes) {
+      MapShape sh;
+      if (v.outline.kind == airspace::Outline::Kind::kCircle) {
+        const Eigen::Vector2d c = frame.toPlane(v.outline.centre.lat_rad, v.outline.centre.lon_rad);
+        for (int k = 0; k < 72; ++k) {
+          const double t = 2.0 * M_PI * k / 72.0;
+          sh.xy.emplace_back(c.x() + v.outline.radius_m * std::cos(t), c.y() + v.outline.radius_m * std::sin(t));
+        }
+      } else {
+        for (const airspace::LatLon& p : v.outline.ring) {
+          const Eigen::Vector2d q = frame.toPlane(p.lat_rad, p.lon_rad);
+          sh.xy.emplace_back(q.x(), q.y());
+        }
+      }
+      sh.fill = counted ? (timed ? "#ff7f0e" : "#d62728") : "#2ca02c";
+      sh.stroke = sh.fill;
+      sh.fill_opacity = 0.18;
+      sh.dashed = timed;
+      sh.legend = counted ? (timed ? "zone, time-limited" : "zone, prohibited / not authorised") : "zone, authorised or open";
+      shapes.push_back(std::move(sh));
+    }
+  }
+  for (const maps::Building& b : ob.buildings()) {
+    MapShape sh;
+    for (const auto& [lat, lon] : b.ring_lat_lon_rad) {
+      const Eigen::Vector2d q = frame.toPlane(lat, lon);
+      sh.xy.emplace_back(q.x(), q.y());
+    }
+    sh.fill = "#7f7f7f";
+    sh.stroke = "#555555";
+    sh.fill_opacity = 0.5;
+    sh.legend = "building";
+    shapes.push_back(std::move(sh));
+  }
+  for (int level : {2, 1}) {
+    const double hal = level == 1 ? r.limits.level1.hal_m : r.limits.level2.hal_m;
+    for (std::size_t i = 1; i < r.route.size(); ++i) {
+      MapShape sh;
+      sh.xy = toPlane(frame, planner::segmentOutline(r.route[i - 1].xyz, r.route[i].xyz, hal));
+      sh.fill = level == 1 ? "#1f77b4" : "#aec7e8";
+      sh.stroke = sh.fill;
+      sh.fill_opacity = level == 1 ? 0.5 : 0.15;
+      sh.legend = level == 1 ? "corridor (level 1)" : "airspace (level 2)";
+      shapes.push_back(std::move(sh));
+    }
+  }
+  std::vector<MapLine> lines;
+  MapLine route;
+  route.stroke = "#000000";
+  route.legend = "route";
+  for (const planner::RoutePoint& p : r.route) route.xy.emplace_back(p.xyz.x(), p.xyz.y());
+  if (!route.xy.empty()) lines.push_back(route);
+  std::vector<MapMarker> markers;
+  const auto& pts = a.mission().points;
+  const Eigen::Vector2d s0 = frame.toPlane(pts.front().lat_rad, pts.front().lon_rad);
+  const Eigen::Vector2d g0 = frame.toPlane(pts.back().lat_rad, pts.back().lon_rad);
+  markers.push_back({s0.x(), s0.y(), "start", "#2ca02c"});
+  markers.push_back({g0.x(), g0.y(), "goal", "#d62728"});
+  for (const planner::Reason& x : r.reasons) {
+    if (!x.lat_rad || !x.lon_rad) continue;
+    const Eigen::Vector2d q = frame.toPlane(*x.lat_rad, *x.lon_rad);
+    markers.push_back({q.x(), q.y(), x.kind + ": " + x.subject, "#9467bd"});
+  }
+  std::vector<std::string> footer{
+      std::string(r.approved ? "APPROVED" : "REJECTED") + ", departure " + maps::formatRfc3339(r.departure) + ", route " +
+      std::to_string(static_cast<int>(std::round(r.planner.length_m))) + " m, planner " + r.planner.algorithm};
+  for (const planner::Reason& x : r.reasons) footer.push_back(x.message);
+  return renderPlanMapSvg("skylane approve: " + (a.mission().name.empty() ? a.mission().source : a.mission().name), shapes,
+                          lines, markers, 250.0, footer);
 }
 
 std::string plSvg(const planner::ApprovalReport& r, const planner::Mission& m) {
@@ -142,7 +245,15 @@ void runApprove(const ApproveOptions& o) {
   if (!o.out_dir.empty()) {
     std::filesystem::create_directories(o.out_dir);
     std::ofstream(std::filesystem::path(o.out_dir) / "report.json") << j.dump(2) << "\n";
-    std::ofstream(std::filesystem::path(o.out_dir) / "pl.svg") << plSvg(r, approver.mission());
+    const std::filesystem::path dir(o.out_dir);
+    std::ofstream(dir / "pl.svg") << plSvg(r, approver.mission());
+    std::ofstream(dir / "map.svg") << mapSvg(r, approver);
+    std::ofstream(dir / "route.geojson") << planner::routeGeoJson(r, approver.mission(), approver.frame()).dump(1) << "\n";
+    const json intent{{"operational_intent", {{"volumes", planner::operationalIntentVolumes(r, approver.frame(), 2, 30.0)},
+                                               {"state", r.approved ? "Accepted" : "Rejected"},
+                                               {"priority", 0}}},
+                      {"corridor_volumes", planner::operationalIntentVolumes(r, approver.frame(), 1, 30.0)}};
+    std::ofstream(dir / "operational_intent.json") << intent.dump(1) << "\n";
   }
   std::cout << j.dump(2) << "\n";
   std::cerr << "skylane: approve: " << (r.approved ? "APPROVED" : "REJECTED") << " in " << r.elapsed_s << " s";
@@ -158,7 +269,9 @@ void addApproveCommands(CLI::App& app) {
   CLI::App* c = app.add_subcommand("approve",
                                    "plan a route around active zones, predict its protection levels and approve or reject it");
   c->add_option("mission", o->mission, "mission JSON file")->required()->check(CLI::ExistingFile);
-  c->add_option("--out", o->out_dir, "also write report.json and pl.svg into this directory");
+  c->add_option("--out", o->out_dir,
+                 "also write report.json, route.geojson, operational_intent.json (ASTM F3548 Volume4D), map.svg and "
+                 "pl.svg into this directory");
   c->add_flag("--progress", o->progress, "print the steps even when stderr is not a terminal");
   c->callback([o]() { runApprove(*o); });
 }

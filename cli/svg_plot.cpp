@@ -302,4 +302,90 @@ std::string renderStanfordSvg(const std::string& title, const std::vector<Stanfo
   return s.str();
 }
 
+std::string renderPlanMapSvg(const std::string& title, const std::vector<MapShape>& shapes,
+                             const std::vector<MapLine>& lines, const std::vector<MapMarker>& markers, double margin_m,
+                             const std::vector<std::string>& footer) {
+  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+  auto grow = [&](double x, double y) {
+    x0 = std::min(x0, x);
+    x1 = std::max(x1, x);
+    y0 = std::min(y0, y);
+    y1 = std::max(y1, y);
+  };
+  for (const MapLine& l : lines) {
+    for (const auto& [x, y] : l.xy) grow(x, y);
+  }
+  for (const MapMarker& m : markers) grow(m.x, m.y);
+  if (x0 > x1) grow(0, 0);
+  x0 -= margin_m;
+  x1 += margin_m;
+  y0 -= margin_m;
+  y1 += margin_m;
+  const double plot = 720, left = 20, top = 50, legend_w = 240;
+  const double scale = plot / std::max(x1 - x0, y1 - y0);
+  const double w = (x1 - x0) * scale, h = (y1 - y0) * scale;
+  const double width = left + w + legend_w, height = top + h + 40 + 16.0 * static_cast<double>(footer.size());
+  auto X = [&](double x) { return left + (x - x0) * scale; };
+  auto Y = [&](double y) { return top + (y1 - y) * scale; };
+  std::ostringstream s;
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << fmt(width) << "\" height=\"" << fmt(height)
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  s << "<text x=\"" << fmt(width / 2) << "\" y=\"26\" text-anchor=\"middle\" font-size=\"15\">" << escape(title) << "</text>\n";
+  s << "<defs><clipPath id=\"view\"><rect x=\"" << fmt(left) << "\" y=\"" << fmt(top) << "\" width=\"" << fmt(w)
+    << "\" height=\"" << fmt(h) << "\"/></clipPath></defs>\n";
+  s << "<rect x=\"" << fmt(left) << "\" y=\"" << fmt(top) << "\" width=\"" << fmt(w) << "\" height=\"" << fmt(h)
+    << "\" fill=\"#fbfbf8\" stroke=\"#999\"/>\n<g clip-path=\"url(#view)\">\n";
+  std::vector<std::pair<std::string, std::string>> legend;  // text, svg swatch
+  auto remember = [&legend](const std::string& text, const std::string& swatch) {
+    if (text.empty()) return;
+    for (const auto& l : legend) {
+      if (l.first == text) return;
+    }
+    legend.emplace_back(text, swatch);
+  };
+  for (const MapShape& sh : shapes) {
+    if (sh.xy.size() < 2) continue;
+    s << "<polygon points=\"";
+    for (const auto& [x, y] : sh.xy) s << fmt(X(x)) << "," << fmt(Y(y)) << " ";
+    s << "\" fill=\"" << sh.fill << "\" fill-opacity=\"" << sh.fill_opacity << "\" stroke=\"" << sh.stroke << "\""
+      << (sh.dashed ? " stroke-dasharray=\"5,3\"" : "") << "/>\n";
+    remember(sh.legend, "<rect width=\"16\" height=\"12\" fill=\"" + sh.fill + "\" fill-opacity=\"" +
+                            std::to_string(sh.fill_opacity) + "\" stroke=\"" + sh.stroke + "\"/>");
+  }
+  for (const MapLine& l : lines) {
+    s << "<polyline fill=\"none\" stroke=\"" << l.stroke << "\" stroke-width=\"" << l.width_px << "\" points=\"";
+    for (const auto& [x, y] : l.xy) s << fmt(X(x)) << "," << fmt(Y(y)) << " ";
+    s << "\"/>\n";
+    remember(l.legend, "<line x1=\"0\" y1=\"6\" x2=\"16\" y2=\"6\" stroke=\"" + l.stroke + "\" stroke-width=\"" +
+                           fmt(l.width_px) + "\"/>");
+  }
+  s << "</g>\n";
+  for (const MapMarker& m : markers) {
+    s << "<circle cx=\"" << fmt(X(m.x)) << "\" cy=\"" << fmt(Y(m.y)) << "\" r=\"5\" fill=\"" << m.colour << "\"/>\n";
+    s << "<text x=\"" << fmt(X(m.x) + 8) << "\" y=\"" << fmt(Y(m.y) - 6) << "\">" << escape(m.label) << "</text>\n";
+  }
+  // Scale bar (a nice length near a fifth of the view) and north arrow.
+  const double bar_m = niceStep((x1 - x0) / 5.0 * 2.0, 2);
+  const double bx = left + 12, by = top + h - 14;
+  s << "<line x1=\"" << fmt(bx) << "\" y1=\"" << fmt(by) << "\" x2=\"" << fmt(bx + bar_m * scale) << "\" y2=\"" << fmt(by)
+    << "\" stroke=\"black\" stroke-width=\"3\"/>\n<text x=\"" << fmt(bx) << "\" y=\"" << fmt(by - 6) << "\">" << fmt(bar_m)
+    << " m</text>\n";
+  const double nx = left + w - 24, ny = top + 16;
+  s << "<path d=\"M" << fmt(nx) << "," << fmt(ny - 10) << " l7,20 l-7,-5 l-7,5 z\" fill=\"black\"/><text x=\"" << fmt(nx)
+    << "\" y=\"" << fmt(ny + 24) << "\" text-anchor=\"middle\">N</text>\n";
+  double ly = top + 10;
+  for (const auto& [text, swatch] : legend) {
+    s << "<g transform=\"translate(" << fmt(left + w + 14) << "," << fmt(ly) << ")\">" << swatch << "<text x=\"22\" y=\"11\">"
+      << escape(text) << "</text></g>\n";
+    ly += 20;
+  }
+  double fy = top + h + 22;
+  for (const std::string& line : footer) {
+    s << "<text x=\"" << fmt(left) << "\" y=\"" << fmt(fy) << "\" font-size=\"11\">" << escape(line) << "</text>\n";
+    fy += 16;
+  }
+  s << "</svg>\n";
+  return s.str();
+}
+
 }  // namespace skylane::cli

@@ -62,4 +62,36 @@ struct StanfordPanel {
 /// unavailable), as drawn by Stanford's WAAS lab.
 [[nodiscard]] std::string renderStanfordSvg(const std::string& title, const std::vector<StanfordPanel>& panels);
 
+/// \brief A filled outline on a plan map (metres east, north).
+struct MapShape {
+  std::vector<std::pair<double, double>> xy;
+  std::string fill;        ///< CSS colour, "none" for none
+  std::string stroke;
+  double fill_opacity = 0.3;
+  bool dashed = false;
+  std::string legend;      ///< shown once per distinct legend text
+};
+
+/// \brief A line on a plan map.
+struct MapLine {
+  std::vector<std::pair<double, double>> xy;
+  std::string stroke;
+  double width_px = 2.0;
+  std::string legend;
+};
+
+/// \brief A labelled point on a plan map.
+struct MapMarker {
+  double x = 0, y = 0;
+  std::string label;
+  std::string colour;
+};
+
+/// \brief A plan view in metres (equal scale on both axes, north up) of shapes, then lines,
+/// then markers, fitted to the lines and markers (plus `margin_m`), with a scale bar, a north
+/// arrow and a legend; shapes are clipped to the view.
+[[nodiscard]] std::string renderPlanMapSvg(const std::string& title, const std::vector<MapShape>& shapes,
+                                           const std::vector<MapLine>& lines, const std::vector<MapMarker>& markers,
+                                           double margin_m, const std::vector<std::string>& footer);
+
 }  // namespace skylane::cli

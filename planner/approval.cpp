@@ -254,6 +254,8 @@ struct Approver::Impl {
 Approver::Approver(Mission mission) : impl_(std::make_unique<Impl>(std::move(mission))) {}
 Approver::~Approver() = default;
 const Mission& Approver::mission() const { return impl_->m; }
+const maps::PlaneFrame& Approver::frame() const { return impl_->frame; }
+const geofence::Obstructions& Approver::obstructions() const { return *impl_->obstructions; }
 
 namespace {
 

@@ -35,6 +35,7 @@
 
 #include "geofence/corridor.hpp"
 #include "geofence/fence.hpp"
+#include "maps/plane_frame.hpp"
 
 #include <functional>
 #include <optional>
@@ -119,6 +120,10 @@ class Approver {
   [[nodiscard]] ApprovalReport approve(const std::function<void(const std::string&)>& progress = {});
 
   [[nodiscard]] const Mission& mission() const;
+  /// \brief The mission's map frame (origin at the start).
+  [[nodiscard]] const maps::PlaneFrame& frame() const;
+  /// \brief The zones and obstacles loaded from the mission's files.
+  [[nodiscard]] const geofence::Obstructions& obstructions() const;
 
  private:
   struct Impl;

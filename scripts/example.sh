@@ -48,3 +48,9 @@ echo "    errors_and_pls.svg, stanford_horizontal.svg, stanford_vertical.svg):"
 for s in no_fault accel_fault sat_10sigma sat_20sigma combined; do
   ./build/skylane simulate examples/simulate/seed001_$s.json --out examples/out/simulate/$s | grep -v '^skylane: simulate: wrote'
 done
+echo "--- preflight approval (examples/out/approve/: report.json, route.geojson, operational_intent.json, map.svg, pl.svg):"
+./build/skylane approve examples/approve/mission.json --out examples/out/approve > /dev/null
+python3 -c 'import json; j=json.load(open("examples/out/approve/report.json")); print(j["decision"], "-", round(j["planner"]["length_m"]), "m,", len(j["predicted"]), "samples, max HPL", max(p["hpl_m"] for p in j["predicted"]), "m, zones:", ", ".join("%s %.0f m" % (z["id"], z["min_clearance_m"]) for z in j["zones"]))'
+echo "--- a mission that is rejected (examples/out/approve_rejected/):"
+./build/skylane approve examples/approve/mission_rejected.json --out examples/out/approve_rejected > /dev/null || true
+python3 -c 'import json; j=json.load(open("examples/out/approve_rejected/report.json")); print(j["decision"], "-", j["reasons"][0]["message"])'

@@ -1,0 +1,32 @@
+#pragma once
+/// \file
+/// \brief The approval in exchange formats: GeoJSON (RFC 7946) for any GIS, and ASTM F3548-21
+/// operational-intent `Volume4D` objects for a UTM / U-space service (field names as in
+/// DESIGN.md: volume.outline_polygon.vertices[{lat, lng}], altitude_lower/upper {value,
+/// reference "W84", units "M"}, time_start/time_end {value, format "RFC3339"}).
+
+#include "planner/approval.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <vector>
+
+namespace skylane::planner {
+
+/// \brief The footprint of one segment's box in the map frame: the rectangle around a→b
+/// widened by `hal_m` on each side and lengthened by `hal_m` at both ends, so that it also
+/// covers the joint cylinders (radius hal_m) at a and b. Counter-clockwise.
+[[nodiscard]] std::vector<Eigen::Vector2d> segmentOutline(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double hal_m);
+
+/// \brief A FeatureCollection: the route (LineString, heights AMSL), its points with ETA, both
+/// box levels (one Polygon per segment), and every reason that has a place (Point).
+[[nodiscard]] nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission,
+                                          const maps::PlaneFrame& frame);
+
+/// \brief One Volume4D per route segment of the given level (1 corridor, 2 airspace): the
+/// segment's outline, its heights ± VAL (ellipsoidal, "W84"), and the time from the segment's
+/// start ETA − `time_buffer_s` to its end ETA + `time_buffer_s`.
+[[nodiscard]] nlohmann::json operationalIntentVolumes(const ApprovalReport& report, const maps::PlaneFrame& frame,
+                                                      int level, double time_buffer_s);
+
+}  // namespace skylane::planner
