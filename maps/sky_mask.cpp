@@ -372,6 +372,9 @@ void raiseMaskByTerrain(SkyMask& mask, const Geodetic& observer, const Terrain& 
 SkyMask computeSkyMask(const Geodetic& observer, const BuildingIndex* buildings, const Terrain* terrain,
                        const SkyMaskOptions& options) {
   SkyMask mask(options.bin_width_rad);
+  if (options.floor_rad > kOpenSky_rad) {
+    for (int k = 0; k < mask.bins(); ++k) mask.raise(k, options.floor_rad);
+  }
   if (terrain != nullptr) raiseMaskByTerrain(mask, observer, *terrain, options);
   if (buildings != nullptr) buildings->raiseMask(mask, observer, options.refraction_k, options.cull);
   return mask;

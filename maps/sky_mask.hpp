@@ -82,6 +82,10 @@ struct SkyMaskOptions {
   int terrain_rays_per_bin = 3;
   double refraction_k = 1.0;  ///< effective Earth radius = k·N (4/3: standard radio refraction)
   bool cull = true;           ///< skip buildings that cannot raise the mask (false: the brute-force reference)
+  /// Every bin starts at this elevation [rad] (default: open sky). A receiver ignores
+  /// satellites below its elevation mask anyway, so starting there loses nothing and lets the
+  /// culling skip every building that cannot reach above it (from high up, most of them).
+  double floor_rad = kOpenSky_rad;
 };
 
 /// \brief Buildings held for fast sky-mask queries: their corners in the ENU frame of an index

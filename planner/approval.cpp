@@ -152,7 +152,9 @@ struct Approver::Impl {
 
   maps::SkyMask skyMaskAt(const maps::Geodetic& g) const {
     const bool raster = !m.terrain_file.empty();
-    return maps::computeSkyMask(g, index.get(), raster ? &terrain : nullptr);
+    maps::SkyMaskOptions options;
+    options.floor_rad = maps::deg2rad(m.mask_deg);  // below the receiver's mask nothing matters
+    return maps::computeSkyMask(g, index.get(), raster ? &terrain : nullptr, options);
   }
 
   integrity::PredictSample predictAt(const maps::Geodetic& g, const maps::GpsTime& t,
@@ -326,7 +328,10 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
           const maps::GpsTime earliest = dep.plus((p.head<2>() - start_xy).norm() / m.cruise_speed_mps);
           return d.valid(p, earliest, latest, penalties);
         };
-        if (!d.cost.empty()) prob.extra_cost = [&d](const Eigen::Vector3d& p) { return d.extraCost(p); };
+        if (!d.cost.empty()) {
+          prob.extra_cost = [&d](const Eigen::Vector3d& p) { return d.extraCost(p); };
+          prob.cost_step_m = d.cell_m / 2.0;
+        }
         prob.resolution_m = m.resolution_m;
         prob.time_limit_s = m.time_limit_s;
         prob.seed = m.seed + static_cast<std::uint64_t>(attempt) * 7919u + leg;

@@ -69,17 +69,29 @@ Eigen::Vector3d toVector(const ob::State* s) {
 /// ∫ (1 + extra_cost) ds along the path; Euclidean distance is an admissible heuristic.
 class IntegrityCostObjective : public ob::StateCostIntegralObjective {
  public:
-  IntegrityCostObjective(const ob::SpaceInformationPtr& si, std::function<double(const Eigen::Vector3d&)> extra)
-      : ob::StateCostIntegralObjective(si, true), extra_(std::move(extra)) {
+  IntegrityCostObjective(const ob::SpaceInformationPtr& si, std::function<double(const Eigen::Vector3d&)> extra,
+                         double step_m)
+      : ob::StateCostIntegralObjective(si, true), extra_(std::move(extra)), step_m_(step_m) {
     description_ = "path length + integrity cost";
   }
   ob::Cost stateCost(const ob::State* s) const override { return ob::Cost(1.0 + extra_(toVector(s))); }
+  /// Trapezoid rule over steps of at most step_m (the cost field's own resolution), rather than
+  /// OMPL's validity-checking resolution, which would evaluate it every few metres.
+  ob::Cost motionCost(const ob::State* s1, const ob::State* s2) const override {
+    const Eigen::Vector3d a = toVector(s1), b = toVector(s2);
+    const double len = (b - a).norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(len / step_m_)));
+    double sum = 0.5 * (extra_(a) + extra_(b));
+    for (int i = 1; i < n; ++i) sum += extra_(a + (b - a) * (static_cast<double>(i) / n));
+    return ob::Cost(len * (1.0 + sum / n));
+  }
   ob::Cost motionCostHeuristic(const ob::State* s1, const ob::State* s2) const override {
     return ob::Cost(si_->distance(s1, s2));
   }
 
  private:
   std::function<double(const Eigen::Vector3d&)> extra_;
+  double step_m_;
 };
 
 /// OMPL's seed generator is process-wide; one query at a time re-seeds it so that a seed gives
@@ -156,7 +168,7 @@ PathResult planPath(const PathProblem& p) {
   const ob::SpaceInformationPtr si = ss.getSpaceInformation();
   ob::OptimizationObjectivePtr objective;
   if (p.extra_cost) {
-    objective = std::make_shared<IntegrityCostObjective>(si, p.extra_cost);
+    objective = std::make_shared<IntegrityCostObjective>(si, p.extra_cost, p.cost_step_m);
   } else {
     objective = std::make_shared<ob::PathLengthOptimizationObjective>(si);
   }

@@ -8,7 +8,7 @@
 /// predicate says so (the vehicle inflated to its first-level box clear of the zones and
 /// obstacles, above the terrain); a motion is checked every `resolution_m` metres (not OMPL's
 /// default fraction of the space's extent). The objective is the path integral of
-/// 1 + extra_cost(p) (StateCostIntegralObjective with interpolation): path length when the
+/// 1 + extra_cost(p) (trapezoid rule every cost_step_m metres): path length when the
 /// extra cost is zero, longer paths preferred where the predicted protection level nears the
 /// alert limit. Simplification keeps validity: OMPL's PathSimplifier only accepts shortcuts
 /// whose motions are valid.
@@ -44,6 +44,7 @@ struct PathProblem {
   Eigen::Vector3d goal_enu_m = Eigen::Vector3d::Zero();
   std::function<bool(const Eigen::Vector3d&)> is_valid;   ///< required
   std::function<double(const Eigen::Vector3d&)> extra_cost;  ///< ≥ 0 per metre; empty = path length
+  double cost_step_m = 25.0;   ///< the cost integral's step along a motion (trapezoid rule)
   double resolution_m = 2.0;   ///< motion checking step
   double time_limit_s = 1.0;
   std::uint64_t seed = 1;

@@ -258,6 +258,27 @@ TEST(SkyMaskBuildings, CulledIndexEqualsBruteForceAndBoundsDenseRayCasting) {
   }
 }
 
+// A floor at the receiver's elevation mask: every bin is max(floor, the brute-force mask), from
+// the street and from a drone above the roofs (where the floor lets the culling skip almost all).
+TEST(SkyMaskBuildings, FloorGivesTheBruteForceMaskRaisedToTheFloor) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> where(-300, 300);
+  const City city = randomCity(rng, 400, 1200.0);
+  const BuildingIndex index(city.buildings, kGround, 50.0);
+  for (int q = 0; q < 6; ++q) {
+    Geodetic p = LocalFrame(kGround).fromEnu({where(rng), where(rng), 0.0});
+    p.h_ell_m = kGround.h_ell_m + (q % 2 ? 80.0 : kEye_m);
+    SkyMaskOptions floored, brute;
+    floored.floor_rad = deg2rad(5.0);
+    brute.cull = false;
+    const SkyMask a = computeSkyMask(p, &index, nullptr, floored);
+    const SkyMask b = computeSkyMask(p, &index, nullptr, brute);
+    for (int k = 0; k < 360; ++k) {
+      ASSERT_EQ(a.binBlocked_rad(k), std::max(deg2rad(5.0), b.binBlocked_rad(k))) << "query " << q << " bin " << k;
+    }
+  }
+}
+
 // --- terrain ----------------------------------------------------------------------------------
 
 TEST(SkyMaskTerrain, FlatGroundGivesTheHorizonDipOfTheObserversHeight) {
