@@ -112,6 +112,21 @@ void run(benchmark::State& state, const std::string& mission_path) {
 void BM_ApproveBundledExample(benchmark::State& state) { run(state, kExample); }
 BENCHMARK(BM_ApproveBundledExample)->Unit(benchmark::kMillisecond)->Iterations(3);
 
+/// The bundled example with each planner (the mission copied beside it with another algorithm).
+void BM_ApproveExamplePlanner(benchmark::State& state) {
+  const auto kind = static_cast<planner::PlannerKind>(state.range(0));
+  state.SetLabel(std::string(planner::plannerName(kind)));
+  json m;
+  std::ifstream(kExample) >> m;
+  m["planner"]["algorithm"] = std::string(planner::plannerName(kind));
+  const std::string path = std::string(SKYLANE_TEST_DATA) + "/../../examples/approve/.bench_" +
+                           std::string(planner::plannerName(kind)) + ".json";
+  std::ofstream(path) << m.dump(1);
+  run(state, path);
+  std::filesystem::remove(path);
+}
+BENCHMARK(BM_ApproveExamplePlanner)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Iterations(3);
+
 void BM_ApproveCity(benchmark::State& state) {
   const auto kind = static_cast<planner::PlannerKind>(state.range(0));
   state.SetLabel(std::string(planner::plannerName(kind)));
