@@ -5,6 +5,11 @@
 #include "planner/route_planner.hpp"
 
 #include "geofence/fence.hpp"
+#include "integrity/gnss/almanac.hpp"
+#include "integrity/predict.hpp"
+#include "maps/buildings.hpp"
+#include "maps/sky_mask.hpp"
+#include "maps/terrain.hpp"
 #include "maps/parse_error.hpp"
 #include "tests/test_util.hpp"
 
@@ -259,6 +264,61 @@ TEST(Approval, ApprovedCorridorsNeverMeetAnActiveProhibitedZone) {
     }
   }
   EXPECT_GE(approved, 5);
+}
+
+// An urban canyon: two 300 m walls 40 m apart along the middle of the direct line. Between them
+// too few satellites are left for a protection level, so the integrity cost steers the route out
+// to open sky (or, failing that, the samples in the canyon would reject it).
+TEST(Approval, UrbanCanyonSendsTheRouteToBetterSky) {
+  const maps::PlaneFrame frame(maps::deg2rad(kLat0), maps::deg2rad(kLon0));
+  auto lonLat = [&frame](double x, double y) {
+    const Eigen::Vector2d ll = frame.toLatLon(Eigen::Vector2d(x, y));
+    return json::array({maps::rad2deg(ll.y()), maps::rad2deg(ll.x())});
+  };
+  json features = json::array();
+  for (double side : {-1.0, 1.0}) {
+    const double y0 = side * 20.0, y1 = side * 35.0;
+    json ring = json::array({lonLat(450, y0), lonLat(1050, y0), lonLat(1050, y1), lonLat(450, y1), lonLat(450, y0)});
+    features.push_back({{"type", "Feature"}, {"geometry", {{"type", "Polygon"}, {"coordinates", {ring}}}},
+                        {"properties", {{"height", 300}}}});
+  }
+  const std::string buildings = test::scratchPath("canyon.geojson");
+  std::ofstream(buildings) << json{{"type", "FeatureCollection"}, {"features", features}}.dump();
+  Mission m = missionWith({}, "canyon");
+  m.buildings_file = buildings;
+  m.cost_weight = 1.0;
+  m.cost_cell_m = 10.0;
+  m.time_limit_s = 1.0;
+  Approver a(m);
+  const ApprovalReport r = a.approve();
+  if (!r.approved) {
+    ASSERT_FALSE(r.reasons.empty());
+    EXPECT_EQ(r.reasons.front().kind, "integrity") << r.reasons.front().message;
+    return;
+  }
+  // Approved: no sample flies between the walls, and every sample has a protection level.
+  for (const PredictedSample& s : r.predicted) {
+    EXPECT_FALSE(s.xyz.x() > 450 && s.xyz.x() < 1050 && std::abs(s.xyz.y()) < 20) << "t = " << s.t_s;
+    EXPECT_TRUE(s.pl_available) << "t = " << s.t_s;
+  }
+  EXPECT_FALSE(r.planner.straight_line);
+  // Between the walls, at the route's height and time, the sky leaves no protection level
+  // (computed here from the buildings directly: sky mask, then the prediction).
+  const maps::Terrain ground = maps::Terrain::flat(408.0);
+  const std::vector<maps::Building> walls = maps::loadBuildings(buildings, ground);
+  const maps::BuildingIndex index(walls, maps::Geodetic{maps::deg2rad(kLat0), maps::deg2rad(kLon0), 0.0});
+  const Eigen::Vector2d mid = frame.toLatLon(Eigen::Vector2d(750, 0));
+  integrity::PredictRequest req;
+  req.place = {mid.x(), mid.y(), r.route.front().h_ell_m};
+  maps::SkyMaskOptions opt;
+  opt.floor_rad = maps::deg2rad(5.0);
+  req.sky_mask = maps::computeSkyMask(req.place, &index, nullptr, opt);
+  integrity::OrbitSource orbits;
+  orbits.addAlmanac(integrity::loadAlmanac(test::dataPath("gnss/alm01jan2020.txt")));
+  const integrity::PredictSample canyon = integrity::predictAt(orbits, req, r.departure.plus(60.0), integrity::IntegrityMethod::kRaim);
+  EXPECT_GT(canyon.blocked, 3u);
+  EXPECT_TRUE(!canyon.pl.pl_computed || canyon.pl.hpl_m > r.limits.level2.hal_m)
+      << canyon.sats.size() << " satellites, HPL " << canyon.pl.hpl_m;
 }
 
 TEST(Mission, ErrorsNameTheField) {
