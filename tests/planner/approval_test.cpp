@@ -321,6 +321,22 @@ TEST(Approval, UrbanCanyonSendsTheRouteToBetterSky) {
       << canyon.sats.size() << " satellites, HPL " << canyon.pl.hpl_m;
 }
 
+// A departure window: the goal lies under a zone until 14:20Z. The 14:00 and 14:10 departures
+// cannot end there; the window's 14:20 departure is approved.
+TEST(Approval, DepartureWindowFindsTheFirstDepartureThatPasses) {
+  const double goal_lon = kLon0 + 0.0198;
+  Mission m = missionWith({circleZone("EX-TEST-UNTIL-1420", kLat0, goal_lon, 100,
+                                      during("2020-01-01T13:00:00Z", "2020-01-01T14:20:00Z"))},
+                          "window");
+  m.departure_latest = m.departure_earliest.plus(3600.0);
+  m.departure_step_s = 600.0;
+  Approver a(m);
+  const ApprovalReport r = a.approve();
+  ASSERT_TRUE(r.approved) << (r.reasons.empty() ? "" : r.reasons.front().message);
+  EXPECT_EQ(maps::formatRfc3339(r.departure), "2020-01-01T14:20:00Z");
+  EXPECT_EQ(r.planner.departures_tried, 3);
+}
+
 TEST(Mission, ErrorsNameTheField) {
   const json good{{"vehicle", {{"lateral_m", 1}, {"longitudinal_m", 1}, {"cruise_speed_mps", 10}}},
                   {"start", {{"lat", 47}, {"lon", 8}}},
