@@ -409,5 +409,48 @@ TEST(Cli, SimulateRefusesABadScenarioWithExitTwo) {
   EXPECT_NE(r.out.find("$.faults[0].sats[0]"), std::string::npos) << r.out;
 }
 
+using nlohmann::json;
+
+TEST(Cli, ApproveWritesTheReportAndItsExchangeFormats) {
+  const std::string out = test::scratchPath("approve_out");
+  const RunResult r = run("approve " + std::string(SKYLANE_TEST_DATA) + "/../../examples/approve/mission.json --out " + out);
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("\"decision\": \"approved\""), std::string::npos);
+  EXPECT_NE(r.out.find("APPROVED"), std::string::npos);
+  std::ifstream report(out + "/report.json");
+  const json j = json::parse(report);
+  EXPECT_EQ(j["decision"], "approved");
+  EXPECT_GE(j["route"].size(), 2u);
+  EXPECT_EQ(j["inputs"][0]["role"], "mission");
+  EXPECT_EQ(j["inputs"][0]["sha256"].get<std::string>().size(), 64u);
+  std::ifstream geo(out + "/route.geojson");
+  const json g = json::parse(geo);
+  EXPECT_EQ(g["type"], "FeatureCollection");
+  EXPECT_EQ(g["features"][0]["geometry"]["type"], "LineString");
+  std::ifstream intent(out + "/operational_intent.json");
+  const json oi = json::parse(intent);
+  const json& v = oi["operational_intent"]["volumes"][0];
+  EXPECT_EQ(v["volume"]["altitude_lower"]["reference"], "W84");
+  EXPECT_EQ(v["time_start"]["format"], "RFC3339");
+  EXPECT_EQ(v["volume"]["outline_polygon"]["vertices"].size(), 4u);
+  EXPECT_EQ(oi["operational_intent"]["volumes"].size(), j["route"].size() - 1);
+}
+
+TEST(Cli, ApproveRejectsAGoalInAProhibitedZoneWithExitOne) {
+  const RunResult r = run("approve " + std::string(SKYLANE_TEST_DATA) + "/../../examples/approve/mission_rejected.json");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("\"decision\": \"rejected\""), std::string::npos);
+  EXPECT_NE(r.out.find("EX-ZH-HOSPITAL"), std::string::npos);
+}
+
+TEST(Cli, ApproveRefusesABadMissionWithExitTwo) {
+  const std::string bad = writeTemp("bad_mission.json", R"({"vehicle":{"lateral_m":1,"longitudinal_m":1,"cruise_speed_mps":10},)"
+                                                       R"("start":{"lat":47,"lon":8},"goal":{"lat":47.01,"lon":8},)"
+                                                       R"("departure":"2020-01-01T14:00:00Z","orbits":["x.txt"],"planner":{"algorithm":"dijkstra"}})");
+  const RunResult r = run("approve " + bad);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("bad_mission.json: field '$.planner.algorithm'"), std::string::npos) << r.out;
+}
+
 }  // namespace
 }  // namespace skylane
