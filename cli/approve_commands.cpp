@@ -249,11 +249,15 @@ void runApprove(const ApproveOptions& o) {
     std::ofstream(dir / "pl.svg") << plSvg(r, approver.mission());
     std::ofstream(dir / "map.svg") << mapSvg(r, approver);
     std::ofstream(dir / "route.geojson") << planner::routeGeoJson(r, approver.mission(), approver.frame()).dump(1) << "\n";
-    const json intent{{"operational_intent", {{"volumes", planner::operationalIntentVolumes(r, approver.frame(), 2, 30.0)},
-                                               {"state", r.approved ? "Accepted" : "Rejected"},
-                                               {"priority", 0}}},
-                      {"corridor_volumes", planner::operationalIntentVolumes(r, approver.frame(), 1, 30.0)}};
-    std::ofstream(dir / "operational_intent.json") << intent.dump(1) << "\n";
+    // An operational intent is only for an approved route (F3548 state "Accepted").
+    std::filesystem::remove(dir / "operational_intent.json");
+    if (r.approved) {
+      const json intent{{"operational_intent", {{"volumes", planner::operationalIntentVolumes(r, approver.frame(), 2, 30.0)},
+                                                 {"state", "Accepted"},
+                                                 {"priority", 0}}},
+                        {"corridor_volumes", planner::operationalIntentVolumes(r, approver.frame(), 1, 30.0)}};
+      std::ofstream(dir / "operational_intent.json") << intent.dump(1) << "\n";
+    }
   }
   std::cout << j.dump(2) << "\n";
   std::cerr << "skylane: approve: " << (r.approved ? "APPROVED" : "REJECTED") << " in " << r.elapsed_s << " s";

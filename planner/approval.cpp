@@ -1,8 +1,6 @@
 #include "planner/approval.hpp"
 
 #include "geofence/obstruction_files.hpp"
-#include "integrity/gnss/almanac.hpp"
-#include "integrity/gnss/rinex_nav.hpp"
 #include "integrity/predict.hpp"
 #include "maps/geoid.hpp"
 #include "maps/parse_error.hpp"
@@ -12,7 +10,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -84,21 +81,7 @@ struct Approver::Impl {
       const maps::Geodetic origin{m.points.front().lat_rad, m.points.front().lon_rad, 0.0};
       index = std::make_unique<maps::BuildingIndex>(obstructions->buildings(), origin);
     }
-    for (std::size_t i = 0; i < m.orbit_files.size(); ++i) {
-      const std::string& f = m.orbit_files[i];
-      std::ifstream in(f);
-      if (!in) {
-        throw maps::ParseError(m.source, 0, "$.orbits[" + std::to_string(i) + "]", f,
-                               "a readable YUMA/SEM almanac or RINEX navigation file");
-      }
-      std::string first;
-      std::getline(in, first);
-      if (first.find("RINEX VERSION") != std::string::npos) {
-        orbits.addNavigation(integrity::loadRinexNav(f));
-      } else {
-        orbits.addAlmanac(integrity::loadAlmanac(f));
-      }
-    }
+    orbits = integrity::loadOrbitFiles(m.orbit_files, m.source, "$.orbits");
     // Search box: every mission point ± margin; heights from the terrain's range over it.
     Eigen::Vector2d lo(kInf, kInf), hi(-kInf, -kInf);
     for (const MissionPoint& p : m.points) {

@@ -1,5 +1,9 @@
 #include "integrity/gnss/orbit_source.hpp"
 
+#include "maps/parse_error.hpp"
+
+#include <fstream>
+
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -79,6 +83,27 @@ double OrbitSource::almanacAge_s(const GpsTime& t) const {
     age = std::max(age, std::abs(t - resolveAlmanacEpoch(a.week_field, a.orbit.toe.sow, t)));
   }
   return age;
+}
+
+OrbitSource loadOrbitFiles(const std::vector<std::string>& files, const std::string& source, const std::string& field) {
+  OrbitSource orbits;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const std::string& f = files[i];
+    std::ifstream in(f);
+    if (!in) {
+      throw maps::ParseError(source, 0, field + "[" + std::to_string(i) + "]", f,
+                             "a readable YUMA/SEM almanac or RINEX navigation file");
+    }
+    std::string first;
+    std::getline(in, first);
+    if (first.find("RINEX VERSION") != std::string::npos) {
+      orbits.addNavigation(loadRinexNav(f));
+    } else {
+      orbits.addAlmanac(loadAlmanac(f));
+    }
+  }
+  if (orbits.empty()) throw maps::ParseError(source, 0, field, "", "files that hold at least one satellite");
+  return orbits;
 }
 
 }  // namespace skylane::integrity

@@ -8,6 +8,7 @@
 #include "maps/geodesy.hpp"
 
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace skylane::integrity {
@@ -53,5 +54,13 @@ class OrbitSource {
   std::vector<AlmanacRecord> almanac_;
   NavigationData nav_;
 };
+
+/// \brief Loads almanacs (YUMA/SEM) and RINEX navigation files, told apart by the RINEX header
+/// line. `source` and `field` name where the list came from (e.g. a mission file and "$.orbits")
+/// in errors.
+/// \throws maps::ParseError naming source, field[i] and the file when it cannot be read, or the
+/// file's own parse error; and when the files hold no satellite at all.
+[[nodiscard]] OrbitSource loadOrbitFiles(const std::vector<std::string>& files, const std::string& source,
+                                         const std::string& field);
 
 }  // namespace skylane::integrity

@@ -1,7 +1,5 @@
 #include "integrity/sim/run.hpp"
 
-#include "integrity/gnss/almanac.hpp"
-#include "integrity/gnss/rinex_nav.hpp"
 
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
@@ -9,7 +7,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <mutex>
 #include <random>
@@ -28,26 +25,7 @@ std::string_view methodName(Method m) {
   return "?";
 }
 
-OrbitSource loadOrbits(const Scenario& s) {
-  OrbitSource orbits;
-  for (std::size_t i = 0; i < s.orbit_files.size(); ++i) {
-    const std::string& f = s.orbit_files[i];
-    std::ifstream in(f);
-    if (!in) {
-      throw maps::ParseError(s.source, 0, "$.orbits[" + std::to_string(i) + "]", f,
-                             "a readable YUMA/SEM almanac or RINEX navigation file");
-    }
-    std::string first;
-    std::getline(in, first);
-    if (first.find("RINEX VERSION") != std::string::npos) {
-      orbits.addNavigation(loadRinexNav(f));
-    } else {
-      orbits.addAlmanac(loadAlmanac(f));
-    }
-  }
-  if (orbits.empty()) throw maps::ParseError(s.source, 0, "$.orbits", "", "files that hold at least one satellite");
-  return orbits;
-}
+OrbitSource loadOrbits(const Scenario& s) { return loadOrbitFiles(s.orbit_files, s.source, "$.orbits"); }
 
 namespace {
 
