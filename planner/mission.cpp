@@ -6,14 +6,20 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <iterator>
+#include <optional>
 
 namespace skylane::planner {
 
 using maps::JsonNode;
 
 namespace {
+
+/// The latitude limit of mission points (the planner's local frame is not made for the poles).
+constexpr double kMaxMissionLatitude_deg = 89.0;
 
 double positive(const JsonNode& n) {
   const double v = n.number();
@@ -24,7 +30,7 @@ double positive(const JsonNode& n) {
 MissionPoint point(const JsonNode& n) {
   n.requireKnownFields({"lat", "lon"});
   const double lat = n.at("lat").number(), lon = n.at("lon").number();
-  if (std::abs(lat) > 89.0) n.at("lat").fail("a latitude within ±89°");
+  if (std::abs(lat) > kMaxMissionLatitude_deg) n.at("lat").fail("a latitude within ±89°");
   if (std::abs(lon) > 180.0) n.at("lon").fail("a longitude within ±180°");
   return {maps::deg2rad(lat), maps::deg2rad(lon)};
 }
@@ -47,13 +53,206 @@ std::vector<std::string> files(const JsonNode& n, const std::string& base_dir) {
   return out;
 }
 
+// --- QGroundControl .plan ----------------------------------------------------------------------
+
+/// MAVLink MAV_CMD values of the mission items a route is made of.
+enum QgcCommand : int {
+  kNavWaypoint = 16,
+  kNavReturnToLaunch = 20,
+  kNavLand = 21,
+  kNavTakeoff = 22,
+};
+
+/// Commands that only work a payload (camera, gimbal, region of interest, servo, relay) and
+/// neither move the vehicle nor make it wait: skipped. MAVLink common.xml numbers.
+constexpr int kPayloadCommands[] = {
+    181, 182, 183, 184,            // DO_SET_RELAY, DO_REPEAT_RELAY, DO_SET_SERVO, DO_REPEAT_SERVO
+    195, 196, 197, 201,            // DO_SET_ROI_LOCATION, _WPNEXT_OFFSET, _NONE, DO_SET_ROI
+    202, 203, 204, 205, 206, 214,  // DO_DIGICAM_CONFIGURE/_CONTROL, DO_MOUNT_CONFIGURE/_CONTROL, cam trigger
+    530, 531, 532,                 // SET_CAMERA_MODE, _ZOOM, _FOCUS
+    1000, 1001,                    // DO_GIMBAL_MANAGER_PITCHYAW, _CONFIGURE
+    2000, 2001, 2003, 2500, 2501,  // IMAGE_START/STOP_CAPTURE, DO_TRIGGER_CONTROL, VIDEO_START/STOP_CAPTURE
+};
+
+/// MAV_FRAME values QGroundControl writes for positions, with their integer-coordinate twins.
+enum class QgcAltitudeReference { kAmsl, kRelativeToHome, kTerrain };
+
+/// Waypoint heights closer than this are "the same" (QGroundControl keeps them as typed; this
+/// only absorbs a decimal round trip).
+constexpr double kSameAltitudeTolerance_m = 1e-3;
+
+const char* commandName(int command) {
+  switch (command) {
+    case kNavWaypoint: return "NAV_WAYPOINT";
+    case kNavReturnToLaunch: return "RETURN_TO_LAUNCH";
+    case kNavLand: return "NAV_LAND";
+    case kNavTakeoff: return "NAV_TAKEOFF";
+    default: return "?";
+  }
+}
+
+QgcAltitudeReference altitudeReference(const JsonNode& frame) {
+  const double f = frame.number();
+  if (f == 0 || f == 5) return QgcAltitudeReference::kAmsl;
+  if (f == 3 || f == 6) return QgcAltitudeReference::kRelativeToHome;
+  if (f == 10 || f == 11) return QgcAltitudeReference::kTerrain;
+  frame.fail("a MAV_FRAME for a position: 0 (AMSL), 3 (relative to home) or 10 (terrain), or 5, 6, 11");
+}
+
+/// params[k] of an item, a finite number ("what" says what it stands for).
+double param(const JsonNode& params, std::size_t k, const std::string& what) {
+  const JsonNode p = params.item(k);
+  if (!p.j.is_number()) p.fail(what + " (a number)");
+  return p.number();
+}
+
+/// A latitude and longitude in degrees written at lat, lon → MissionPoint.
+MissionPoint qgcPosition(const JsonNode& lat_node, const JsonNode& lon_node) {
+  const char* lat_what = "a latitude in degrees within ±89°";
+  const char* lon_what = "a longitude in degrees within ±180°";
+  if (!lat_node.j.is_number()) lat_node.fail(lat_what);
+  if (!lon_node.j.is_number()) lon_node.fail(lon_what);
+  const double lat = lat_node.number(), lon = lon_node.number();
+  if (!(std::abs(lat) <= kMaxMissionLatitude_deg)) lat_node.fail(lat_what);
+  if (!(std::abs(lon) <= 180.0)) lon_node.fail(lon_what);
+  return {maps::deg2rad(lat), maps::deg2rad(lon)};
+}
+
+/// The position of a takeoff or land item, or none when it has none: both null (QGroundControl
+/// writes NaN as null), or both exactly 0 (ArduPilot's "here").
+std::optional<MissionPoint> optionalPosition(const JsonNode& params) {
+  const JsonNode lat = params.item(4), lon = params.item(5);
+  if (lat.j.is_null() && lon.j.is_null()) return std::nullopt;
+  if (lat.j.is_number() && lon.j.is_number() && lat.j.get<double>() == 0.0 && lon.j.get<double>() == 0.0) {
+    return std::nullopt;
+  }
+  return qgcPosition(lat, lon);
+}
+
+bool samePlace(const MissionPoint& a, const MissionPoint& b) { return a.lat_rad == b.lat_rad && a.lon_rad == b.lon_rad; }
+
 }  // namespace
 
-Mission parseMission(const nlohmann::json& doc, const std::string& source, const std::string& base_dir) {
+QgcPlanRoute parseQgcPlanRoute(const nlohmann::json& doc, const std::string& source) {
   const JsonNode root{doc, "$", source};
-  root.requireKnownFields({"name", "vehicle", "k1", "k2", "start", "goal", "waypoints", "altitude", "departure",
-                           "departure_window", "zones", "zone_format", "terrain", "ground_amsl_m", "buildings",
-                           "authorisations", "orbits", "integrity", "planner"});
+  if (!doc.is_object()) root.fail("a QGroundControl plan (an object with fileType \"Plan\" and a mission)");
+  if (root.has("fileType") && !(root.at("fileType").j.is_string() && root.at("fileType").str() == "Plan")) {
+    root.at("fileType").fail("\"Plan\" (a QGroundControl .plan file)");
+  }
+  const JsonNode mission = root.at("mission");
+  if (!mission.j.is_object()) mission.fail("an object with items and plannedHomePosition");
+
+  std::optional<MissionPoint> home;
+  if (mission.has("plannedHomePosition")) {
+    const JsonNode h = mission.at("plannedHomePosition");
+    if (h.array().size() < 2) h.fail("[lat, lon, alt] in degrees and metres");
+    home = qgcPosition(h.item(0), h.item(1));
+  }
+  const auto needHome = [&](const JsonNode& item, const char* why) {
+    if (home) return *home;
+    throw maps::ParseError(source, 0, mission.path + ".plannedHomePosition", "",
+                           std::string("[lat, lon, alt] in degrees and metres (") + why + " at " + item.path + ")");
+  };
+
+  QgcPlanRoute route;
+  std::optional<MissionPoint> start;
+  bool returned = false;  // a RETURN_TO_LAUNCH was seen: the mission ends there
+  std::optional<double> common_height_m;
+  bool heights_agree = true;
+  const auto add = [&](const MissionPoint& p) {
+    if (route.points.empty() || !samePlace(route.points.back(), p)) route.points.push_back(p);
+  };
+
+  const JsonNode items = mission.at("items");
+  for (std::size_t i = 0; i < items.array().size(); ++i) {
+    const JsonNode item = items.item(i);
+    if (!item.j.is_object()) item.fail("a mission item (an object with type SimpleItem)");
+    const std::string type = item.at("type").str();
+    if (type == "ComplexItem") {
+      const std::string kind = item.has("complexItemType") ? maps::quoteJson(item.at("complexItemType").j) : "complex";
+      throw maps::ParseError(source, 0, item.path, kind + " ComplexItem",
+                             "a SimpleItem (surveys, corridor and structure scans are not supported: "
+                             "convert the pattern to waypoints in QGroundControl, or plan its corners as waypoints)");
+    }
+    if (type != "SimpleItem") item.at("type").fail("SimpleItem");
+    const JsonNode command_node = item.at("command");
+    const double command_value = command_node.number();
+    if (command_value != std::floor(command_value) || std::abs(command_value) > 1e6) {
+      command_node.fail("a MAVLink command number");
+    }
+    const int command = static_cast<int>(command_value);
+    if (std::find(std::begin(kPayloadCommands), std::end(kPayloadCommands), command) != std::end(kPayloadCommands)) {
+      continue;
+    }
+    if (command != kNavWaypoint && command != kNavTakeoff && command != kNavLand && command != kNavReturnToLaunch) {
+      command_node.fail("16 NAV_WAYPOINT, 22 NAV_TAKEOFF, 21 NAV_LAND or 20 RETURN_TO_LAUNCH (or a camera, gimbal, "
+                        "ROI, servo or relay command, which is skipped); other commands change the route or its "
+                        "timing and are not supported");
+    }
+    if (returned) {
+      item.fail(std::string("no ") + commandName(command) + " after RETURN_TO_LAUNCH (the vehicle has gone home)");
+    }
+    if (command == kNavReturnToLaunch) {
+      if (!start) start = needHome(item, "RETURN_TO_LAUNCH flies to it");
+      if (route.points.empty()) add(*start);
+      add(needHome(item, "RETURN_TO_LAUNCH flies to it"));
+      returned = true;
+      continue;
+    }
+    const JsonNode params = item.at("params");
+    if (params.array().size() < 7) {
+      params.fail("7 parameters [param1 … param7]: params[4], params[5], params[6] = latitude, longitude, altitude");
+    }
+    if (command == kNavTakeoff) {
+      if (start) item.fail("a NAV_TAKEOFF before every other positional item");
+      (void)altitudeReference(item.at("frame"));
+      const auto p = optionalPosition(params);
+      start = p ? *p : needHome(item, "the start when NAV_TAKEOFF gives no position");
+      add(*start);
+      continue;
+    }
+    if (!start) {
+      start = needHome(item, "the start when no NAV_TAKEOFF gives a position");
+      add(*start);
+    }
+    const QgcAltitudeReference reference = altitudeReference(item.at("frame"));
+    if (command == kNavLand) {
+      if (const auto p = optionalPosition(params)) add(*p);
+      continue;
+    }
+    // NAV_WAYPOINT
+    const JsonNode lat = params.item(4), lon = params.item(5);
+    if (lat.j.is_number() && lon.j.is_number() && lat.j.get<double>() == 0.0 && lon.j.get<double>() == 0.0) {
+      lat.fail("a waypoint position (0, 0 means \"here\" to some autopilots: give the place)");
+    }
+    add(qgcPosition(lat, lon));
+    const double height_m = param(params, 6, "an altitude in metres");
+    if (reference == QgcAltitudeReference::kAmsl) {
+      heights_agree = false;
+    } else if (!common_height_m) {
+      common_height_m = height_m;
+      route.cruise_agl_field = params.path + "[6]";
+    } else if (std::abs(height_m - *common_height_m) > kSameAltitudeTolerance_m) {
+      heights_agree = false;
+    }
+  }
+  if (route.points.size() < 2) {
+    items.fail("at least one NAV_WAYPOINT, NAV_LAND with a position or RETURN_TO_LAUNCH away from the start");
+  }
+  if (heights_agree && common_height_m) {
+    route.cruise_agl_m = *common_height_m;
+  } else {
+    route.cruise_agl_field.clear();
+  }
+  return route;
+}
+
+Mission parseMission(const nlohmann::json& doc, const std::string& source, const std::string& base_dir,
+                     const JsonFileReader& read_json) {
+  const JsonNode root{doc, "$", source};
+  root.requireKnownFields({"name", "vehicle", "k1", "k2", "start", "goal", "waypoints", "qgc_plan", "altitude",
+                           "departure", "departure_window", "zones", "zone_format", "terrain", "ground_amsl_m",
+                           "buildings", "authorisations", "orbits", "integrity", "planner"});
   Mission m;
   m.source = source;
   if (root.has("name")) m.name = root.at("name").str();
@@ -68,22 +267,67 @@ Mission parseMission(const nlohmann::json& doc, const std::string& source, const
   }
   if (root.has("k1")) m.levels.k1 = root.at("k1").number();
   if (root.has("k2")) m.levels.k2 = root.at("k2").number();
-  m.points.push_back(point(root.at("start")));
-  if (root.has("waypoints")) {
-    const JsonNode w = root.at("waypoints");
-    for (std::size_t i = 0; i < w.array().size(); ++i) m.points.push_back(point(w.item(i)));
+  // The route: start, waypoints and goal here, or a QGroundControl .plan; exactly one of the two.
+  std::optional<QgcPlanRoute> plan_route;
+  {
+    std::string given;
+    for (const char* key : {"start", "waypoints", "goal"}) {
+      if (root.has(key)) given += (given.empty() ? "$." : ", $.") + std::string(key);
+    }
+    if (root.has("qgc_plan") && !given.empty()) {
+      throw maps::ParseError(source, 0, "$.qgc_plan", maps::quoteJson(root.at("qgc_plan").j),
+                             "either qgc_plan or start/waypoints/goal, not both (" + given + " also given)");
+    }
+    if (!root.has("qgc_plan") && given.empty()) {
+      throw maps::ParseError(source, 0, "$.start", "",
+                             "a route: start and goal (waypoints optional), or qgc_plan naming a QGroundControl .plan");
+    }
   }
-  m.points.push_back(point(root.at("goal")));
+  if (root.has("qgc_plan")) {
+    const JsonNode q = root.at("qgc_plan");
+    const std::string name = q.str();
+    if (name.empty()) q.fail("the name of a QGroundControl .plan file");
+    m.qgc_plan_file = resolve(base_dir, name);
+    nlohmann::json plan;
+    try {
+      plan = read_json ? read_json(m.qgc_plan_file) : maps::readJsonFile(m.qgc_plan_file);
+    } catch (const maps::ParseError& e) {
+      if (e.source() != m.qgc_plan_file || e.field() != "file") throw;
+      q.fail("a readable QGroundControl .plan file (" + m.qgc_plan_file + " cannot be read)");
+    }
+    plan_route = parseQgcPlanRoute(plan, m.qgc_plan_file);
+    m.points = plan_route->points;
+  } else {
+    m.points.push_back(point(root.at("start")));
+    if (root.has("waypoints")) {
+      const JsonNode w = root.at("waypoints");
+      for (std::size_t i = 0; i < w.array().size(); ++i) m.points.push_back(point(w.item(i)));
+    }
+    m.points.push_back(point(root.at("goal")));
+  }
+  bool cruise_given = false;
   if (root.has("altitude")) {
     const JsonNode a = root.at("altitude");
     a.requireKnownFields({"cruise_agl_m", "min_agl_m", "max_agl_m", "max_amsl_m"});
-    if (a.has("cruise_agl_m")) m.cruise_agl_m = positive(a.at("cruise_agl_m"));
+    cruise_given = a.has("cruise_agl_m");
+    if (cruise_given) m.cruise_agl_m = positive(a.at("cruise_agl_m"));
     if (a.has("min_agl_m")) m.min_agl_m = a.at("min_agl_m").number();
     if (a.has("max_agl_m")) m.max_agl_m = positive(a.at("max_agl_m"));
     if (a.has("max_amsl_m")) m.max_amsl_m = a.at("max_amsl_m").number();
-    if (!(m.min_agl_m <= m.cruise_agl_m && m.cruise_agl_m <= m.max_agl_m)) {
-      a.fail("min_agl_m ≤ cruise_agl_m ≤ max_agl_m");
+  }
+  if (plan_route && plan_route->cruise_agl_m && !cruise_given) {
+    const double h = *plan_route->cruise_agl_m;
+    if (!(h > 0.0 && m.min_agl_m <= h && h <= m.max_agl_m)) {
+      throw maps::ParseError(m.qgc_plan_file, 0, plan_route->cruise_agl_field, maps::quoteJson(nlohmann::json(h)),
+                             "a waypoint height above ground > 0 and within the mission's min_agl_m … max_agl_m (" +
+                                 maps::quoteJson(nlohmann::json(m.min_agl_m)) + " … " +
+                                 maps::quoteJson(nlohmann::json(m.max_agl_m)) +
+                                 " m), or altitude.cruise_agl_m in the mission file");
     }
+    m.cruise_agl_m = h;
+  }
+  if (root.has("altitude") && !(m.min_agl_m <= m.cruise_agl_m && m.cruise_agl_m <= m.max_agl_m)) {
+    root.at("altitude").fail("min_agl_m ≤ cruise_agl_m ≤ max_agl_m");
   }
   m.departure_earliest = m.departure_latest = time(root.at("departure"));
   if (root.has("departure_window")) {

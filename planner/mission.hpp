@@ -1,9 +1,10 @@
 #pragma once
 /// \file
-/// \brief The mission file of `skylane approve`: vehicle, box factors, start and goal (or
-/// waypoints), altitude limits, departure time or window, the airspace and map files, the
-/// orbit files and integrity method, and the planner's settings (schema in the README,
-/// "Mission file"). Unknown and missing fields are errors naming them.
+/// \brief The mission file of `skylane approve`: vehicle, box factors, the route (start,
+/// waypoints and goal, or a QGroundControl `.plan` mission), altitude limits, departure time or
+/// window, the airspace and map files, the orbit files and integrity method, and the planner's
+/// settings (schema in the README, "Mission file"). Unknown and missing fields are errors
+/// naming them.
 
 #include "geofence/corridor.hpp"
 #include "integrity/gnss/error_model.hpp"
@@ -14,6 +15,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include <functional>
 #include <optional>
 #include <set>
 #include <string>
@@ -37,6 +39,7 @@ struct Mission {
   geofence::BoxLevels levels;
   /// \brief Start, the waypoints to visit in order, and the goal.
   std::vector<MissionPoint> points;
+  std::string qgc_plan_file;  ///< the QGroundControl .plan the points came from; empty: the mission file
   double cruise_agl_m = 60.0;
   double min_agl_m = 30.0;
   double max_agl_m = 120.0;
@@ -66,9 +69,40 @@ struct Mission {
   int max_replans = 2;         ///< per departure, after a violation
 };
 
+/// \brief The route of a QGroundControl `.plan` mission.
+struct QgcPlanRoute {
+  /// \brief Start (the takeoff item's position, else the planned home), every later
+  /// positional item in order (home for RETURN_TO_LAUNCH); the last one is the goal. Consecutive
+  /// items at the same place count once.
+  std::vector<MissionPoint> points;
+  /// \brief The NAV_WAYPOINT items' common height when every one is relative to home (frame 3)
+  /// or to the terrain (frame 10) and they agree; taken as height above ground.
+  std::optional<double> cruise_agl_m;
+  std::string cruise_agl_field;  ///< where that height is written (first waypoint's params[6])
+};
+
+/// \brief The route of a QGroundControl `.plan` document (`mission.items`, SimpleItems with
+/// command 16 NAV_WAYPOINT, 22 NAV_TAKEOFF, 21 NAV_LAND or 20 RETURN_TO_LAUNCH;
+/// params[4], params[5] = latitude, longitude in degrees, params[6] = altitude in the item's
+/// `frame`: 0 AMSL, 3 relative to home, 10 above terrain; the 5, 6, 11 integer variants too).
+/// A takeoff or land item without a position (null, or 0, 0) means "here". Camera, gimbal,
+/// region-of-interest, servo and relay commands are skipped; every other command, and
+/// ComplexItems (surveys, corridor and structure scans), is refused naming the item.
+/// Per-waypoint altitudes are not followed: the planner flies at the mission's cruise AGL.
+/// \throws maps::ParseError naming `source`, the JSON path (e.g. "$.mission.items[3].params[4]"),
+/// the value and what was expected.
+[[nodiscard]] QgcPlanRoute parseQgcPlanRoute(const nlohmann::json& doc, const std::string& source);
+
+/// \brief Reads a JSON file named by a mission (the resolved path); maps::readJsonFile unless a
+/// caller (a test, the fuzzer) supplies another.
+using JsonFileReader = std::function<nlohmann::json(const std::string& path)>;
+
 /// \brief Parses a mission document; relative file names are resolved against `base_dir`.
-/// \throws maps::ParseError naming the source, the field and what was expected.
-[[nodiscard]] Mission parseMission(const nlohmann::json& doc, const std::string& source, const std::string& base_dir);
+/// A `qgc_plan` route is read with `read_json` (maps::readJsonFile when empty).
+/// \throws maps::ParseError naming the source (the mission, or the .plan for an error inside
+/// it), the field and what was expected.
+[[nodiscard]] Mission parseMission(const nlohmann::json& doc, const std::string& source, const std::string& base_dir,
+                                   const JsonFileReader& read_json = {});
 /// \brief readJsonFile + parseMission.
 [[nodiscard]] Mission loadMission(const std::string& path);
 
