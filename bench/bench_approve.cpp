@@ -87,26 +87,28 @@ std::string cityMission(planner::PlannerKind kind) {
          {"buildings", dir + "/buildings.geojson"},
          {"orbits", {std::string(SKYLANE_TEST_DATA) + "/gnss/alm01jan2020.txt"}},
          {"integrity", {{"sample_s", 1.0}, {"cost_weight", 1.0}, {"cost_cell_m", 100}}},
-         {"planner", {{"algorithm", std::string(planner::plannerName(kind))}, {"time_limit_s", 3.0}, {"seed", 5},
+         {"planner", {{"algorithm", std::string(planner::plannerName(kind))}, {"time_limit_s", 6.0}, {"iterations", 2000}, {"seed", 5},
                       {"resolution_m", 5.0}, {"margin_m", 600}}}};
   std::ofstream(path) << m.dump(1);
   return path;
 }
 
 void run(benchmark::State& state, const std::string& mission_path) {
-  double length = 0, planning = 0;
+  double length = 0, planning = 0, iterations = 0;
   int approved = 0, n = 0;
   for (auto _ : state) {
     planner::Approver a(planner::loadMission(mission_path));  // loading is part of the job
     const planner::ApprovalReport r = a.approve();
     length += r.planner.length_m;
     planning += r.planner.planning_time_s;
+    iterations += static_cast<double>(r.planner.iterations);
     approved += r.approved ? 1 : 0;
     ++n;
   }
   state.counters["route_m"] = length / n;
   state.counters["planning_s"] = planning / n;
   state.counters["approved"] = static_cast<double>(approved) / n;
+  state.counters["iterations"] = static_cast<double>(iterations) / n;
 }
 
 void BM_ApproveBundledExample(benchmark::State& state) { run(state, kExample); }

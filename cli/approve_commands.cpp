@@ -104,6 +104,8 @@ json reportJson(const planner::ApprovalReport& r, const planner::Mission& m) {
                   {"planning_time_s", std::round(r.planner.planning_time_s * 1e4) / 1e4},
                   {"length_m", roundToMm(r.planner.length_m)},
                   {"attempts", r.planner.attempts},
+                  {"iterations", r.planner.iterations},
+                  {"stopped_by_time", r.planner.stopped_by_time},
                   {"departures_tried", r.planner.departures_tried},
                   {"seed", m.seed}};
   j["elapsed_s"] = std::round(r.elapsed_s * 1e3) / 1e3;

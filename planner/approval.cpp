@@ -317,11 +317,14 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
         }
         prob.resolution_m = m.resolution_m;
         prob.time_limit_s = m.time_limit_s;
+        prob.max_iterations = m.iterations;
         prob.seed = m.seed + static_cast<std::uint64_t>(attempt) * 7919u + leg;
         prob.planner = m.planner;
         prob.simplify = m.simplify;
         last = planPath(prob);
         report.planner.planning_time_s += last.planning_time_s + last.simplify_time_s;
+        report.planner.iterations += last.iterations;
+        report.planner.stopped_by_time = report.planner.stopped_by_time || last.stopped_by_time;
         if (last.status != PathStatus::kExact) {
           ok = false;
           break;
@@ -353,7 +356,8 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
           r.lon_rad = g.lon_rad;
           r.h_ell_m = g.h_ell_m;
         } else {
-          r.message = "no route found within " + std::to_string(m.time_limit_s) + " s of planning (" + report.planner.status + ")";
+          r.message = "no route found within " + std::to_string(last.iterations) + " planner iterations (" +
+                      report.planner.status + (last.stopped_by_time ? ", stopped by the time limit)" : ")");
         }
         last_reasons = {r};
         last_route.clear();

@@ -89,6 +89,8 @@ struct PlannerStats {
   double planning_time_s = 0.0;
   double length_m = 0.0;
   int attempts = 0;          ///< plans made in all
+  std::uint64_t iterations = 0;  ///< planner iterations in all
+  bool stopped_by_time = false;  ///< some search ended at the time limit (then not reproducible)
   int departures_tried = 0;
 };
 

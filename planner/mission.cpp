@@ -377,13 +377,19 @@ Mission parseMission(const nlohmann::json& doc, const std::string& source, const
   }
   if (root.has("planner")) {
     const JsonNode p = root.at("planner");
-    p.requireKnownFields({"algorithm", "time_limit_s", "seed", "resolution_m", "simplify", "margin_m", "max_replans"});
+    p.requireKnownFields(
+        {"algorithm", "time_limit_s", "iterations", "seed", "resolution_m", "simplify", "margin_m", "max_replans"});
     if (p.has("algorithm")) {
       const auto k = parsePlannerKind(p.at("algorithm").str());
       if (!k) p.at("algorithm").fail("\"rrtstar\", \"informed_rrtstar\", \"bitstar\" or \"prmstar\"");
       m.planner = *k;
     }
     if (p.has("time_limit_s")) m.time_limit_s = positive(p.at("time_limit_s"));
+    if (p.has("iterations")) {
+      const double it = p.at("iterations").number();
+      if (!(it >= 1 && it <= 1e9 && it == std::floor(it))) p.at("iterations").fail("a whole number 1…10⁹");
+      m.iterations = static_cast<std::uint64_t>(it);
+    }
     if (p.has("seed")) {
       const double s = p.at("seed").number();
       if (!(s >= 0 && s < 4294967296.0 && s == std::floor(s))) p.at("seed").fail("a whole number 0…2³²−1");

@@ -62,6 +62,7 @@ struct Mission {
   double cost_cell_m = 50.0;   ///< grid of the integrity cost field
   PlannerKind planner = PlannerKind::kRrtStar;
   double time_limit_s = 1.0;
+  std::uint64_t iterations = 3000;  ///< the planner's iteration budget (reproducible), per leg
   std::uint64_t seed = 1;
   double resolution_m = 2.0;
   bool simplify = true;

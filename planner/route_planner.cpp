@@ -1,6 +1,7 @@
 #include "planner/route_planner.hpp"
 
 #include <ompl/base/Planner.h>
+#include <ompl/base/PlannerTerminationCondition.h>
 #include <ompl/base/objectives/PathLengthOptimizationObjective.h>
 #include <ompl/base/objectives/StateCostIntegralObjective.h>
 #include <ompl/base/spaces/RealVectorStateSpace.h>
@@ -15,6 +16,7 @@
 #include <ompl/util/RandomNumbers.h>
 #include <ompl/util/Time.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <mutex>
@@ -186,8 +188,21 @@ PathResult planPath(const PathProblem& p) {
   ss.setup();
 
   const auto t0 = std::chrono::steady_clock::now();
-  const ob::PlannerStatus status = ss.solve(p.time_limit_s);
+  std::atomic<std::uint64_t> checks{0};
+  std::atomic<bool> by_time{false};
+  const ob::PlannerTerminationCondition timed = ob::timedPlannerTerminationCondition(p.time_limit_s);
+  const ob::PlannerTerminationCondition ptc([&]() {
+    if (++checks > p.max_iterations) return true;
+    if (timed()) {
+      by_time = true;
+      return true;
+    }
+    return false;
+  });
+  const ob::PlannerStatus status = ss.solve(ptc);
   out.planning_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.iterations = checks;
+  out.stopped_by_time = by_time;
   if (status != ob::PlannerStatus::EXACT_SOLUTION && status != ob::PlannerStatus::APPROXIMATE_SOLUTION) {
     out.status = PathStatus::kNoSolution;
     return out;

@@ -15,7 +15,9 @@
 ///
 /// Planners: RRT* (Karaman & Frazzoli, IJRR 30(7), 2011), Informed RRT* (Gammell, Srinivasa &
 /// Barfoot, IROS 2014), BIT* (Gammell, Srinivasa & Barfoot, ICRA 2015), PRM* (Karaman &
-/// Frazzoli 2011). A seed makes a run reproducible.
+/// Frazzoli 2011). A seed makes a run reproducible when the iteration budget, not the time
+/// limit, ends the search (OMPL's seed generator is re-seeded before each query). PRM* grows its
+/// roadmap in a second thread, so its result can still vary between runs.
 
 #include <Eigen/Core>
 
@@ -46,7 +48,11 @@ struct PathProblem {
   std::function<double(const Eigen::Vector3d&)> extra_cost;  ///< ≥ 0 per metre; empty = path length
   double cost_step_m = 25.0;   ///< the cost integral's step along a motion (trapezoid rule)
   double resolution_m = 2.0;   ///< motion checking step
-  double time_limit_s = 1.0;
+  double time_limit_s = 1.0;   ///< a safety net: the iteration budget should end the search
+  /// \brief The search ends after this many checks of the planner's termination condition
+  /// (about one per iteration): the same seed then gives the same route whatever the machine's
+  /// load. When the time limit ends the search first, the route depends on the speed.
+  std::uint64_t max_iterations = 3000;
   std::uint64_t seed = 1;
   PlannerKind planner = PlannerKind::kRrtStar;
   bool simplify = true;
@@ -68,6 +74,8 @@ struct PathResult {
   double cost = 0.0;                    ///< objective value (= length when no extra cost)
   double planning_time_s = 0.0;
   double simplify_time_s = 0.0;
+  std::uint64_t iterations = 0;         ///< termination checks made
+  bool stopped_by_time = false;         ///< the time limit ended the search (not reproducible)
   std::string planner;
   bool straight_line = false;           ///< the direct segment was valid and taken without search
 };

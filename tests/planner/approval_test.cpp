@@ -33,7 +33,8 @@ PathProblem openBox() {
   p.start_enu_m = Eigen::Vector3d(0, 0, 50);
   p.goal_enu_m = Eigen::Vector3d(1000, 0, 50);
   p.resolution_m = 1.0;
-  p.time_limit_s = 0.5;
+  p.time_limit_s = 10.0;  // a safety net: the iteration budget ends the search (reproducible)
+  p.max_iterations = 1500;
   return p;
 }
 
@@ -139,7 +140,7 @@ Mission missionWith(const std::vector<json>& zones, const std::string& name, dou
          {"ground_amsl_m", 408},
          {"orbits", {test::dataPath("gnss/alm01jan2020.txt")}},
          {"integrity", {{"cost_weight", 0.0}}},
-         {"planner", {{"time_limit_s", 0.3}, {"seed", 3}}}};
+         {"planner", {{"time_limit_s", 10.0}, {"iterations", 600}, {"seed", 3}}}};
   return parseMission(m, name + ".json", ".");
 }
 
@@ -240,7 +241,6 @@ TEST(Approval, ApprovedCorridorsNeverMeetAnActiveProhibitedZone) {
     }
     const std::string name = "random_" + std::to_string(scene);
     Mission m = missionWith(zones, name);
-    m.time_limit_s = 0.3;
     Approver a(m);
     const ApprovalReport r = a.approve();
     if (!r.approved) continue;
@@ -288,7 +288,6 @@ TEST(Approval, UrbanCanyonSendsTheRouteToBetterSky) {
   m.buildings_file = buildings;
   m.cost_weight = 1.0;
   m.cost_cell_m = 10.0;
-  m.time_limit_s = 1.0;
   Approver a(m);
   const ApprovalReport r = a.approve();
   if (!r.approved) {
