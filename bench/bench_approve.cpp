@@ -87,7 +87,7 @@ std::string cityMission(planner::PlannerKind kind) {
          {"buildings", dir + "/buildings.geojson"},
          {"orbits", {std::string(SKYLANE_TEST_DATA) + "/gnss/alm01jan2020.txt"}},
          {"integrity", {{"sample_s", 1.0}, {"cost_weight", 1.0}, {"cost_cell_m", 100}}},
-         {"planner", {{"algorithm", std::string(planner::plannerName(kind))}, {"time_limit_s", 6.0}, {"iterations", 2000}, {"seed", 5},
+         {"planner", {{"algorithm", std::string(planner::plannerName(kind))}, {"time_limit_s", 8.0}, {"iterations", 10000}, {"seed", 5},
                       {"resolution_m", 5.0}, {"margin_m", 600}}}};
   std::ofstream(path) << m.dump(1);
   return path;
