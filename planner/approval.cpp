@@ -269,7 +269,10 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
   for (const MissionPoint& p : m.points) {
     const Eigen::Vector2d xy = d.frame.toPlane(p.lat_rad, p.lon_rad);
     const auto g = d.ground(xy);
-    if (!g) throw maps::ParseError(m.source, 0, "$.start/$.goal", "", "a point the terrain model covers");
+    if (!g) {
+      throw maps::ParseError(m.source, 0, m.qgc_plan_file.empty() ? "$.start/$.waypoints/$.goal" : "$.qgc_plan", "",
+                             "route points the terrain model covers");
+    }
     stops.emplace_back(xy.x(), xy.y(), *g + m.cruise_agl_m);
   }
   double direct_m = 0.0;
