@@ -200,12 +200,13 @@ Fence::Fence(Corridor level1, Corridor level2, std::vector<airspace::Zone> zones
 Fence::Fence(Corridor level1, Corridor level2, Obstructions obstructions)
     : level1_(std::move(level1)), level2_(std::move(level2)), obstructions_(std::move(obstructions)) {}
 
-FenceVerdict Fence::check(const TimedVolume& v) const {
+FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions,
+                         const TimedVolume& v) {
   FenceVerdict out;
-  const double tol = obstructions_.options().tolerance_m;
-  out.checks.push_back(boxCheck(Level::kCorridor, level1_, v.volume, tol));
-  out.checks.push_back(boxCheck(Level::kAirspace, level2_, v.volume, tol));
-  std::vector<Check> near = obstructions_.check(v);
+  const double tol = obstructions.options().tolerance_m;
+  out.checks.push_back(boxCheck(Level::kCorridor, level1, v.volume, tol));
+  out.checks.push_back(boxCheck(Level::kAirspace, level2, v.volume, tol));
+  std::vector<Check> near = obstructions.check(v);
   out.checks.insert(out.checks.end(), std::make_move_iterator(near.begin()), std::make_move_iterator(near.end()));
 
   for (int wanted : {2, 1}) {
@@ -219,6 +220,8 @@ FenceVerdict Fence::check(const TimedVolume& v) const {
   }
   return out;
 }
+
+FenceVerdict Fence::check(const TimedVolume& v) const { return checkVolume(level1_, level2_, obstructions_, v); }
 
 std::vector<FenceVerdict> Fence::check(const std::vector<TimedVolume>& samples) const {
   std::vector<FenceVerdict> out;

@@ -141,6 +141,11 @@ class Obstructions {
   FenceOptions options_;
 };
 
+/// \brief The fence check of one volume against two box levels and the obstructions (what
+/// Fence::check does; for callers that own the pieces separately, such as route approval).
+[[nodiscard]] FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions,
+                                       const TimedVolume& v);
+
 /// \brief Both box levels, the zones and the obstacles, checked together.
 class Fence {
  public:

@@ -441,29 +441,18 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
         }
         // The fence: both levels, zones and obstacles at this instant.
         const geofence::TimedVolume v{t, t, {ps.xyz, ps.hpl_m, ps.vpl_m}};
-        geofence::FenceVerdict fv;
-        fv.checks.push_back(geofence::Check{});
-        {
-          const auto c1 = level1.contains(v.volume);
-          const auto c2 = level2.contains(v.volume);
-          if (c1.verdict != geofence::Verdict::kInside) ++level1_exceedances;
-          fv.checks.clear();
-          geofence::Check k1;
-          k1.level = geofence::Level::kCorridor;
-          k1.verdict = c1.verdict;
-          k1.margin_h_m = c1.margin_h_m;
-          k1.margin_v_m = c1.margin_v_m;
-          fv.checks.push_back(k1);
-          geofence::Check k2;
-          k2.level = geofence::Level::kAirspace;
-          k2.verdict = c2.verdict;
-          k2.margin_h_m = c2.margin_h_m;
-          k2.margin_v_m = c2.margin_v_m;
-          fv.checks.push_back(k2);
-          if (c2.verdict != geofence::Verdict::kInside) {
+        geofence::FenceVerdict fv = geofence::checkVolume(level1, level2, *d.obstructions, v);
+        for (const geofence::Check& c : fv.checks) {
+          if (c.level == geofence::Level::kCorridor) {
+            // Level 1 is not a rejection: in flight HPL > HAL₁ reruns the monitoring.
+            if (c.verdict != geofence::Verdict::kInside) ++level1_exceedances;
+            continue;
+          }
+          if (c.level == geofence::Level::kAirspace) {
+            if (c.verdict == geofence::Verdict::kInside) continue;
             Reason r;
             r.kind = "airspace";
-            const bool horizontal = c2.margin_h_m < c2.margin_v_m;
+            const bool horizontal = c.margin_h_m < c.margin_v_m;
             r.subject = horizontal ? "HPL" : "VPL";
             r.value_m = horizontal ? ps.hpl_m : ps.vpl_m;
             r.limit_m = horizontal ? d.limits.level2.hal_m : d.limits.level2.val_m;
@@ -471,9 +460,8 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
                         fmtMetres(*r.limit_m) + " by " + fmtMetres(*r.value_m - *r.limit_m);
             addReason(r);
             violations.emplace_back(ps.xyz, std::min(300.0, std::max(ps.hpl_m, 20.0)));
+            continue;
           }
-        }
-        for (geofence::Check& c : d.obstructions->check(v)) {
           if (c.verdict != geofence::Verdict::kInside) {
             Reason r;
             r.kind = c.level == geofence::Level::kZone ? "zone" : "obstacle";
@@ -496,7 +484,6 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
               it->min_clearance_m = std::min(it->min_clearance_m, *c.clearance_m);
             }
           }
-          fv.checks.push_back(std::move(c));
         }
         ps.fence = std::move(fv);
         predicted.push_back(std::move(ps));
