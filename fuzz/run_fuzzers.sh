@@ -3,7 +3,7 @@
 #
 #   fuzz/run_fuzzers.sh [build-dir] [seconds-per-target] [target ...]
 #
-# Defaults: build-fuzz, 60 s, all eleven targets. Work files go to $SKYLANE_FUZZ_WORK
+# Defaults: build-fuzz, 60 s, all twelve targets. Work files go to $SKYLANE_FUZZ_WORK
 # (default /tmp/skylane-fuzz): <target>/corpus (grows), <target>/artifacts (crash-*, timeout-*,
 # oom-*), <target>/log. The repository is only read. Exits non-zero if any target found something.
 # Extra libFuzzer flags can be passed in $SKYLANE_FUZZ_ARGS (e.g. "-jobs=2 -workers=2").
@@ -14,7 +14,7 @@ build="${1:-$root/build-fuzz}"
 seconds="${2:-60}"
 shift $(( $# > 2 ? 2 : $# ))
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(yuma sem rinex_nav rinex_obs geometry text_fields zones buildings fence scenario mission)
+[ ${#targets[@]} -eq 0 ] && targets=(yuma sem rinex_nav rinex_obs geometry text_fields zones buildings fence scenario mission nmea)
 work="${SKYLANE_FUZZ_WORK:-/tmp/skylane-fuzz}"
 data="$root/tests/data"
 
@@ -48,6 +48,7 @@ seed() {  # target corpus-dir
     buildings) cp "$root"/fuzz/corpus/buildings/* "$root"/examples/skymask/*.geojson "$c"/ ;;
     fence) cp "$root"/fuzz/corpus/fence/* "$c"/ ;;
     scenario) cp "$root"/fuzz/corpus/scenario/* "$c"/ ;;
+    nmea) cp "$root"/fuzz/corpus/nmea/* "$c"/ ;;
     mission) cp "$root"/fuzz/corpus/mission/* "$c"/ ;;
     *) echo "unknown target $t" >&2; exit 2 ;;
   esac
