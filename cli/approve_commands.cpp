@@ -124,13 +124,6 @@ json reportJson(const planner::ApprovalReport& r, const planner::Mission& m) {
   return j;
 }
 
-std::vector<std::pair<double, double>> toPlane(const maps::PlaneFrame& frame, const std::vector<Eigen::Vector2d>& xy) {
-  std::vector<std::pair<double, double>> out;
-  for (const Eigen::Vector2d& v : xy) out.emplace_back(v.x(), v.y());
-  (void)frame;
-  return out;
-}
-
 std::string mapSvg(const planner::ApprovalReport& r, const planner::Approver& a) {
   const maps::PlaneFrame& frame = a.frame();
   std::vector<MapShape> shapes;
@@ -179,7 +172,9 @@ std::string mapSvg(const planner::ApprovalReport& r, const planner::Approver& a)
     const double hal = level == 1 ? r.limits.level1.hal_m : r.limits.level2.hal_m;
     for (std::size_t i = 1; i < r.route.size(); ++i) {
       MapShape sh;
-      sh.xy = toPlane(frame, planner::segmentOutline(r.route[i - 1].xyz, r.route[i].xyz, hal));
+      for (const Eigen::Vector2d& v : planner::segmentOutline(r.route[i - 1].xyz, r.route[i].xyz, hal)) {
+        sh.xy.emplace_back(v.x(), v.y());
+      }
       sh.fill = level == 1 ? "#1f77b4" : "#aec7e8";
       sh.stroke = sh.fill;
       sh.fill_opacity = level == 1 ? 0.5 : 0.15;

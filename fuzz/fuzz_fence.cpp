@@ -41,13 +41,8 @@ void useBoxes(const geofence::CorridorSpec& spec) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const std::string text(reinterpret_cast<const char*>(data), size);
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception&) {
-    return 0;
-  }
+  const nlohmann::json doc = nlohmann::json::parse(data, data + size, nullptr, /*allow_exceptions=*/false);
+  if (doc.is_discarded()) return 0;
   const std::string source = "fuzz.json";
   fuzz::parseThenUse(source, [&] { return geofence::parseCorridorSpec(doc, source); }, useBoxes);
   fuzz::parseThenUse(source, [&] { return geofence::parseFix(doc, source); }, [&](const geofence::Fix& f) {

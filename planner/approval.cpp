@@ -302,7 +302,9 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
       std::vector<Eigen::Vector3d> pts{stops.front()};
       PathResult last;
       bool ok = true;
+      std::size_t failed_leg = 0;
       for (std::size_t leg = 1; leg < stops.size() && ok; ++leg) {
+        failed_leg = leg;
         PathProblem prob;
         prob.lower_enu_m = d.lower;
         prob.upper_enu_m = d.upper;
@@ -343,7 +345,7 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
         r.subject = report.planner.status;
         if (last.status == PathStatus::kInvalidStart || last.status == PathStatus::kInvalidGoal) {
           const bool start = last.status == PathStatus::kInvalidStart;
-          const Eigen::Vector3d p = start ? pts.back() : stops[pts.size() == 1 ? 1 : stops.size() - 1];
+          const Eigen::Vector3d p = start ? pts.back() : stops[failed_leg];
           r.message = std::string(start ? "the start" : "the goal") +
                       " is not flyable at cruise height: it is inside (or within the level-1 box of) an active zone"
                       " or obstacle, or outside the altitude limits";
@@ -515,6 +517,10 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
   report.reasons = last_reasons;
   if (!last_route.empty() && departures.size() == 1) {
     say("looking for a later departure");
+    std::vector<Eigen::Vector3d> pts;
+    for (const RoutePoint& p : last_route) pts.push_back(p.xyz);
+    const geofence::Corridor level1(pts, d.limits.level1, {});
+    const geofence::Corridor level2(pts, d.limits.level2, {});
     for (double shift = m.departure_step_s; shift <= 86400.0; shift += m.departure_step_s) {
       const maps::GpsTime dep = m.departure_earliest.plus(shift);
       bool pass = true;
@@ -525,10 +531,10 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
           pass = false;
           break;
         }
+        // The same rule as the approval: every check but level 1 must hold.
         const geofence::TimedVolume v{t, t, {last_samples.xyz[k], pr.pl.hpl_m, pr.pl.vpl_m}};
-        if (pr.pl.hpl_m > d.limits.level2.hal_m || pr.pl.vpl_m > d.limits.level2.val_m) pass = false;
-        for (const geofence::Check& c : d.obstructions->check(v, 0.0)) {
-          if (c.verdict != geofence::Verdict::kInside) pass = false;
+        for (const geofence::Check& c : geofence::checkVolume(level1, level2, *d.obstructions, v).checks) {
+          if (c.level != geofence::Level::kCorridor && c.verdict != geofence::Verdict::kInside) pass = false;
         }
       }
       if (pass) {

@@ -73,7 +73,7 @@ class IntegrityCostObjective : public ob::StateCostIntegralObjective {
  public:
   IntegrityCostObjective(const ob::SpaceInformationPtr& si, std::function<double(const Eigen::Vector3d&)> extra,
                          double step_m)
-      : ob::StateCostIntegralObjective(si, true), extra_(std::move(extra)), step_m_(step_m) {
+      : ob::StateCostIntegralObjective(si, false), extra_(std::move(extra)), step_m_(step_m) {
     description_ = "path length + integrity cost";
   }
   ob::Cost stateCost(const ob::State* s) const override { return ob::Cost(1.0 + extra_(toVector(s))); }
