@@ -1,6 +1,5 @@
 #include "cli/approve_commands.hpp"
 
-#include "cli/json_numbers.hpp"
 #include "cli/svg_plot.hpp"
 #include "cli/zones_commands.hpp"
 #include "maps/file_digest.hpp"
@@ -28,101 +27,6 @@ struct ApproveOptions {
   std::string out_dir;
   bool progress = false;
 };
-
-double deg(double rad) { return std::round(maps::rad2deg(rad) * 1e7) / 1e7; }
-
-json reasonJson(const planner::Reason& r, const maps::GpsTime& dep) {
-  json j;
-  j["kind"] = r.kind;
-  j["subject"] = r.subject;
-  j["message"] = r.message;
-  if (r.t_s) j["time"] = maps::formatRfc3339(dep.plus(*r.t_s), 1);
-  if (r.lat_rad) j["lat"] = deg(*r.lat_rad);
-  if (r.lon_rad) j["lon"] = deg(*r.lon_rad);
-  if (r.h_ell_m) j["h_ell_m"] = roundToMm(*r.h_ell_m);
-  if (r.value_m) j["value_m"] = roundToMm(*r.value_m);
-  if (r.limit_m) j["limit_m"] = roundToMm(*r.limit_m);
-  return j;
-}
-
-json reportJson(const planner::ApprovalReport& r, const planner::Mission& m) {
-  json j;
-  j["mission"] = m.name;
-  j["source"] = m.source;
-  j["decision"] = r.approved ? "approved" : "rejected";
-  j["reasons"] = json::array();
-  for (const planner::Reason& x : r.reasons) j["reasons"].push_back(reasonJson(x, r.departure));
-  j["departure"] = maps::formatRfc3339(r.departure);
-  if (r.earliest_passing_departure) j["earliest_passing_departure"] = maps::formatRfc3339(*r.earliest_passing_departure);
-  json route = json::array();
-  for (const planner::RoutePoint& p : r.route) {
-    route.push_back({{"lat", deg(p.lat_rad)},
-                     {"lon", deg(p.lon_rad)},
-                     {"h_ell_m", roundToMm(p.h_ell_m)},
-                     {"alt_amsl_m", roundToMm(p.alt_amsl_m)},
-                     {"eta", maps::formatRfc3339(r.departure.plus(p.eta_s), 1)},
-                     {"eta_s", roundToMm(p.eta_s)}});
-  }
-  j["route"] = route;
-  j["corridor"] = {{"level", 1}, {"hal_m", roundToMm(r.limits.level1.hal_m)}, {"val_m", roundToMm(r.limits.level1.val_m)},
-                   {"k", m.levels.k1}, {"centre_line", "route"}};
-  j["airspace"] = {{"level", 2}, {"hal_m", roundToMm(r.limits.level2.hal_m)}, {"val_m", roundToMm(r.limits.level2.val_m)},
-                   {"k", m.levels.k2}, {"centre_line", "route"}};
-  json predicted = json::array();
-  for (const planner::PredictedSample& s : r.predicted) {
-    json p{{"time", maps::formatRfc3339(r.departure.plus(s.t_s), 1)},
-           {"lat", deg(s.lat_rad)},
-           {"lon", deg(s.lon_rad)},
-           {"h_ell_m", roundToMm(s.h_ell_m)},
-           {"satellites", s.satellites},
-           {"blocked", s.blocked},
-           {"hpl_m", s.pl_available ? json(roundToMm(s.hpl_m)) : json(nullptr)},
-           {"vpl_m", s.pl_available ? json(roundToMm(s.vpl_m)) : json(nullptr)},
-           {"hal1_m", roundToMm(r.limits.level1.hal_m)},
-           {"val1_m", roundToMm(r.limits.level1.val_m)},
-           {"hal2_m", roundToMm(r.limits.level2.hal_m)},
-           {"val2_m", roundToMm(r.limits.level2.val_m)}};
-    for (const geofence::Check& c : s.fence.checks) {
-      if (c.level == geofence::Level::kAirspace) {
-        p["margin_h_m"] = roundToMm(c.margin_h_m);
-        p["margin_v_m"] = roundToMm(c.margin_v_m);
-      }
-    }
-    predicted.push_back(p);
-  }
-  j["predicted"] = predicted;
-  j["level1_exceedances"] = r.level1_exceedances;
-  json zones = json::array();
-  for (const planner::ZoneApproach& z : r.zones) {
-    zones.push_back({{"id", z.identifier}, {"restriction", z.restriction}, {"counted", z.counted},
-                     {"min_clearance_m", roundToMm(z.min_clearance_m)}});
-  }
-  j["zones"] = zones;
-  j["planner"] = {{"algorithm", r.planner.algorithm},
-                  {"status", r.planner.status},
-                  {"straight_line", r.planner.straight_line},
-                  {"planning_time_s", std::round(r.planner.planning_time_s * 1e4) / 1e4},
-                  {"length_m", roundToMm(r.planner.length_m)},
-                  {"attempts", r.planner.attempts},
-                  {"iterations", r.planner.iterations},
-                  {"stopped_by_time", r.planner.stopped_by_time},
-                  {"departures_tried", r.planner.departures_tried},
-                  {"seed", m.seed}};
-  j["elapsed_s"] = std::round(r.elapsed_s * 1e3) / 1e3;
-  // The inputs' digests: the approval can be audited and replayed against exactly these files.
-  json inputs = json::array();
-  auto add = [&inputs](const std::string& role, const std::string& path) {
-    if (!path.empty()) inputs.push_back({{"role", role}, {"file", path}, {"sha256", maps::fileSha256Hex(path)}});
-  };
-  add("mission", m.source);
-  for (const std::string& f : m.zone_files) add("zones", f);
-  add("buildings", m.buildings_file);
-  add("terrain", m.terrain_file);
-  for (const std::string& f : m.orbit_files) add("orbits", f);
-  j["inputs"] = inputs;
-  j["software"] = {{"name", "skylane"}, {"planner_seed", m.seed}};
-  return j;
-}
 
 std::string mapSvg(const planner::ApprovalReport& r, const planner::Approver& a) {
   const maps::PlaneFrame& frame = a.frame();
@@ -238,7 +142,7 @@ void runApprove(const ApproveOptions& o) {
   const planner::ApprovalReport r = approver.approve([show](const std::string& s) {
     if (show) std::cerr << "skylane: approve: " << s << "\n";
   });
-  const json j = reportJson(r, approver.mission());
+  const json j = planner::approvalReportJson(r, approver.mission());
   if (!o.out_dir.empty()) {
     std::filesystem::create_directories(o.out_dir);
     std::ofstream(std::filesystem::path(o.out_dir) / "report.json") << j.dump(2) << "\n";

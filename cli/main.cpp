@@ -6,6 +6,7 @@
 #include "cli/integrity_commands.hpp"
 #include "cli/simulate_commands.hpp"
 #include "cli/skymask_commands.hpp"
+#include "cli/track_commands.hpp"
 #include "cli/zones_commands.hpp"
 #include "integrity/gnss/parse_error.hpp"
 
@@ -23,6 +24,7 @@ int main(int argc, char** argv) {
   skylane::cli::addFenceCommands(app);
   skylane::cli::addSimulateCommands(app);
   skylane::cli::addApproveCommands(app);
+  skylane::cli::addTrackCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

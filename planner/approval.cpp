@@ -19,6 +19,8 @@ namespace skylane::planner {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Least radius round a replan's start within which only the vehicle's point must be clear [m].
+constexpr double kMinExempt_m = 10.0;
 
 /// φ(r) of the file comment: grows without bound as PL approaches the alert limit.
 double integrityPenalty(double r) {
@@ -59,6 +61,12 @@ struct Approver::Impl {
   int cols = 0, rows = 0;
   std::vector<double> cost;
   std::vector<Eigen::Vector2d> grid_pl;  ///< (HPL, VPL) per cell; NaN when unavailable
+  bool cost_grid_built = false;
+
+  /// The approval steps of approval.hpp from `stops` (map frame) for each departure in turn;
+  /// `from_vehicle`: a replan from where the vehicle is (no later-departure search).
+  ApprovalReport run(const std::vector<Eigen::Vector3d>& stops, const std::vector<maps::GpsTime>& departures,
+                     bool from_vehicle, const std::function<void(const std::string&)>& progress);
 
   explicit Impl(Mission mission)
       : m(std::move(mission)),
@@ -241,6 +249,7 @@ Approver::~Approver() = default;
 const Mission& Approver::mission() const { return impl_->m; }
 const maps::PlaneFrame& Approver::frame() const { return impl_->frame; }
 const geofence::Obstructions& Approver::obstructions() const { return *impl_->obstructions; }
+const integrity::OrbitSource& Approver::orbits() const { return impl_->orbits; }
 
 namespace {
 
@@ -254,40 +263,73 @@ struct RouteSamples {
 
 }  // namespace
 
-ApprovalReport Approver::approve(const std::function<void(const std::string&)>& progress) {
-  Impl& d = *impl_;
-  const Mission& m = d.m;
-  const auto started = std::chrono::steady_clock::now();
-  auto say = [&progress](const std::string& s) {
-    if (progress) progress(s);
-  };
-  ApprovalReport report;
-  report.limits = d.limits;
-
-  // Mission points at cruise height above the terrain.
+std::vector<Eigen::Vector3d> Approver::missionStops() const {
+  const Mission& m = impl_->m;
   std::vector<Eigen::Vector3d> stops;
   for (const MissionPoint& p : m.points) {
-    const Eigen::Vector2d xy = d.frame.toPlane(p.lat_rad, p.lon_rad);
-    const auto g = d.ground(xy);
+    const Eigen::Vector2d xy = impl_->frame.toPlane(p.lat_rad, p.lon_rad);
+    const auto g = impl_->ground(xy);
     if (!g) {
       throw maps::ParseError(m.source, 0, m.qgc_plan_file.empty() ? "$.start/$.waypoints/$.goal" : "$.qgc_plan", "",
                              "route points the terrain model covers");
     }
     stops.emplace_back(xy.x(), xy.y(), *g + m.cruise_agl_m);
   }
-  double direct_m = 0.0;
-  for (std::size_t i = 1; i < stops.size(); ++i) direct_m += (stops[i] - stops[i - 1]).head<2>().norm();
-  const double direct_s = direct_m / m.cruise_speed_mps;
-  const double flight_bound_s = 2.0 * direct_s + 120.0;
+  return stops;
+}
 
-  const bool masked = d.index || !m.terrain_file.empty();
+ApprovalReport Approver::approve(const std::function<void(const std::string&)>& progress) {
+  const Mission& m = impl_->m;
   std::vector<maps::GpsTime> departures;
   for (double dt = 0.0; dt <= (m.departure_latest - m.departure_earliest) + 1e-6; dt += m.departure_step_s) {
     departures.push_back(m.departure_earliest.plus(dt));
   }
+  return impl_->run(missionStops(), departures, false, progress);
+}
 
-  say("predicted protection levels over the area (integrity cost field)");
-  d.buildCostGrid(m.departure_earliest.plus(direct_s / 2.0));
+ApprovalReport Approver::replanFrom(const Eigen::Vector3d& p_map, const maps::GpsTime& now, std::size_t next_stop,
+                                    const std::function<void(const std::string&)>& progress) {
+  if (!p_map.allFinite()) throw std::invalid_argument("replanFrom: the vehicle's position is not finite");
+  std::vector<Eigen::Vector3d> all = missionStops();
+  if (next_stop < 1 || next_stop >= all.size()) {
+    throw std::invalid_argument("replanFrom: next stop " + std::to_string(next_stop) + " is not one of the mission's 1.." +
+                                std::to_string(all.size() - 1));
+  }
+  std::vector<Eigen::Vector3d> stops{p_map};
+  stops.insert(stops.end(), all.begin() + static_cast<std::ptrdiff_t>(next_stop), all.end());
+  return impl_->run(stops, {now}, true, progress);
+}
+
+ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, const std::vector<maps::GpsTime>& departures,
+                                   bool from_vehicle, const std::function<void(const std::string&)>& progress) {
+  Impl& d = *this;
+  const auto started = std::chrono::steady_clock::now();
+  auto say = [&progress](const std::string& s) {
+    if (progress) progress(s);
+  };
+  ApprovalReport report;
+  report.limits = d.limits;
+  double direct_m = 0.0;
+  for (std::size_t i = 1; i < stops.size(); ++i) direct_m += (stops[i] - stops[i - 1]).head<2>().norm();
+  const double direct_s = direct_m / m.cruise_speed_mps;
+  const double flight_bound_s = 2.0 * direct_s + 120.0;
+  const maps::GpsTime latest_departure = departures.back();
+
+  const bool masked = d.index || !m.terrain_file.empty();
+  if (!cost_grid_built) {
+    say("predicted protection levels over the area (integrity cost field)");
+    d.buildCostGrid(departures.front().plus(direct_s / 2.0));
+    cost_grid_built = true;
+  }
+  // From the vehicle: the search box reaches it, and near it only the vehicle's own point must be
+  // clear (it may have drifted so close to a zone that its box is not: the route leads it away).
+  Eigen::Vector3d box_lo = d.lower, box_hi = d.upper;
+  double exempt_m = 0.0;
+  if (from_vehicle) {
+    box_lo = box_lo.cwiseMin(stops.front() - Eigen::Vector3d::Constant(1.0));
+    box_hi = box_hi.cwiseMax(stops.front() + Eigen::Vector3d::Constant(1.0));
+    exempt_m = std::max(kMinExempt_m, 2.0 * d.planningVolume(stops.front()).hpl_m);
+  }
 
   std::vector<std::pair<Eigen::Vector3d, double>> penalties;
   std::vector<Reason> last_reasons;
@@ -306,14 +348,18 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
       for (std::size_t leg = 1; leg < stops.size() && ok; ++leg) {
         failed_leg = leg;
         PathProblem prob;
-        prob.lower_enu_m = d.lower;
-        prob.upper_enu_m = d.upper;
+        prob.lower_enu_m = box_lo;
+        prob.upper_enu_m = box_hi;
         prob.start_enu_m = pts.back();
         prob.goal_enu_m = stops[leg];
         const Eigen::Vector2d start_xy = stops.front().head<2>();
-        const maps::GpsTime latest = m.departure_latest.plus(flight_bound_s);
-        prob.is_valid = [&d, &penalties, start_xy, dep, latest, &m](const Eigen::Vector3d& p) {
+        const maps::GpsTime latest = latest_departure.plus(flight_bound_s);
+        const Eigen::Vector3d vehicle = stops.front();
+        prob.is_valid = [&d, &penalties, start_xy, dep, latest, this, vehicle, exempt_m](const Eigen::Vector3d& p) {
           const maps::GpsTime earliest = dep.plus((p.head<2>() - start_xy).norm() / m.cruise_speed_mps);
+          if (exempt_m > 0.0 && (p - vehicle).norm() <= exempt_m) {
+            return !d.obstructions->firstConflict({earliest, latest, {p, 0.0, 0.0}});
+          }
           return d.valid(p, earliest, latest, penalties);
         };
         if (!d.cost.empty()) {
@@ -350,7 +396,7 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
                       " is not flyable at cruise height: it is inside (or within the level-1 box of) an active zone"
                       " or obstacle, or outside the altitude limits";
           if (const auto c = d.obstructions->firstConflict(
-                  {dep, m.departure_latest.plus(flight_bound_s), {p, d.limits.level1.hal_m, d.limits.level1.val_m}})) {
+                  {dep, latest_departure.plus(flight_bound_s), {p, d.limits.level1.hal_m, d.limits.level1.val_m}})) {
             r.kind = c->level == geofence::Level::kZone ? "zone" : "obstacle";
             r.subject = c->subject;
             r.message = std::string(start ? "the start" : "the goal") + " lies in " +
@@ -464,7 +510,9 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
             violations.emplace_back(ps.xyz, std::min(300.0, std::max(ps.hpl_m, 20.0)));
             continue;
           }
-          if (c.verdict != geofence::Verdict::kInside) {
+          // A replan's first metres leave the place the vehicle is in; they are not its reasons.
+          const bool leaving = from_vehicle && (ps.xyz - stops.front()).norm() <= exempt_m;
+          if (c.verdict != geofence::Verdict::kInside && !leaving) {
             Reason r;
             r.kind = c.level == geofence::Level::kZone ? "zone" : "obstacle";
             r.subject = c.subject;
@@ -515,14 +563,14 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
   // (within 24 h, in departure steps) at which the same route passes its integrity checks.
   report.approved = false;
   report.reasons = last_reasons;
-  if (!last_route.empty() && departures.size() == 1) {
+  if (!last_route.empty() && departures.size() == 1 && !from_vehicle) {
     say("looking for a later departure");
     std::vector<Eigen::Vector3d> pts;
     for (const RoutePoint& p : last_route) pts.push_back(p.xyz);
     const geofence::Corridor level1(pts, d.limits.level1, {});
     const geofence::Corridor level2(pts, d.limits.level2, {});
     for (double shift = m.departure_step_s; shift <= 86400.0; shift += m.departure_step_s) {
-      const maps::GpsTime dep = m.departure_earliest.plus(shift);
+      const maps::GpsTime dep = departures.front().plus(shift);
       bool pass = true;
       for (std::size_t k = 0; k < last_samples.t_s.size() && pass; ++k) {
         const maps::GpsTime t = dep.plus(last_samples.t_s[k]);

@@ -35,6 +35,7 @@
 
 #include "geofence/corridor.hpp"
 #include "geofence/fence.hpp"
+#include "integrity/gnss/orbit_source.hpp"
 #include "maps/plane_frame.hpp"
 
 #include <functional>
@@ -121,9 +122,24 @@ class Approver {
   /// \brief Runs the whole approval; `progress(message)` is called at each step.
   [[nodiscard]] ApprovalReport approve(const std::function<void(const std::string&)>& progress = {});
 
+  /// \brief A new route from where the vehicle is (map frame: x, y, ellipsoidal height) through
+  /// the mission's remaining points from `next_stop` (index into Mission::points, ≥ 1) to the goal,
+  /// departing `now`: the same steps as approve() for one departure. Within max(10 m, 2 × the
+  /// planning volume) of the vehicle only its own point must be clear of zones and obstacles, and
+  /// samples there give no zone or obstacle reason (the route leads the vehicle out). Reuses the
+  /// cost field of an earlier approve() or replan.
+  /// \throws std::invalid_argument for a non-finite position or a next_stop out of range.
+  [[nodiscard]] ApprovalReport replanFrom(const Eigen::Vector3d& p_map, const maps::GpsTime& now, std::size_t next_stop,
+                                          const std::function<void(const std::string&)>& progress = {});
+  /// \brief The mission's points at cruise height above the terrain (map frame).
+  /// \throws maps::ParseError when the terrain does not cover one.
+  [[nodiscard]] std::vector<Eigen::Vector3d> missionStops() const;
+
   [[nodiscard]] const Mission& mission() const;
   /// \brief The mission's map frame (origin at the start).
   [[nodiscard]] const maps::PlaneFrame& frame() const;
+  /// \brief The mission's orbit files (for live PLs from raw pseudoranges).
+  [[nodiscard]] const integrity::OrbitSource& orbits() const;
   /// \brief The zones and obstacles loaded from the mission's files.
   [[nodiscard]] const geofence::Obstructions& obstructions() const;
 

@@ -1,10 +1,15 @@
 #include "planner/report_formats.hpp"
 
+#include "maps/file_digest.hpp"
+#include "maps/json_node.hpp"
+
 #include <cmath>
 
 namespace skylane::planner {
 
 namespace {
+
+using nlohmann::json;
 
 double round7(double deg) { return std::round(deg * 1e7) / 1e7; }
 double roundMm(double m) { return std::round(m * 1e3) / 1e3; }
@@ -14,7 +19,103 @@ nlohmann::json lonLat(const maps::PlaneFrame& frame, const Eigen::Vector2d& xy) 
   return {round7(maps::rad2deg(ll.y())), round7(maps::rad2deg(ll.x()))};
 }
 
+double deg(double rad) { return round7(maps::rad2deg(rad)); }
+
+nlohmann::json reasonJson(const Reason& r, const maps::GpsTime& dep) {
+  json j;
+  j["kind"] = r.kind;
+  j["subject"] = r.subject;
+  j["message"] = r.message;
+  if (r.t_s) j["time"] = maps::formatRfc3339(dep.plus(*r.t_s), 1);
+  if (r.lat_rad) j["lat"] = deg(*r.lat_rad);
+  if (r.lon_rad) j["lon"] = deg(*r.lon_rad);
+  if (r.h_ell_m) j["h_ell_m"] = roundMm(*r.h_ell_m);
+  if (r.value_m) j["value_m"] = roundMm(*r.value_m);
+  if (r.limit_m) j["limit_m"] = roundMm(*r.limit_m);
+  return j;
+}
+
 }  // namespace
+
+nlohmann::json approvalReportJson(const ApprovalReport& r, const Mission& m) {
+  using nlohmann::json;
+  json j;
+  j["mission"] = m.name;
+  j["source"] = m.source;
+  j["decision"] = r.approved ? "approved" : "rejected";
+  j["reasons"] = json::array();
+  for (const Reason& x : r.reasons) j["reasons"].push_back(reasonJson(x, r.departure));
+  j["departure"] = maps::formatRfc3339(r.departure);
+  if (r.earliest_passing_departure) j["earliest_passing_departure"] = maps::formatRfc3339(*r.earliest_passing_departure);
+  json route = json::array();
+  for (const RoutePoint& p : r.route) {
+    route.push_back({{"lat", deg(p.lat_rad)},
+                     {"lon", deg(p.lon_rad)},
+                     {"h_ell_m", roundMm(p.h_ell_m)},
+                     {"alt_amsl_m", roundMm(p.alt_amsl_m)},
+                     {"eta", maps::formatRfc3339(r.departure.plus(p.eta_s), 1)},
+                     {"eta_s", roundMm(p.eta_s)}});
+  }
+  j["route"] = route;
+  j["corridor"] = {{"level", 1}, {"hal_m", roundMm(r.limits.level1.hal_m)}, {"val_m", roundMm(r.limits.level1.val_m)},
+                   {"k", m.levels.k1}, {"centre_line", "route"}};
+  j["airspace"] = {{"level", 2}, {"hal_m", roundMm(r.limits.level2.hal_m)}, {"val_m", roundMm(r.limits.level2.val_m)},
+                   {"k", m.levels.k2}, {"centre_line", "route"}};
+  json predicted = json::array();
+  for (const PredictedSample& s : r.predicted) {
+    json p{{"time", maps::formatRfc3339(r.departure.plus(s.t_s), 1)},
+           {"lat", deg(s.lat_rad)},
+           {"lon", deg(s.lon_rad)},
+           {"h_ell_m", roundMm(s.h_ell_m)},
+           {"satellites", s.satellites},
+           {"blocked", s.blocked},
+           {"hpl_m", s.pl_available ? json(roundMm(s.hpl_m)) : json(nullptr)},
+           {"vpl_m", s.pl_available ? json(roundMm(s.vpl_m)) : json(nullptr)},
+           {"hal1_m", roundMm(r.limits.level1.hal_m)},
+           {"val1_m", roundMm(r.limits.level1.val_m)},
+           {"hal2_m", roundMm(r.limits.level2.hal_m)},
+           {"val2_m", roundMm(r.limits.level2.val_m)}};
+    for (const geofence::Check& c : s.fence.checks) {
+      if (c.level == geofence::Level::kAirspace) {
+        p["margin_h_m"] = roundMm(c.margin_h_m);
+        p["margin_v_m"] = roundMm(c.margin_v_m);
+      }
+    }
+    predicted.push_back(p);
+  }
+  j["predicted"] = predicted;
+  j["level1_exceedances"] = r.level1_exceedances;
+  json zones = json::array();
+  for (const ZoneApproach& z : r.zones) {
+    zones.push_back({{"id", z.identifier}, {"restriction", z.restriction}, {"counted", z.counted},
+                     {"min_clearance_m", roundMm(z.min_clearance_m)}});
+  }
+  j["zones"] = zones;
+  j["planner"] = {{"algorithm", r.planner.algorithm},
+                  {"status", r.planner.status},
+                  {"straight_line", r.planner.straight_line},
+                  {"planning_time_s", std::round(r.planner.planning_time_s * 1e4) / 1e4},
+                  {"length_m", roundMm(r.planner.length_m)},
+                  {"attempts", r.planner.attempts},
+                  {"iterations", r.planner.iterations},
+                  {"stopped_by_time", r.planner.stopped_by_time},
+                  {"departures_tried", r.planner.departures_tried},
+                  {"seed", m.seed}};
+  j["elapsed_s"] = std::round(r.elapsed_s * 1e3) / 1e3;
+  // The inputs' digests: the approval can be audited and replayed against exactly these files.
+  json inputs = json::array();
+  auto add = [&inputs](const std::string& role, const std::string& path) {
+    if (!path.empty()) inputs.push_back({{"role", role}, {"file", path}, {"sha256", maps::fileSha256Hex(path)}});
+  };
+  add("mission", m.source);
+  for (const std::string& f : m.zone_files) add("zones", f);
+  add("buildings", m.buildings_file);
+  add("terrain", m.terrain_file);
+  for (const std::string& f : m.orbit_files) add("orbits", f);
+  j["inputs"] = inputs;
+  j["software"] = {{"name", "skylane"}, {"planner_seed", m.seed}};
+  return j;
+}
 
 std::vector<Eigen::Vector2d> segmentOutline(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double hal_m) {
   Eigen::Vector2d d = (b - a).head<2>();
@@ -102,6 +203,58 @@ nlohmann::json operationalIntentVolumes(const ApprovalReport& report, const maps
          {"time_end", {{"value", maps::formatRfc3339(report.departure.plus(b.eta_s + time_buffer_s), 0)}, {"format", "RFC3339"}}}});
   }
   return volumes;
+}
+
+ApprovedFlight parseApprovalReport(const nlohmann::json& doc, const std::string& source) {
+  const maps::JsonNode root{doc, "$", source};
+  if (!doc.is_object()) root.fail("an approval report (a JSON object written by skylane approve)");
+  ApprovedFlight f;
+  f.report_source = source;
+  f.mission_name = root.has("mission") ? root.at("mission").str() : std::string();
+  f.mission_source = root.at("source").str();
+  const std::string decision = root.at("decision").str();
+  if (decision != "approved" && decision != "rejected") root.at("decision").fail("\"approved\" or \"rejected\"");
+  f.approved = decision == "approved";
+  const auto time = [](const maps::JsonNode& n) {
+    const auto t = maps::parseRfc3339(n.str());
+    if (!t) n.fail("an RFC 3339 date-time");
+    return *t;
+  };
+  f.departure = time(root.at("departure"));
+  const maps::JsonNode route = root.at("route");
+  if (route.array().size() < 2) route.fail("a route of at least 2 points");
+  for (std::size_t i = 0; i < route.j.size(); ++i) {
+    const maps::JsonNode p = route.item(i);
+    RoutePoint rp;
+    const double lat = p.at("lat").number(), lon = p.at("lon").number();
+    if (std::abs(lat) > 90.0) p.at("lat").fail("a latitude in [-90, 90] degrees");
+    if (std::abs(lon) > 180.0) p.at("lon").fail("a longitude in [-180, 180] degrees");
+    rp.lat_rad = maps::deg2rad(lat);
+    rp.lon_rad = maps::deg2rad(lon);
+    rp.h_ell_m = p.at("h_ell_m").number();
+    rp.alt_amsl_m = p.has("alt_amsl_m") ? p.at("alt_amsl_m").number() : rp.h_ell_m;
+    rp.eta_s = p.at("eta_s").number();
+    if (!f.route.empty() && rp.eta_s < f.route.back().eta_s) p.at("eta_s").fail("an ETA not before the previous point's");
+    f.route.push_back(rp);
+  }
+  const auto limits = [](const maps::JsonNode& n) {
+    geofence::AlertLimits l;
+    l.hal_m = n.at("hal_m").number();
+    l.val_m = n.at("val_m").number();
+    if (!(l.hal_m > 0.0)) n.at("hal_m").fail("an alert limit > 0 m");
+    if (!(l.val_m > 0.0)) n.at("val_m").fail("an alert limit > 0 m");
+    return l;
+  };
+  f.level1 = limits(root.at("corridor"));
+  f.level2 = limits(root.at("airspace"));
+  if (root.has("inputs")) {
+    const maps::JsonNode inputs = root.at("inputs");
+    for (std::size_t i = 0; i < inputs.array().size(); ++i) {
+      const maps::JsonNode in = inputs.item(i);
+      if (in.has("role") && in.at("role").str() == "mission" && in.has("sha256")) f.mission_sha256 = in.at("sha256").str();
+    }
+  }
+  return f;
 }
 
 }  // namespace skylane::planner

@@ -13,6 +13,27 @@
 
 namespace skylane::planner {
 
+/// \brief The approval report (`skylane approve` prints it, `report.json`; README "The report"):
+/// decision, reasons, departure, route with ETAs, both box levels, predicted samples, zones,
+/// planner statistics and the inputs' SHA-256 digests.
+[[nodiscard]] nlohmann::json approvalReportJson(const ApprovalReport& report, const Mission& mission);
+
+/// \brief What live tracking needs of an approval report.
+struct ApprovedFlight {
+  std::string report_source;   ///< the report file
+  std::string mission_name;
+  std::string mission_source;  ///< the mission file as the report names it
+  std::string mission_sha256;  ///< its digest at approval time (empty when the report has none)
+  bool approved = false;
+  maps::GpsTime departure;
+  std::vector<RoutePoint> route;  ///< lat, lon, h_ell, AMSL, ETA (xyz left for the caller's frame)
+  geofence::AlertLimits level1, level2;
+};
+
+/// \brief Reads the fields of approvalReportJson that tracking uses.
+/// \throws maps::ParseError naming `source`, the JSON path, the value and what was expected.
+[[nodiscard]] ApprovedFlight parseApprovalReport(const nlohmann::json& doc, const std::string& source);
+
 /// \brief The footprint of one segment's box in the map frame: the rectangle around a→b
 /// widened by `hal_m` on each side and lengthened by `hal_m` at both ends, so that it also
 /// covers the joint cylinders (radius hal_m) at a and b. Counter-clockwise.

@@ -1,0 +1,371 @@
+#include "cli/track_commands.hpp"
+
+#include "integrity/gnss/nmea.hpp"
+#include "integrity/gnss/rinex_nav.hpp"
+#include "integrity/gnss/rinex_obs.hpp"
+#include "integrity/raim/spp.hpp"
+#include "maps/parse_error.hpp"
+#include "planner/tracking/track_store.hpp"
+#include "planner/tracking/tracker.hpp"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+namespace skylane::cli {
+namespace {
+
+using maps::ParseError;
+using nlohmann::json;
+
+std::atomic<bool> g_stop{false};
+extern "C" void onStopSignal(int) { g_stop = true; }
+
+struct TrackOptions {
+  std::vector<std::string> approvals;
+  std::string input = "-";
+  std::string format = "jsonl";
+  std::vector<std::string> navs;
+  std::string date;
+  std::string db;
+  std::string out;
+  std::string level1 = "3/5";
+  std::string level2 = "1/1";
+  int recover_after = 2;
+  double stale_after_s = 3.0;
+  double cooldown_s = 10.0;
+  double max_jump_s = 300.0;
+  bool no_replan = false;
+  bool replan_on_pl = false;
+  int batch = 200;
+};
+
+std::pair<int, int> parseMofN(const std::string& text, const char* option) {
+  int m = 0, n = 0;
+  char slash = 0;
+  std::istringstream s(text);
+  if (!(s >> m >> slash >> n) || slash != '/' || !s.eof() || m < 1 || n < m) {
+    throw ParseError(option, 0, option, text, "M/N with 1 ≤ M ≤ N (M violated fixes of the last N)");
+  }
+  return {m, n};
+}
+
+/// Lines from a file, stdin or UDP datagrams (one or more lines each), with a timeout so that a
+/// stop signal and stale flights are noticed while the input is quiet.
+class LineSource {
+ public:
+  explicit LineSource(const std::string& input) : name_(input) {
+    if (input == "-") {
+      fd_ = STDIN_FILENO;
+      live_ = true;
+    } else if (input.rfind("udp://", 0) == 0) {
+      const std::string hostport = input.substr(6);
+      const auto colon = hostport.rfind(':');
+      sockaddr_in addr{};
+      addr.sin_family = AF_INET;
+      const std::string host = colon == std::string::npos ? "" : hostport.substr(0, colon);
+      const std::string port = colon == std::string::npos ? "" : hostport.substr(colon + 1);
+      char* end = nullptr;
+      const long p = std::strtol(port.c_str(), &end, 10);
+      if (host.empty() || port.empty() || *end != '\0' || p < 1 || p > 65535 || inet_pton(AF_INET, host.c_str(), &addr.sin_addr) != 1) {
+        throw ParseError("--input", 0, "--input", input, "udp://IPv4:PORT, e.g. udp://127.0.0.1:5005");
+      }
+      addr.sin_port = htons(static_cast<std::uint16_t>(p));
+      fd_ = socket(AF_INET, SOCK_DGRAM, 0);
+      if (fd_ < 0 || bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+        throw ParseError("--input", 0, "--input", input, std::string("a UDP port to listen on (") + std::strerror(errno) + ")");
+      }
+      udp_ = live_ = true;
+    } else {
+      fd_ = open(input.c_str(), O_RDONLY);
+      if (fd_ < 0) throw ParseError(input, 0, "--input", input, std::string("a readable file (") + std::strerror(errno) + ")");
+    }
+  }
+  ~LineSource() {
+    if (fd_ > STDIN_FILENO) close(fd_);
+  }
+  LineSource(const LineSource&) = delete;
+  LineSource& operator=(const LineSource&) = delete;
+
+  enum class Status { kLine, kTimeout, kEnd };
+  /// Next line (without the line end); kTimeout after `timeout_ms` without one on a live input.
+  Status next(std::string& line, int timeout_ms) {
+    for (;;) {
+      const auto nl = buffer_.find('\n');
+      if (nl != std::string::npos) {
+        line = buffer_.substr(0, nl);
+        buffer_.erase(0, nl + 1);
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        return Status::kLine;
+      }
+      if (eof_) {
+        if (buffer_.empty()) return Status::kEnd;
+        line.swap(buffer_);
+        buffer_.clear();
+        return Status::kLine;
+      }
+      if (live_) {
+        pollfd p{fd_, POLLIN, 0};
+        const int r = poll(&p, 1, timeout_ms);
+        if (r == 0 || (r < 0 && errno == EINTR)) return Status::kTimeout;
+      }
+      char chunk[65536];
+      const ssize_t n = udp_ ? recv(fd_, chunk, sizeof chunk, 0) : read(fd_, chunk, sizeof chunk);
+      if (n < 0 && errno == EINTR) return Status::kTimeout;
+      if (n <= 0) {
+        if (!udp_) eof_ = true;
+        continue;
+      }
+      buffer_.append(chunk, static_cast<std::size_t>(n));
+      if (udp_ && buffer_.back() != '\n') buffer_.push_back('\n');  // a datagram ends its last line
+    }
+  }
+  [[nodiscard]] bool live() const { return live_; }
+  [[nodiscard]] const std::string& name() const { return name_; }
+
+ private:
+  std::string name_;
+  int fd_ = -1;
+  bool live_ = false, udp_ = false, eof_ = false;
+  std::string buffer_;
+};
+
+void runTrack(const TrackOptions& o) {
+  if (o.format != "jsonl" && o.format != "nmea" && o.format != "rinex") {
+    throw ParseError("--format", 0, "--format", o.format, "jsonl, nmea or rinex");
+  }
+  planner::TrackerOptions topt;
+  std::tie(topt.level1_m, topt.level1_n) = parseMofN(o.level1, "--level1");
+  std::tie(topt.level2_m, topt.level2_n) = parseMofN(o.level2, "--level2");
+  topt.recover_after = o.recover_after;
+  topt.stale_after_s = o.stale_after_s;
+  topt.replan_cooldown_s = o.cooldown_s;
+  topt.max_time_jump_s = o.max_jump_s;
+  topt.replan = !o.no_replan;
+  topt.replan_on_pl_exceedance = o.replan_on_pl;
+  planner::Tracker tracker(topt);
+
+  std::unique_ptr<planner::TrackStore> store;
+  std::map<std::string, std::string> report_of;
+  if (!o.db.empty()) {
+    store = std::make_unique<planner::TrackStore>(o.db);
+    for (const planner::StoredFlight& f : store->flights()) {
+      const std::string id = tracker.addApprovalFile(f.report, f.id);
+      tracker.restore(id, planner::parseFlightState(f.state, o.db + ": flight " + id), f.route);
+      report_of[id] = f.report;
+      std::cerr << "skylane: track: resumed flight " << id << " (" << tracker.state(id).fixes << " fixes so far, route version "
+                << tracker.state(id).route_version << ")\n";
+    }
+  }
+  for (const std::string& a : o.approvals) {
+    const auto eq = a.find('=');
+    const std::string id = eq == std::string::npos ? "" : a.substr(0, eq);
+    const std::string path = eq == std::string::npos ? a : a.substr(eq + 1);
+    if (!id.empty() && report_of.count(id)) continue;  // resumed from the database
+    const std::string got = tracker.addApprovalFile(path, id);
+    report_of[got] = path;
+  }
+  if (tracker.flights().empty()) throw ParseError("--approval", 0, "--approval", "", "at least one approval report");
+  if ((o.format == "nmea" || o.format == "rinex") && tracker.flights().size() != 1) {
+    throw ParseError("--format", 0, "--format", o.format, "one approval (an NMEA or RINEX stream is one vehicle)");
+  }
+
+  std::ofstream out_file;
+  if (!o.out.empty()) {
+    out_file.open(o.out, std::ios::app);
+    if (!out_file) throw ParseError(o.out, 0, "--out", o.out, "a writable file");
+  }
+  std::ostream& out = o.out.empty() ? std::cout : out_file;
+  std::size_t accepted = 0, rejected = 0, events = 0, line_no = 0;
+  const std::size_t resume_line = store && o.input != "-" ? store->inputLine(o.input) : 0;
+  auto emit = [&](const std::vector<planner::TrackEvent>& evs) {
+    for (const planner::TrackEvent& e : evs) {
+      out << e.dump() << "\n";
+      ++events;
+      if (e.at("event") == "rejected_input") ++rejected;
+      if (e.at("event") == "fix") ++accepted;
+      if (store) store->appendEvent(e);
+    }
+  };
+  int pending = 0;
+  auto checkpoint = [&](bool force) {
+    if (!store || (!force && pending < o.batch)) return;
+    for (const std::string& id : tracker.flights()) {
+      store->putFlight({id, report_of[id], planner::flightStateJson(tracker.state(id)), tracker.routeJson(id)});
+    }
+    if (o.input != "-") store->setInputLine(o.input, line_no);
+    store->commit();
+    out.flush();
+    pending = 0;
+  };
+  auto process = [&](const planner::TrackFix& fix) {
+    if (store) store->begin();
+    emit(tracker.process(fix));
+    ++pending;
+    checkpoint(false);
+  };
+  auto reject = [&](const std::string& source, std::size_t line, const std::string& why) {
+    if (store) store->begin();
+    emit({tracker.rejectedInput(source, line, why)});
+    std::cerr << "skylane: track: skipped " << source << ": " << why << "\n";
+    ++pending;
+  };
+
+  std::signal(SIGTERM, onStopSignal);
+  std::signal(SIGINT, onStopSignal);
+  if (resume_line > 0) std::cerr << "skylane: track: " << o.input << ": resuming after line " << resume_line << "\n";
+
+  if (o.format == "rinex") {
+    // Replay: skylane's own position and PLs at every epoch (SPP with the mission's method).
+    if (o.navs.empty()) throw ParseError("--nav", 0, "--nav", "", "a RINEX navigation file for the observation replay");
+    const integrity::ObservationData obs = integrity::loadRinexObs(o.input);
+    integrity::NavigationData nav;
+    for (const std::string& n : o.navs) nav.merge(integrity::loadRinexNav(n));
+    integrity::SppConfig cfg;
+    std::optional<Eigen::Vector3d> prior = obs.approx_position_ecef;
+    for (const integrity::ObservationEpoch& ep : obs.epochs) {
+      if (g_stop) break;
+      line_no = static_cast<std::size_t>(ep.source_line);
+      if (line_no <= resume_line) continue;
+      const std::string source = o.input + ":" + std::to_string(ep.source_line);
+      const integrity::SppEpoch s = integrity::solveSppEpoch(ep, obs, nav, cfg, prior);
+      if (!s.solved || !s.pl.pl_computed) {
+        reject(source, line_no, "no position or protection level at this epoch: " + s.note);
+        continue;
+      }
+      prior = s.p_ecef;
+      planner::TrackFix f;
+      f.time = s.t;
+      f.lat_rad = s.position.lat_rad;
+      f.lon_rad = s.position.lon_rad;
+      f.h_ell_m = s.position.h_ell_m;
+      f.hpl_m = s.pl.hpl_m;
+      f.vpl_m = s.pl.vpl_m;
+      f.pl_source = planner::PlSource::kRaw;
+      f.source = source;
+      f.line = line_no;
+      process(f);
+    }
+  } else {
+    LineSource in(o.input);
+    std::optional<integrity::NmeaDate> date;
+    if (!o.date.empty()) {
+      const auto t = maps::parseRfc3339(o.date + "T00:00:00Z");
+      if (!t) throw ParseError("--date", 0, "--date", o.date, "a date YYYY-MM-DD (for NMEA streams without RMC/ZDA)");
+      const maps::CalendarTime c = maps::utcFromGps(*t);
+      date = integrity::NmeaDate{{0.0}, c.year, c.month, c.day};
+    }
+    integrity::NmeaEpochAssembler nmea(date);
+    std::size_t epoch_line = 0;  // the line of the GGA that opened the NMEA epoch
+    auto nmeaFix = [&](const std::optional<integrity::NmeaFix>& nf) {
+      if (!nf) return;
+      const std::string source = o.input + ":" + std::to_string(epoch_line);
+      try {
+        planner::TrackFix f = planner::trackFixFromNmea(*nf, source);
+        f.line = epoch_line;
+        process(f);
+      } catch (const maps::ParseError& e) {
+        reject(source, epoch_line, e.what());
+      }
+    };
+    auto last_wall = std::chrono::steady_clock::now();
+    std::string text;
+    for (;;) {
+      if (g_stop) break;
+      const LineSource::Status st = in.next(text, 250);
+      if (st == LineSource::Status::kEnd) break;
+      if (st == LineSource::Status::kTimeout) {
+        // A quiet live input: stream time runs on with the wall clock for the stale check.
+        if (in.live() && tracker.streamTime()) {
+          const double quiet = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_wall).count();
+          if (store) store->begin();
+          emit(tracker.sweepStale(tracker.streamTime()->plus(quiet)));
+          checkpoint(true);
+        }
+        continue;
+      }
+      last_wall = std::chrono::steady_clock::now();
+      ++line_no;
+      if (line_no <= resume_line) continue;
+      if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
+      const std::string source = o.input + ":" + std::to_string(line_no);
+      if (o.format == "jsonl") {
+        planner::TrackFix f;
+        try {
+          json doc;
+          try {
+            doc = json::parse(text);
+          } catch (const json::parse_error& e) {
+            throw ParseError(source, 0, "$", text.substr(0, 60), std::string("one JSON object per line (") + e.what() + ")");
+          }
+          f = planner::parseTrackFixJson(doc, source);
+          f.line = line_no;
+        } catch (const std::exception& e) {
+          reject(source, line_no, e.what());
+          continue;
+        }
+        process(f);
+      } else {
+        try {
+          const integrity::NmeaSentence s = integrity::parseNmeaSentence(text, source);
+          if (std::holds_alternative<integrity::NmeaGga>(s)) {
+            std::optional<integrity::NmeaFix> closed = nmea.add(s);
+            nmeaFix(closed);
+            epoch_line = line_no;
+          } else {
+            nmeaFix(nmea.add(s));
+          }
+        } catch (const std::exception& e) {
+          reject(source, line_no, e.what());
+        }
+      }
+    }
+    if (o.format == "nmea" && !g_stop) nmeaFix(nmea.flush());
+  }
+  if (store) store->begin();
+  if (tracker.streamTime()) emit(tracker.sweepStale(*tracker.streamTime()));
+  checkpoint(true);
+  out.flush();
+  std::cerr << "skylane: track: " << accepted << " fix" << (accepted == 1 ? "" : "es") << " accepted, " << rejected
+            << " rejected, " << events << " events" << (g_stop ? " (stopped by a signal; state saved)" : "") << "\n";
+}
+
+}  // namespace
+
+void addTrackCommands(CLI::App& app) {
+  auto o = std::make_shared<TrackOptions>();
+  CLI::App* c = app.add_subcommand(
+      "track", "live corridor tracking: check each fix against its corridor, airspace and zones; rerun monitoring; replan");
+  c->add_option("--approval", o->approvals, "approval report (skylane approve --out DIR: DIR/report.json), as [ID=]FILE; repeatable")
+      ->required();
+  c->add_option("--input", o->input, "FILE, - (stdin) or udp://127.0.0.1:PORT");
+  c->add_option("--format", o->format, "jsonl, nmea (GGA + GST [+ GBS]) or rinex (observation replay; needs --nav)");
+  c->add_option("--nav", o->navs, "RINEX navigation file(s) for --format rinex");
+  c->add_option("--date", o->date, "UTC date YYYY-MM-DD of an NMEA stream without RMC/ZDA");
+  c->add_option("--db", o->db, "SQLite database: approvals, flight states and events; a restart resumes from it");
+  c->add_option("--out", o->out, "append the events to this file (default: stdout)");
+  c->add_option("--level1", o->level1, "level-1 persistence M/N before a replan (default 3/5)");
+  c->add_option("--level2", o->level2, "level-2, zone and obstacle persistence M/N (default 1/1: at once)");
+  c->add_option("--recover-after", o->recover_after, "fixes in a row inside a level before 'recovered' (default 2)");
+  c->add_option("--stale-after", o->stale_after_s, "seconds without a fix before 'stale' (default 3)");
+  c->add_option("--cooldown", o->cooldown_s, "least seconds between two replans of a flight (default 10)");
+  c->add_option("--max-time-jump", o->max_jump_s, "a fix more than this many seconds after the last is rejected (default 300)");
+  c->add_flag("--no-replan", o->no_replan, "report violations without replanning");
+  c->add_flag("--replan-on-pl", o->replan_on_pl, "also replan when level 1 is violated by the PLs alone");
+  c->add_option("--batch", o->batch, "fixes per database transaction (default 200)");
+  c->callback([o]() { runTrack(*o); });
+}
+
+}  // namespace skylane::cli

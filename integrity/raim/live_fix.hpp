@@ -1,0 +1,77 @@
+#pragma once
+/// \file
+/// \brief One live epoch from raw pseudoranges (live corridor tracking): the position, the
+/// protection levels with the mission's method, and fault detection and exclusion on demand.
+///
+/// Measurement model: P_i = |r_s,i − r| + c·δt_r,c(i) + ε_i, with r_s,i the satellite's position
+/// at transmit time in the reception ECEF frame (light time and Sagnac applied, as
+/// OrbitSource::visible gives it), c(i) the satellite's constellation (one receiver clock each)
+/// and P_i already corrected for the satellite clock (and, dual frequency, iono-free): what a
+/// receiver's raw output or the simulator gives. Linearised WLS from the reported position
+/// (Kaplan & Hegarty, 3rd ed., §7.3), the troposphere/ionosphere in the σ's of the error model.
+///
+/// Two passes, as live tracking uses them:
+/// - **first pass** (`exclude = false`): all satellites in view, detection only. When the
+///   detection test fires (RAIM χ² on the LSR, or any ARAIM solution-separation test), the
+///   fault-free protection level no longer bounds the error: the fix's PL becomes
+///   PL_det = PL + max_i |Δx_i| (horizontal: the horizontal norm, vertical: |Δx_U|), Δx_i the
+///   shift of the solution when satellite i (ARAIM: each monitored subset) is left out — the
+///   displacement the data themselves show a fault could have caused. (skylane's reading: the
+///   seeds give no PL for a detected, not yet excluded fault; this one grows with the fault and
+///   falls back to the fault-free PL once the fault is excluded.)
+/// - **monitoring rerun** (`exclude = true`): the method's FDE (RAIM w-test, ARAIM
+///   solution-separation exclusion), the position and PLs of the remaining geometry.
+
+#include "integrity/gnss/orbit_source.hpp"
+#include "integrity/gnss/satellite_id.hpp"
+#include "integrity/pl_summary.hpp"
+#include "maps/geodesy.hpp"
+
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace skylane::integrity {
+
+/// \brief One pseudorange of a live epoch.
+struct RawRange {
+  SatId sat;
+  double pr_m = 0.0;  ///< corrected pseudorange [m] (see the file comment)
+  /// \brief The satellite at transmit time (reception ECEF frame); computed from the orbits when
+  /// absent.
+  std::optional<Eigen::Vector3d> sat_ecef_m;
+};
+
+/// \brief What a live epoch is solved with.
+struct LiveFixConfig {
+  IntegrityMethod method = IntegrityMethod::kRaim;
+  ErrorModel model;
+  RaimConfig raim;
+  AraimConfig araim;
+  double elevation_mask_rad = 5.0 * M_PI / 180.0;
+};
+
+/// \brief The outcome of one live epoch.
+struct LiveFix {
+  bool solved = false;
+  std::string note;  ///< why not solved, or what happened
+  Eigen::Vector3d p_ecef = Eigen::Vector3d::Zero();
+  maps::Geodetic position;
+  std::vector<SatId> used;
+  std::vector<SatId> excluded;
+  std::vector<SatId> missing_orbit;  ///< satellites with neither a position nor an orbit
+  bool fault_detected = false;       ///< the detection test of the all-in-view solution fired
+  bool fault_excluded = false;
+  PlSummary pl;                      ///< of the final geometry (first pass: PL_det when detected)
+  double fault_free_hpl_m = 0.0, fault_free_vpl_m = 0.0;  ///< the PL before the detection term
+};
+
+/// \brief Solves one epoch. `initial` is the reported position (the linearisation point);
+/// `orbits` gives satellite positions a range does not carry (nullptr: every range must).
+/// \throws std::invalid_argument for a non-finite pseudorange or position.
+[[nodiscard]] LiveFix solveLiveFix(const std::vector<RawRange>& ranges, const maps::Geodetic& initial, const GpsTime& t,
+                                   const LiveFixConfig& cfg, bool exclude, const OrbitSource* orbits);
+
+}  // namespace skylane::integrity

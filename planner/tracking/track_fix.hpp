@@ -1,0 +1,79 @@
+#pragma once
+/// \file
+/// \brief One live position fix for `skylane track`, from any input format: a JSON line, an
+/// NMEA 0183 epoch (GGA + GST, + GBS) or a RINEX observation epoch (README "Live tracking").
+///
+/// JSON line (one object per line; unknown fields are errors):
+///   {"flight": "F1", "time": "2020-01-01T14:00:05Z", "lat": 47.37, "lon": 8.53, "h_ell_m": 520.0,
+///    "hpl_m": 1.1, "vpl_m": 1.3,
+///    "pseudoranges": [{"sat": "G05", "pr_m": 21456789.123, "ecef_m": [x, y, z]}, …],
+///    "imu": {"grade": "tactical", "sigma_n_m": 0.4, "sigma_e_m": 0.4, "sigma_u_m": 0.7}}
+/// - `flight` (or `vehicle`) names the approval; it may be left out when only one is tracked;
+/// - `hpl_m`/`vpl_m`: the onboard protection levels (both or neither);
+/// - `pseudoranges`: corrected pseudoranges (integrity/raim/live_fix.hpp), each with the
+///   satellite's ECEF position at transmit time or, without it, from the mission's orbit files;
+///   with them skylane computes its own position and PLs with the mission's method;
+/// - `imu`: the onboard INS's position σ's (north, east, up) and grade; the PL is then
+///   max(GNSS PL, seed 000's nominal-INS PL) — HPL_IMU,nominal = Q⁻¹(λ·P_nom,H)·√(σ_N² + σ_E²),
+///   VPL alike with σ_U (seed 000; λ by grade, P_nom = ⅓ of 0.5e-7 as Seed000Config).
+/// A fix needs a protection level from one of these.
+
+#include "integrity/gnss/nmea.hpp"
+#include "integrity/raim/live_fix.hpp"
+#include "maps/time.hpp"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace skylane::planner {
+
+/// \brief The onboard INS's position uncertainty (1σ) [m] and grade (0 aviation, 1 tactical, 2 consumer).
+struct InsUncertainty {
+  int grade = 2;
+  double sigma_n_m = 0.0, sigma_e_m = 0.0, sigma_u_m = 0.0;
+};
+
+/// \brief Where a fix's protection levels came from.
+enum class PlSource { kOnboard, kRaw, kNmeaGst };
+
+/// \brief "onboard", "raw", "nmea_gst".
+[[nodiscard]] const char* plSourceName(PlSource s);
+
+/// \brief One fix of a stream.
+struct TrackFix {
+  std::string flight;  ///< empty: the only flight tracked
+  maps::GpsTime time;
+  double lat_rad = 0.0, lon_rad = 0.0, h_ell_m = 0.0;
+  std::optional<double> hpl_m, vpl_m;          ///< onboard (or from GST)
+  PlSource pl_source = PlSource::kOnboard;
+  std::vector<integrity::RawRange> ranges;     ///< raw pseudoranges, when given
+  std::optional<InsUncertainty> ins;
+  std::string source;  ///< "file:line"
+  std::size_t line = 0;
+};
+
+/// \brief Parses one JSON-lines fix (the file comment's schema).
+/// \throws maps::ParseError naming `source`, the field, the value and what was expected.
+[[nodiscard]] TrackFix parseTrackFixJson(const nlohmann::json& doc, const std::string& source);
+
+/// \brief Integrity risks behind the NMEA protection levels.
+struct NmeaPlRisk {
+  double p_h = 2e-9;    ///< horizontal: K_H = √(−2 ln p_h) (the RAIM fault-free horizontal budget)
+  double p_v = 9.8e-8;  ///< vertical: K_V = Q⁻¹(p_v / 2)
+};
+
+/// \brief An NMEA epoch as a fix. HPL = K_H·σ_H with σ_H the GST error ellipse's semi-major axis
+/// (the larger of the latitude and longitude σ's when the ellipse is empty): P(|e_H| > K·σ_major)
+/// ≤ e^(−K²/2) for any ellipse. VPL = K_V·σ_alt. With GBS, each σ is the larger of GST's and the
+/// receiver's RAIM expected error. A fix without GST has no PL.
+/// \throws maps::ParseError naming `source` when the epoch has no position (quality 0 or empty
+/// fields) or no GST.
+[[nodiscard]] TrackFix trackFixFromNmea(const integrity::NmeaFix& fix, const std::string& source, const NmeaPlRisk& risk = {});
+
+/// \brief The PLs of an INS uncertainty (seed 000 nominal-INS hypothesis; see the file comment).
+[[nodiscard]] std::pair<double, double> insNominalPl(const InsUncertainty& ins);
+
+}  // namespace skylane::planner

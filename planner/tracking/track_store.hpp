@@ -1,0 +1,67 @@
+#pragma once
+/// \file
+/// \brief The tracker's embedded database (SQLite): approvals, each flight's state and current
+/// route, the event log, and how far each input file was read — written in one transaction per
+/// batch, so a tracker killed at any moment and restarted resumes every flight where the last
+/// committed batch left it and re-reads the input from there: no accepted fix is lost (a fix
+/// of the batch that was not committed is processed again).
+///
+/// Tables: flights(id, report, state JSON, route JSON), events(seq, flight, time, type, JSON),
+/// inputs(name, line).
+
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+struct sqlite3;
+struct sqlite3_stmt;
+
+namespace skylane::planner {
+
+/// \brief A flight as the database keeps it.
+struct StoredFlight {
+  std::string id;
+  std::string report;  ///< the approval report file
+  nlohmann::json state;
+  nlohmann::json route;
+};
+
+/// \brief The database of one tracker.
+class TrackStore {
+ public:
+  /// \brief Opens (creates) the database file.
+  /// \throws std::runtime_error naming the file and SQLite's message.
+  explicit TrackStore(const std::string& path);
+  ~TrackStore();
+  TrackStore(const TrackStore&) = delete;
+  TrackStore& operator=(const TrackStore&) = delete;
+
+  [[nodiscard]] std::vector<StoredFlight> flights() const;
+  /// \brief The last line read of an input (0 when never read).
+  [[nodiscard]] std::size_t inputLine(const std::string& name) const;
+  /// \brief Events in order (all, or of one type).
+  [[nodiscard]] std::vector<nlohmann::json> events(const std::string& type = {}) const;
+
+  /// \brief Starts a batch (a transaction); the writes below join it.
+  void begin();
+  void putFlight(const StoredFlight& f);
+  void appendEvent(const nlohmann::json& event);
+  void setInputLine(const std::string& name, std::size_t line);
+  /// \brief Commits the batch.
+  void commit();
+  [[nodiscard]] bool inBatch() const { return in_batch_; }
+
+ private:
+  void exec(const char* sql) const;
+  [[noreturn]] void fail(const std::string& what) const;
+  std::string path_;
+  sqlite3* db_ = nullptr;
+  sqlite3_stmt* put_flight_ = nullptr;
+  sqlite3_stmt* put_event_ = nullptr;
+  sqlite3_stmt* put_input_ = nullptr;
+  bool in_batch_ = false;
+};
+
+}  // namespace skylane::planner

@@ -1,0 +1,481 @@
+#include "planner/tracking/tracker.hpp"
+
+#include "maps/file_digest.hpp"
+#include "maps/geodesy.hpp"
+#include "maps/json_node.hpp"
+#include "maps/parse_error.hpp"
+#include "maps/text_file.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+namespace skylane::planner {
+
+using nlohmann::json;
+
+namespace {
+
+double roundMm(double v) { return std::round(v * 1e3) / 1e3; }
+double roundDeg(double rad) { return std::round(maps::rad2deg(rad) * 1e8) / 1e8; }
+json metres(double v) { return std::isfinite(v) ? json(roundMm(v)) : json(nullptr); }
+
+constexpr int kLevels = 4;
+
+/// Pushes v into a window of at most n values and returns how many are true.
+int pushWindow(std::vector<bool>& w, bool v, int n) {
+  w.push_back(v);
+  while (static_cast<int>(w.size()) > n) w.erase(w.begin());
+  return static_cast<int>(std::count(w.begin(), w.end(), true));
+}
+
+json event(const char* type, const std::string& flight, const maps::GpsTime& t) {
+  return json{{"event", type}, {"flight", flight}, {"time", maps::formatRfc3339(t, 3)}};
+}
+
+}  // namespace
+
+struct Tracker::Flight {
+  std::string id;
+  ApprovedFlight plan;
+  std::shared_ptr<Approver> approver;
+  std::unique_ptr<geofence::Corridor> level1, level2;
+  std::vector<Eigen::Vector3d> stops;  ///< the mission's points (map frame)
+  integrity::LiveFixConfig live;
+  FlightState st;
+
+  void buildBoxes() {
+    std::vector<Eigen::Vector3d> path;
+    for (RoutePoint& p : plan.route) {
+      const Eigen::Vector2d xy = approver->frame().toPlane(p.lat_rad, p.lon_rad);
+      p.xyz = Eigen::Vector3d(xy.x(), xy.y(), p.h_ell_m);
+      path.push_back(p.xyz);
+    }
+    level1 = std::make_unique<geofence::Corridor>(path, plan.level1);
+    level2 = std::make_unique<geofence::Corridor>(path, plan.level2);
+  }
+};
+
+Tracker::Tracker(TrackerOptions options) : options_(options) {
+  if (options_.level1_m < 1 || options_.level1_n < options_.level1_m || options_.level2_m < 1 ||
+      options_.level2_n < options_.level2_m) {
+    throw std::invalid_argument("tracker: persistence needs 1 ≤ M ≤ N for both rules (level 1: " +
+                                std::to_string(options_.level1_m) + " of " + std::to_string(options_.level1_n) +
+                                ", level 2: " + std::to_string(options_.level2_m) + " of " +
+                                std::to_string(options_.level2_n) + ")");
+  }
+  if (options_.recover_after < 1) throw std::invalid_argument("tracker: recover_after must be ≥ 1");
+  if (!(options_.stale_after_s > 0) || !(options_.max_time_jump_s > 0) || !(options_.replan_cooldown_s >= 0)) {
+    throw std::invalid_argument("tracker: stale_after_s and max_time_jump_s must be > 0 s, replan_cooldown_s ≥ 0 s");
+  }
+}
+
+Tracker::~Tracker() = default;
+
+void Tracker::addFlight(const std::string& id, const ApprovedFlight& approval, std::shared_ptr<Approver> approver) {
+  if (id.empty()) throw std::invalid_argument("tracker: a flight needs an identifier");
+  if (flights_.count(id)) throw std::invalid_argument("tracker: flight \"" + id + "\" is already tracked");
+  if (!approval.approved) throw std::invalid_argument("tracker: flight \"" + id + "\": its route was rejected, not approved");
+  auto f = std::make_unique<Flight>();
+  f->id = id;
+  f->plan = approval;
+  f->approver = std::move(approver);
+  f->buildBoxes();
+  f->stops = f->approver->missionStops();
+  const Mission& m = f->approver->mission();
+  f->live.method = m.method;
+  f->live.model = m.model;
+  f->live.elevation_mask_rad = maps::deg2rad(m.mask_deg);
+  flights_.emplace(id, std::move(f));
+}
+
+std::string Tracker::addApprovalFile(const std::string& report_path, const std::string& id) {
+  const ApprovedFlight plan = parseApprovalReport(maps::readJsonFile(report_path), report_path);
+  namespace fs = std::filesystem;
+  fs::path mission = plan.mission_source;
+  if (!fs::exists(mission)) mission = fs::path(report_path).parent_path() / fs::path(plan.mission_source).filename();
+  if (!fs::exists(mission)) {
+    throw maps::ParseError(report_path, 0, "$.source", plan.mission_source,
+                           "a mission file that exists (as written, or beside the report)");
+  }
+  const std::string key = fs::weakly_canonical(mission).string();
+  if (!plan.mission_sha256.empty() && maps::fileSha256Hex(mission.string()) != plan.mission_sha256) {
+    throw maps::ParseError(report_path, 0, "$.inputs[role=mission].sha256", plan.mission_sha256,
+                           "the digest of " + mission.string() + " (the mission changed since it was approved)");
+  }
+  if (!plan.approved) throw maps::ParseError(report_path, 0, "$.decision", "rejected", "an approved route");
+  auto it = approvers_.find(key);
+  if (it == approvers_.end()) it = approvers_.emplace(key, std::make_shared<Approver>(loadMission(mission.string()))).first;
+  std::string name = id.empty() ? plan.mission_name : id;
+  if (name.empty()) name = fs::path(report_path).stem().string();
+  if (flights_.count(name)) {
+    throw maps::ParseError(report_path, 0, "flight id", name, "an id not used by another approval (give ID=REPORT)");
+  }
+  addFlight(name, plan, it->second);
+  return name;
+}
+
+std::vector<std::string> Tracker::flights() const {
+  std::vector<std::string> out;
+  for (const auto& [id, f] : flights_) out.push_back(id);
+  return out;
+}
+
+std::string Tracker::onlyFlight() const { return flights_.size() == 1 ? flights_.begin()->first : std::string(); }
+
+const FlightState& Tracker::state(const std::string& id) const { return flights_.at(id)->st; }
+
+json Tracker::routeJson(const std::string& id) const {
+  const Flight& f = *flights_.at(id);
+  json route = json::array();
+  for (const RoutePoint& p : f.plan.route) {
+    route.push_back({{"lat", roundDeg(p.lat_rad)}, {"lon", roundDeg(p.lon_rad)}, {"h_ell_m", roundMm(p.h_ell_m)},
+                     {"alt_amsl_m", roundMm(p.alt_amsl_m)}, {"eta_s", roundMm(p.eta_s)}});
+  }
+  return {{"departure", maps::formatRfc3339(f.plan.departure, 3)}, {"route", route}};
+}
+
+void Tracker::restore(const std::string& id, const FlightState& state, const json& route) {
+  Flight& f = *flights_.at(id);
+  f.st = state;
+  if (route.is_object() && route.contains("route")) {
+    const std::string source = "tracker database, flight " + id;
+    const maps::JsonNode root{route, "$", source};
+    const auto t = maps::parseRfc3339(root.at("departure").str());
+    if (!t) root.at("departure").fail("an RFC 3339 date-time");
+    std::vector<RoutePoint> pts;
+    const maps::JsonNode list = root.at("route");
+    for (std::size_t i = 0; i < list.array().size(); ++i) {
+      const maps::JsonNode p = list.item(i);
+      RoutePoint rp;
+      rp.lat_rad = maps::deg2rad(p.at("lat").number());
+      rp.lon_rad = maps::deg2rad(p.at("lon").number());
+      rp.h_ell_m = p.at("h_ell_m").number();
+      rp.alt_amsl_m = p.at("alt_amsl_m").number();
+      rp.eta_s = p.at("eta_s").number();
+      pts.push_back(rp);
+    }
+    if (pts.size() < 2) list.fail("a route of at least 2 points");
+    f.plan.route = pts;
+    f.plan.departure = *t;
+    f.buildBoxes();
+  }
+}
+
+TrackEvent Tracker::rejectedInput(const std::string& source, std::size_t line, const std::string& why) const {
+  json e{{"event", "rejected_input"}, {"source", source}, {"error", why}};
+  if (line > 0) e["line"] = line;
+  return e;
+}
+
+std::vector<TrackEvent> Tracker::sweepStale(const maps::GpsTime& now) {
+  std::vector<TrackEvent> out;
+  for (auto& [id, f] : flights_) {
+    if (!f->st.last_time || f->st.stale_reported) continue;
+    const double gap = now - *f->st.last_time;
+    if (gap <= options_.stale_after_s) continue;
+    // A flight past its route's end and near its goal has landed: silence is expected.
+    json e = event("stale", id, now);
+    e["last_fix"] = maps::formatRfc3339(*f->st.last_time, 3);
+    e["gap_s"] = std::round(gap * 1e3) / 1e3;
+    e["expected_within_s"] = options_.stale_after_s;
+    out.push_back(std::move(e));
+    f->st.stale_reported = true;
+  }
+  last_sweep_ = now;
+  return out;
+}
+
+std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
+  std::vector<TrackEvent> out;
+  const std::string id = fix.flight.empty() ? onlyFlight() : fix.flight;
+  const auto it = flights_.find(id);
+  if (it == flights_.end()) {
+    out.push_back(rejectedInput(fix.source, fix.line,
+                                fix.flight.empty() ? "the fix names no flight and " + std::to_string(flights_.size()) +
+                                                         " flights are tracked (give \"flight\")"
+                                                   : "unknown flight \"" + fix.flight + "\" (no approval loaded for it)"));
+    return out;
+  }
+  Flight& f = *it->second;
+  FlightState& st = f.st;
+  if (st.last_time) {
+    const double dt = fix.time - *st.last_time;
+    std::string why;
+    if (dt == 0.0) why = "duplicate time " + maps::formatRfc3339(fix.time, 3) + " (already accepted for flight " + id + ")";
+    else if (dt < 0.0) why = "out of order: " + maps::formatRfc3339(fix.time, 3) + " is before the last accepted fix " +
+                            maps::formatRfc3339(*st.last_time, 3);
+    else if (dt > options_.max_time_jump_s) {
+      why = "time jump of " + std::to_string(static_cast<long long>(dt)) + " s after the last accepted fix (more than " +
+            std::to_string(static_cast<long long>(options_.max_time_jump_s)) + " s)";
+    }
+    if (!why.empty()) {
+      json e = rejectedInput(fix.source, fix.line, why);
+      e["flight"] = id;
+      out.push_back(std::move(e));
+      return out;
+    }
+  }
+  if (!stream_time_ || fix.time - *stream_time_ > 0) stream_time_ = fix.time;
+  if (!last_sweep_ || *stream_time_ - *last_sweep_ >= 1.0) {
+    for (TrackEvent& e : sweepStale(*stream_time_)) out.push_back(std::move(e));
+  }
+
+  // Protection levels and position.
+  const maps::PlaneFrame& frame = f.approver->frame();
+  maps::Geodetic pos{fix.lat_rad, fix.lon_rad, fix.h_ell_m};
+  std::optional<double> hpl = fix.hpl_m, vpl = fix.vpl_m;
+  PlSource source = fix.hpl_m ? fix.pl_source : PlSource::kOnboard;
+  std::optional<integrity::LiveFix> first;
+  std::string note;
+  if (!fix.ranges.empty()) {
+    first = integrity::solveLiveFix(fix.ranges, pos, fix.time, f.live, false, &f.approver->orbits());
+    if (first->solved && first->pl.pl_computed) {
+      pos = first->position;
+      hpl = first->pl.hpl_m;
+      vpl = first->pl.vpl_m;
+      source = PlSource::kRaw;
+    } else {
+      note = "raw pseudoranges gave no PL (" + first->note + (first->pl.reason.empty() ? "" : "; " + first->pl.reason) + ")";
+      first.reset();
+    }
+  }
+  if (fix.ins) {
+    const auto [h, v] = insNominalPl(*fix.ins);
+    hpl = std::max(hpl.value_or(0.0), h);
+    vpl = std::max(vpl.value_or(0.0), v);
+  }
+  if (!hpl || !vpl) {
+    json e = rejectedInput(fix.source, fix.line, "no protection level for the fix: " + (note.empty() ? "none given" : note));
+    e["flight"] = id;
+    out.push_back(std::move(e));
+    return out;
+  }
+  st.last_time = fix.time;
+  st.stale_reported = false;
+  ++st.fixes;
+
+  auto volumeAt = [&](const maps::Geodetic& g, double h, double v) {
+    const Eigen::Vector2d xy = frame.toPlane(g.lat_rad, g.lon_rad);
+    return geofence::TimedVolume{fix.time, fix.time, {Eigen::Vector3d(xy.x(), xy.y(), g.h_ell_m), h, v}};
+  };
+  geofence::TimedVolume vol = volumeAt(pos, *hpl, *vpl);
+  geofence::FenceVerdict verdict = geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), vol);
+  auto levelVerdict = [](const geofence::FenceVerdict& v, geofence::Level l) {
+    geofence::Verdict worst = geofence::Verdict::kInside;
+    for (const geofence::Check& c : v.checks) {
+      if (c.level != l || c.verdict == geofence::Verdict::kInside) continue;
+      if (c.verdict == geofence::Verdict::kOutside || worst == geofence::Verdict::kInside) worst = c.verdict;
+    }
+    return worst;
+  };
+
+  // Monitoring rerun: FDE over the raw measurements when level 1 is not held.
+  bool rerun = false;
+  if (first && levelVerdict(verdict, geofence::Level::kCorridor) != geofence::Verdict::kInside) {
+    const integrity::LiveFix again = integrity::solveLiveFix(fix.ranges, pos, fix.time, f.live, true, &f.approver->orbits());
+    rerun = true;
+    ++st.rerun_count;
+    json e = event("monitoring_rerun", id, fix.time);
+    e["fault_detected"] = first->fault_detected;
+    json excluded = json::array();
+    for (const integrity::SatId& s : again.excluded) excluded.push_back(s.str());
+    e["excluded"] = excluded;
+    e["hpl_before_m"] = metres(*hpl);
+    e["vpl_before_m"] = metres(*vpl);
+    e["verdict_before"] = geofence::verdictName(levelVerdict(verdict, geofence::Level::kCorridor));
+    if (again.solved && again.pl.pl_computed) {
+      pos = again.position;
+      hpl = again.pl.hpl_m;
+      vpl = again.pl.vpl_m;
+      vol = volumeAt(pos, *hpl, *vpl);
+      verdict = geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), vol);
+      e["hpl_after_m"] = metres(*hpl);
+      e["vpl_after_m"] = metres(*vpl);
+      e["verdict_after"] = geofence::verdictName(levelVerdict(verdict, geofence::Level::kCorridor));
+    } else {
+      e["hpl_after_m"] = nullptr;
+      e["vpl_after_m"] = nullptr;
+      e["verdict_after"] = e["verdict_before"];
+      e["note"] = again.note + again.pl.reason;
+    }
+    e["line"] = fix.line;
+    out.push_back(std::move(e));
+  }
+
+  // Persistence per level.
+  std::array<geofence::Verdict, kLevels> lv{};
+  for (int l = 0; l < kLevels; ++l) lv[l] = levelVerdict(verdict, static_cast<geofence::Level>(l));
+  const bool bad1 = lv[0] != geofence::Verdict::kInside;
+  const bool bad2 = lv[1] != geofence::Verdict::kInside || lv[2] != geofence::Verdict::kInside ||
+                    lv[3] != geofence::Verdict::kInside;
+  const int count1 = pushWindow(st.level1_window, bad1, options_.level1_n);
+  const int count2 = pushWindow(st.level2_window, bad2, options_.level2_n);
+  const bool pl_cause = *hpl > f.plan.level1.hal_m || *vpl > f.plan.level1.val_m;
+  std::optional<geofence::Level> trigger;
+  for (int l = 0; l < kLevels; ++l) {
+    const auto level = static_cast<geofence::Level>(l);
+    const bool bad = lv[l] != geofence::Verdict::kInside;
+    if (bad) {
+      st.inside_streak[l] = 0;
+      if (!st.violated[l]) {
+        st.violated[l] = true;
+        json e = event("violation", id, fix.time);
+        e["level"] = geofence::levelName(level);
+        e["verdict"] = geofence::verdictName(lv[l]);
+        for (const geofence::Check& c : verdict.checks) {
+          if (c.level != level || c.verdict == geofence::Verdict::kInside) continue;
+          e["subject"] = c.subject;
+          e["margin_h_m"] = metres(c.margin_h_m);
+          e["margin_v_m"] = metres(c.margin_v_m);
+          if (c.clearance_m) e["clearance_m"] = metres(*c.clearance_m);
+          break;
+        }
+        if (level == geofence::Level::kCorridor) {
+          e["cause"] = pl_cause ? "protection_level" : "position";
+          e["rerun"] = rerun;
+        }
+        e["hpl_m"] = metres(*hpl);
+        e["vpl_m"] = metres(*vpl);
+        e["line"] = fix.line;
+        out.push_back(std::move(e));
+      }
+    } else if (st.violated[l] && ++st.inside_streak[l] >= options_.recover_after) {
+      st.violated[l] = false;
+      json e = event("recovered", id, fix.time);
+      e["level"] = geofence::levelName(level);
+      e["after_fixes"] = st.inside_streak[l];
+      e["line"] = fix.line;
+      out.push_back(std::move(e));
+    }
+  }
+  if (count2 >= options_.level2_m && bad2) {
+    trigger = lv[1] != geofence::Verdict::kInside ? geofence::Level::kAirspace
+              : lv[2] != geofence::Verdict::kInside ? geofence::Level::kZone
+                                                    : geofence::Level::kObstacle;
+  } else if (count1 >= options_.level1_m && bad1 && (!pl_cause || options_.replan_on_pl_exceedance)) {
+    trigger = geofence::Level::kCorridor;
+  }
+
+  // Progress along the mission's points.
+  const Eigen::Vector3d p_map = vol.volume.p_map;
+  while (st.next_stop + 1 < f.stops.size() &&
+         (f.stops[st.next_stop] - p_map).head<2>().norm() <= options_.waypoint_radius_m) {
+    ++st.next_stop;
+  }
+
+  // The fix event.
+  json e = event("fix", id, fix.time);
+  e["line"] = fix.line;
+  e["lat"] = roundDeg(pos.lat_rad);
+  e["lon"] = roundDeg(pos.lon_rad);
+  e["h_ell_m"] = roundMm(pos.h_ell_m);
+  e["hpl_m"] = metres(*hpl);
+  e["vpl_m"] = metres(*vpl);
+  e["pl_source"] = plSourceName(source);
+  if (first) e["fault_detected"] = first->fault_detected;
+  e["verdict"] = geofence::verdictName(verdict.verdict);
+  e["violated"] = verdict.violated ? json(geofence::levelName(*verdict.violated)) : json(nullptr);
+  json levels = json::object();
+  json near = json::array();
+  for (const geofence::Check& c : verdict.checks) {
+    if (c.level == geofence::Level::kCorridor || c.level == geofence::Level::kAirspace) {
+      levels[geofence::levelName(c.level)] = {{"verdict", geofence::verdictName(c.verdict)},
+                                             {"margin_h_m", metres(c.margin_h_m)},
+                                             {"margin_v_m", metres(c.margin_v_m)},
+                                             {"segment", c.index}};
+    } else {
+      near.push_back({{"level", geofence::levelName(c.level)},
+                      {"subject", c.subject},
+                      {"verdict", geofence::verdictName(c.verdict)},
+                      {"clearance_m", metres(c.clearance_m.value_or(0.0))}});
+    }
+  }
+  e["levels"] = levels;
+  e["near"] = near;
+  e["route_version"] = st.route_version;
+  if (rerun) e["rerun"] = true;
+  if (!note.empty()) e["note"] = note;
+  out.push_back(std::move(e));
+
+  // Replan from where the vehicle is.
+  if (trigger && options_.replan && (!st.last_replan || fix.time - *st.last_replan >= options_.replan_cooldown_s)) {
+    st.last_replan = fix.time;
+    ++st.replans;
+    const ApprovalReport r = f.approver->replanFrom(p_map, fix.time, st.next_stop);
+    json rp = event("replan", id, fix.time);
+    rp["trigger"] = geofence::levelName(*trigger);
+    rp["from"] = {{"lat", roundDeg(pos.lat_rad)}, {"lon", roundDeg(pos.lon_rad)}, {"h_ell_m", roundMm(pos.h_ell_m)}};
+    rp["decision"] = r.approved ? "approved" : "rejected";
+    rp["report"] = approvalReportJson(r, f.approver->mission());
+    rp["report"].erase("predicted");  // the samples stay in the tracker's database with the route
+    if (r.approved) {
+      rp["operational_intent"] = {{"volumes", operationalIntentVolumes(r, frame, 2, 30.0)},
+                                  {"state", "Accepted"},
+                                  {"priority", 0}};
+      rp["corridor_volumes"] = operationalIntentVolumes(r, frame, 1, 30.0);
+      f.plan.route = r.route;
+      f.plan.departure = r.departure;
+      f.buildBoxes();
+      ++st.route_version;
+      // The new corridor starts with a clean record: its violations are reported anew.
+      st.level1_window.clear();
+      st.level2_window.clear();
+      st.violated.fill(false);
+      st.inside_streak.fill(0);
+    }
+    rp["route_version"] = st.route_version;
+    rp["planning_time_s"] = std::round(r.elapsed_s * 1e4) / 1e4;
+    rp["line"] = fix.line;
+    out.push_back(std::move(rp));
+  }
+  return out;
+}
+
+json flightStateJson(const FlightState& s) {
+  json j;
+  j["last_time"] = s.last_time ? json(maps::formatRfc3339(*s.last_time, 3)) : json(nullptr);
+  j["level1_window"] = s.level1_window;
+  j["level2_window"] = s.level2_window;
+  j["violated"] = s.violated;
+  j["inside_streak"] = s.inside_streak;
+  j["last_replan"] = s.last_replan ? json(maps::formatRfc3339(*s.last_replan, 3)) : json(nullptr);
+  j["stale_reported"] = s.stale_reported;
+  j["next_stop"] = s.next_stop;
+  j["route_version"] = s.route_version;
+  j["fixes"] = s.fixes;
+  j["reruns"] = s.rerun_count;
+  j["replans"] = s.replans;
+  return j;
+}
+
+FlightState parseFlightState(const json& j, const std::string& source) {
+  const maps::JsonNode root{j, "$", source};
+  FlightState s;
+  try {
+    auto time = [&](const char* key) -> std::optional<maps::GpsTime> {
+      if (!root.has(key)) return std::nullopt;
+      const auto t = maps::parseRfc3339(root.at(key).str());
+      if (!t) root.at(key).fail("an RFC 3339 date-time");
+      return t;
+    };
+    s.last_time = time("last_time");
+    s.last_replan = time("last_replan");
+    s.level1_window = j.at("level1_window").get<std::vector<bool>>();
+    s.level2_window = j.at("level2_window").get<std::vector<bool>>();
+    s.violated = j.at("violated").get<std::array<bool, 4>>();
+    s.inside_streak = j.at("inside_streak").get<std::array<int, 4>>();
+    s.stale_reported = j.at("stale_reported").get<bool>();
+    s.next_stop = j.at("next_stop").get<std::size_t>();
+    s.route_version = j.at("route_version").get<int>();
+    s.fixes = j.at("fixes").get<std::uint64_t>();
+    s.rerun_count = j.at("reruns").get<std::uint64_t>();
+    s.replans = j.at("replans").get<std::uint64_t>();
+  } catch (const nlohmann::json::exception& e) {
+    throw maps::ParseError(source, 0, "$", maps::quoteJson(j), std::string("a tracker flight state (") + e.what() + ")");
+  }
+  return s;
+}
+
+}  // namespace skylane::planner

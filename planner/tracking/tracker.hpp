@@ -1,0 +1,125 @@
+#pragma once
+/// \file
+/// \brief Live corridor tracking (`skylane track`; DESIGN.md question 3): every fix of every
+/// approved flight, with its live protection volume, is checked against its corridor (level 1),
+/// its airspace (level 2), the active zones and the obstacles; a level-1 violation reruns the
+/// integrity monitoring (FDE over the raw pseudoranges, when the fix has them); a persistent
+/// violation, or a level-2, zone or obstacle violation, replans from where the vehicle is.
+///
+/// Per fix:
+/// 1. Order: a fix not after the flight's last accepted one (duplicate or out of order), or more
+///    than `max_time_jump_s` after it, is rejected (`rejected_input`), as is an unknown flight.
+/// 2. Protection levels: raw pseudoranges → skylane's own position and PLs with the mission's
+///    method, first pass detection only (integrity/raim/live_fix.hpp); else the onboard (or NMEA
+///    GST) PLs; an INS block raises them to seed 000's nominal-INS PL when that is larger.
+/// 3. The fence check of the volume at the fix time (geofence::checkVolume).
+/// 4. Level 1 not inside and raw pseudoranges → **monitoring rerun**: FDE, the PLs of the
+///    remaining geometry, the check again; the fix's verdict is the rerun's.
+/// 5. Persistence: a level counts as violated in a fix when its check is not inside
+///    (indeterminate counts). Level 1 is persistent when violated in ≥ level1_m of the last
+///    level1_n fixes; level 2, zones and obstacles with level2_m of level2_n (default 1 of 1:
+///    at once). A `violation` event marks a level's first violated fix; `recovered` follows
+///    `recover_after` fixes in a row inside it.
+/// 6. Replan from the vehicle's estimated position (Approver::replanFrom) when level 2, a zone or
+///    an obstacle is persistently violated, or level 1 is persistently violated because of the
+///    position — the PLs fit the corridor (HPL ≤ HAL₁, VPL ≤ VAL₁) but the volume is not in it:
+///    the vehicle drifted. A level-1 violation by the PLs alone is not replanned unless
+///    `replan_on_pl_exceedance`: no corridor of the same width can hold a PL wider than itself.
+///    At most one replan per `replan_cooldown_s`. An approved replan replaces both box levels.
+/// 7. `stale`: a flight without a fix for `stale_after_s` of stream time (once per gap).
+
+#include "planner/approval.hpp"
+#include "planner/report_formats.hpp"
+#include "planner/tracking/track_fix.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace skylane::planner {
+
+/// \brief Hysteresis, persistence and timing of the tracker (the file comment's steps).
+struct TrackerOptions {
+  int level1_m = 3, level1_n = 5;
+  int level2_m = 1, level2_n = 1;
+  int recover_after = 2;
+  bool replan = true;
+  bool replan_on_pl_exceedance = false;
+  double replan_cooldown_s = 10.0;
+  double stale_after_s = 3.0;
+  double max_time_jump_s = 300.0;
+  double waypoint_radius_m = 30.0;  ///< a mission waypoint is passed once a fix comes this close
+};
+
+/// \brief One event of the output stream: {"event": type, "flight", "time", …}.
+using TrackEvent = nlohmann::json;
+
+/// \brief A flight's persistent state (what a restarted tracker needs to go on).
+struct FlightState {
+  std::optional<maps::GpsTime> last_time;
+  std::vector<bool> level1_window, level2_window;  ///< oldest first, at most N each
+  std::array<bool, 4> violated{};                  ///< per geofence::Level
+  std::array<int, 4> inside_streak{};
+  std::optional<maps::GpsTime> last_replan;
+  bool stale_reported = false;
+  std::size_t next_stop = 1;  ///< index into Mission::points of the next point to reach
+  int route_version = 0;      ///< 0: the approved route; n: the n-th accepted replan
+  std::uint64_t fixes = 0, rerun_count = 0, replans = 0;
+};
+
+/// \brief Tracks many flights in one process.
+class Tracker {
+ public:
+  explicit Tracker(TrackerOptions options = {});
+  ~Tracker();
+  Tracker(const Tracker&) = delete;
+  Tracker& operator=(const Tracker&) = delete;
+
+  /// \brief Registers a flight under `id` from its approval; `approver` holds the mission's zones,
+  /// obstacles, orbits and planner (one may serve several flights of the same mission).
+  /// \throws std::invalid_argument for a duplicate id, a rejected approval, or a route the
+  /// corridor cannot be built from.
+  void addFlight(const std::string& id, const ApprovedFlight& approval, std::shared_ptr<Approver> approver);
+  /// \brief Loads an approval report, its mission (the report's `source`, as written or beside
+  /// the report) and checks the mission's SHA-256 against the report's; the id is `id` or, when
+  /// empty, the mission's name. Approvers are shared by mission file. Returns the id.
+  /// \throws maps::ParseError naming the report, the field and what was expected.
+  std::string addApprovalFile(const std::string& report_path, const std::string& id = {});
+
+  /// \brief Processes one fix; returns its events (the `fix` event last but for a replan).
+  [[nodiscard]] std::vector<TrackEvent> process(const TrackFix& fix);
+  /// \brief A `rejected_input` event for a record that could not be read.
+  [[nodiscard]] TrackEvent rejectedInput(const std::string& source, std::size_t line, const std::string& why) const;
+  /// \brief `stale` events for flights silent for stale_after_s before `now` (stream time).
+  [[nodiscard]] std::vector<TrackEvent> sweepStale(const maps::GpsTime& now);
+
+  /// \brief The ids of the flights tracked.
+  [[nodiscard]] std::vector<std::string> flights() const;
+  /// \brief The single flight's id, or empty when there are several.
+  [[nodiscard]] std::string onlyFlight() const;
+  /// \brief A flight's state and current route (for persistence); restore() puts them back.
+  [[nodiscard]] const FlightState& state(const std::string& id) const;
+  [[nodiscard]] nlohmann::json routeJson(const std::string& id) const;
+  void restore(const std::string& id, const FlightState& state, const nlohmann::json& route);
+  /// \brief The latest fix time over all flights (stream time).
+  [[nodiscard]] std::optional<maps::GpsTime> streamTime() const { return stream_time_; }
+  [[nodiscard]] const TrackerOptions& options() const { return options_; }
+
+ private:
+  struct Flight;
+  TrackerOptions options_;
+  std::map<std::string, std::unique_ptr<Flight>> flights_;
+  std::map<std::string, std::shared_ptr<Approver>> approvers_;  ///< by mission file
+  std::optional<maps::GpsTime> stream_time_;
+  std::optional<maps::GpsTime> last_sweep_;
+};
+
+/// \brief FlightState as JSON and back (the tracker database keeps it).
+[[nodiscard]] nlohmann::json flightStateJson(const FlightState& s);
+/// \throws maps::ParseError naming `source` for a malformed state.
+[[nodiscard]] FlightState parseFlightState(const nlohmann::json& j, const std::string& source);
+
+}  // namespace skylane::planner
