@@ -58,7 +58,7 @@ TrackFix parseTrackFixJson(const json& doc, const std::string& source) {
   f.h_ell_m = root.at("h_ell_m").number();
   if (std::abs(f.h_ell_m) > 1e5) root.at("h_ell_m").fail("an ellipsoidal height within ±100 km");
   if (root.has("hpl_m") != root.has("vpl_m")) {
-    root.at(root.has("hpl_m") ? "vpl_m" : "hpl_m").fail("both hpl_m and vpl_m, or neither");
+    root.orNull(root.has("hpl_m") ? "vpl_m" : "hpl_m").fail("both hpl_m and vpl_m, or neither");
   }
   if (root.has("hpl_m")) {
     for (const char* key : {"hpl_m", "vpl_m"}) {

@@ -1,0 +1,463 @@
+// Live corridor tracking (issue 8): per-fix verdicts, persistence, monitoring reruns that exclude
+// a faulty satellite of a simulated flight, replans from a drifted vehicle, immediate zone
+// events, and NMEA / JSON-lines agreement.
+#include "planner/tracking/tracker.hpp"
+
+#include "integrity/sim/sensors.hpp"
+#include "integrity/sim/trajectory.hpp"
+#include "maps/parse_error.hpp"
+#include "maps/text_file.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+namespace skylane::planner {
+namespace {
+
+using nlohmann::json;
+
+const std::string kExampleDir = std::string(SKYLANE_TEST_DATA) + "/../../examples/approve";
+
+/// The bundled example mission, with changes.
+Mission exampleMission(const std::function<void(json&)>& edit = {}) {
+  json doc = maps::readJsonFile(kExampleDir + "/mission.json");
+  if (edit) edit(doc);
+  return parseMission(doc, kExampleDir + "/mission.json", kExampleDir);
+}
+
+/// An approved flight and its approver; the report goes through its JSON form (writer → reader).
+struct Approved {
+  std::shared_ptr<Approver> approver;
+  ApprovalReport report;
+  ApprovedFlight flight;
+};
+
+Approved approveMission(Mission m) {
+  Approved a;
+  a.approver = std::make_shared<Approver>(std::move(m));
+  a.report = a.approver->approve();
+  EXPECT_TRUE(a.report.approved);
+  a.flight = parseApprovalReport(approvalReportJson(a.report, a.approver->mission()), "report.json");
+  return a;
+}
+
+/// Position along the approved route t seconds after departure (map frame).
+Eigen::Vector3d along(const ApprovalReport& r, double t) {
+  for (std::size_t i = 1; i < r.route.size(); ++i) {
+    if (t <= r.route[i].eta_s) {
+      const double f = (t - r.route[i - 1].eta_s) / (r.route[i].eta_s - r.route[i - 1].eta_s);
+      return r.route[i - 1].xyz + f * (r.route[i].xyz - r.route[i - 1].xyz);
+    }
+  }
+  return r.route.back().xyz;
+}
+
+TrackFix fixAt(const Approver& a, const maps::GpsTime& t, const Eigen::Vector3d& p_map, double hpl, double vpl,
+               std::size_t line) {
+  TrackFix f;
+  f.flight = "F1";
+  f.time = t;
+  const Eigen::Vector2d ll = a.frame().toLatLon(p_map.head<2>());
+  f.lat_rad = ll.x();
+  f.lon_rad = ll.y();
+  f.h_ell_m = p_map.z();
+  f.hpl_m = hpl;
+  f.vpl_m = vpl;
+  f.line = line;
+  f.source = "test:" + std::to_string(line);
+  return f;
+}
+
+std::vector<json> ofType(const std::vector<json>& events, const std::string& type) {
+  std::vector<json> out;
+  for (const json& e : events) {
+    if (e.at("event") == type) out.push_back(e);
+  }
+  return out;
+}
+
+/// The unit vector across the route's first segment (left of the direction of flight).
+Eigen::Vector3d acrossFirstSegment(const ApprovalReport& r) {
+  const Eigen::Vector2d d = (r.route[1].xyz - r.route[0].xyz).head<2>().normalized();
+  return Eigen::Vector3d(-d.y(), d.x(), 0.0);
+}
+
+class TrackerOnExample : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { example_ = new Approved(approveMission(exampleMission())); }
+  static void TearDownTestSuite() {
+    delete example_;
+    example_ = nullptr;
+  }
+  static Approved* example_;
+};
+Approved* TrackerOnExample::example_ = nullptr;
+
+TEST_F(TrackerOnExample, FixesOnTheRouteWithSmallPlsAreInsideEveryLevel) {
+  Tracker tracker;
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  for (int k = 0; k < 20; ++k) {
+    const auto ev = tracker.process(fixAt(*example_->approver, r.departure.plus(k), along(r, k), 0.5, 0.5, k + 1));
+    ASSERT_EQ(ev.size(), 1u) << ev.front().dump();
+    const json& fix = ev.back();
+    EXPECT_EQ(fix.at("verdict"), "inside");
+    // Level-1 margin: HAL₁ − (cross-track offset ≈ 0) − HPL, to the rounding of the route (mm).
+    EXPECT_NEAR(fix.at("levels").at("level1").at("margin_h_m").get<double>(), r.limits.level1.hal_m - 0.5, 0.01);
+    EXPECT_NEAR(fix.at("levels").at("level2").at("margin_h_m").get<double>(), r.limits.level2.hal_m - 0.5, 0.01);
+  }
+}
+
+TEST_F(TrackerOnExample, OneNoisyFixRaisesAViolationButNoReplan) {
+  Tracker tracker;  // level 1: 3 of 5
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  const Eigen::Vector3d side = acrossFirstSegment(r);
+  std::vector<json> all;
+  for (int k = 0; k < 12; ++k) {
+    Eigen::Vector3d p = along(r, k);
+    if (k == 5) p += 3.0 * side;  // one fix 3 m off the centre line: outside HAL₁ = 1.44 m
+    for (json& e : tracker.process(fixAt(*example_->approver, r.departure.plus(k), p, 0.5, 0.5, k + 1))) all.push_back(e);
+  }
+  const auto violations = ofType(all, "violation");
+  ASSERT_EQ(violations.size(), 1u);
+  EXPECT_EQ(violations[0].at("level"), "level1");
+  EXPECT_EQ(violations[0].at("cause"), "position");
+  EXPECT_EQ(violations[0].at("line"), 6);
+  EXPECT_TRUE(ofType(all, "replan").empty());
+  const auto recovered = ofType(all, "recovered");
+  ASSERT_EQ(recovered.size(), 1u);
+  EXPECT_EQ(recovered[0].at("line"), 8);  // two fixes in a row inside after the violation
+}
+
+TEST_F(TrackerOnExample, PersistentDriftReplansFromTheVehicleWithACorridorClearOfTheZones) {
+  // GIVEN the vehicle drifting 8 m to the side of its corridor from t = 40 s on
+  TrackerOptions opt;
+  opt.level1_m = 3;
+  opt.level1_n = 5;
+  Tracker tracker(opt);
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  const Eigen::Vector3d side = acrossFirstSegment(r);
+  std::vector<json> all;
+  std::optional<json> replan;
+  Eigen::Vector3d replan_from;
+  for (int k = 0; k < 50 && !replan; ++k) {
+    Eigen::Vector3d p = along(r, k);
+    if (k >= 40) p += 8.0 * side;
+    for (json& e : tracker.process(fixAt(*example_->approver, r.departure.plus(k), p, 0.5, 0.5, k + 1))) {
+      if (e.at("event") == "replan") {
+        replan = e;
+        replan_from = p;
+      }
+      all.push_back(e);
+    }
+  }
+  // THEN the third violated fix (3 of 5) replans, from where the vehicle is
+  ASSERT_TRUE(replan);
+  EXPECT_EQ(replan->at("line"), 43);
+  EXPECT_EQ(replan->at("trigger"), "level1");
+  ASSERT_EQ(replan->at("decision"), "approved") << replan->dump();
+  EXPECT_EQ(replan->at("route_version"), 1);
+  EXPECT_FALSE(replan->at("operational_intent").at("volumes").empty());
+  const json& route = replan->at("report").at("route");
+  const Eigen::Vector2d first = example_->approver->frame().toPlane(maps::deg2rad(route[0].at("lat").get<double>()),
+                                                                     maps::deg2rad(route[0].at("lon").get<double>()));
+  EXPECT_LT((first - replan_from.head<2>()).norm(), 0.01);
+  // AND the new corridor (level-1 box along every new segment, sampled each metre) meets no
+  // active counted zone: checked with the obstructions directly, not through the tracker.
+  const geofence::Obstructions& ob = example_->approver->obstructions();
+  std::vector<Eigen::Vector3d> pts;
+  for (const json& p : route) {
+    const Eigen::Vector2d xy = example_->approver->frame().toPlane(maps::deg2rad(p.at("lat").get<double>()),
+                                                                    maps::deg2rad(p.at("lon").get<double>()));
+    pts.emplace_back(xy.x(), xy.y(), p.at("h_ell_m").get<double>());
+  }
+  const maps::GpsTime t = r.departure.plus(42);
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    const double len = (pts[i] - pts[i - 1]).norm();
+    for (double s = 0; s <= len; s += 1.0) {
+      const Eigen::Vector3d p = pts[i - 1] + (s / len) * (pts[i] - pts[i - 1]);
+      const auto c = ob.firstConflict({t, t, {p, r.limits.level1.hal_m, r.limits.level1.val_m}});
+      if (c) {
+        EXPECT_NE(c->level, geofence::Level::kZone) << "segment " << i << " at " << s << " m meets " << c->subject;
+      }
+    }
+  }
+  // AND the next fix at the drifted place is inside the new corridor
+  const auto next = tracker.process(fixAt(*example_->approver, r.departure.plus(43), replan_from, 0.5, 0.5, 44));
+  EXPECT_EQ(next.back().at("levels").at("level1").at("verdict"), "inside") << next.back().dump();
+  EXPECT_EQ(next.back().at("route_version"), 1);
+}
+
+TEST_F(TrackerOnExample, ProtectionVolumeTouchingAProhibitedZoneIsReportedAtOnce) {
+  TrackerOptions opt;
+  opt.replan = false;
+  Tracker tracker(opt);
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  // EX-ZH-HELIPORT: a circle of 250 m round (47.379 N, 8.538 E) from 0 to 300 m AGL.
+  const maps::PlaneFrame& frame = example_->approver->frame();
+  const Eigen::Vector2d c = frame.toPlane(maps::deg2rad(47.379), maps::deg2rad(8.538));
+  const Eigen::Vector2d start = r.route.front().xyz.head<2>();
+  const Eigen::Vector2d towards = (start - c).normalized();
+  const double h = r.route.front().xyz.z();
+  auto at = [&](double from_edge_m) {
+    const Eigen::Vector2d p = c + towards * (250.0 + from_edge_m);
+    return Eigen::Vector3d(p.x(), p.y(), h);
+  };
+  // 30 m from the edge with HPL 10 m: clear; the next fix, HPL 40 m: it touches.
+  const auto clear = tracker.process(fixAt(*example_->approver, r.departure.plus(1), at(30.0), 10.0, 5.0, 1));
+  EXPECT_TRUE(ofType(clear, "violation").empty() || ofType(clear, "violation")[0].at("level") != "zone");
+  const auto touch = tracker.process(fixAt(*example_->approver, r.departure.plus(2), at(30.0), 40.0, 5.0, 2));
+  const auto v = ofType(touch, "violation");
+  const auto zone = std::find_if(v.begin(), v.end(), [](const json& e) { return e.at("level") == "zone"; });
+  ASSERT_NE(zone, v.end());
+  EXPECT_EQ(zone->at("subject"), "EX-ZH-HELIPORT");
+  // The overlap is HPL − distance to the edge, 10 m, to the circle's projection allowance.
+  EXPECT_NEAR(zone->at("margin_h_m").get<double>(), -10.0, 0.5);
+  const json& near = touch.back().at("near");
+  const auto in_near = std::find_if(near.begin(), near.end(), [](const json& n) { return n.at("subject") == "EX-ZH-HELIPORT"; });
+  ASSERT_NE(in_near, near.end());
+  EXPECT_EQ(in_near->at("verdict"), "outside");
+  EXPECT_EQ(in_near->at("clearance_m"), 0.0);
+}
+
+TEST_F(TrackerOnExample, BadOrderUnknownFlightsAndStaleFlightsAreReportedAndSkipped) {
+  Tracker tracker;
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  const Approver& a = *example_->approver;
+  EXPECT_EQ(ofType(tracker.process(fixAt(a, r.departure.plus(10), along(r, 10), 0.5, 0.5, 1)), "fix").size(), 1u);
+  auto dup = tracker.process(fixAt(a, r.departure.plus(10), along(r, 10), 0.5, 0.5, 2));
+  ASSERT_EQ(dup.size(), 1u);
+  EXPECT_EQ(dup[0].at("event"), "rejected_input");
+  EXPECT_NE(dup[0].at("error").get<std::string>().find("duplicate time"), std::string::npos);
+  auto back = tracker.process(fixAt(a, r.departure.plus(9), along(r, 9), 0.5, 0.5, 3));
+  EXPECT_NE(back[0].at("error").get<std::string>().find("out of order"), std::string::npos);
+  auto jump = tracker.process(fixAt(a, r.departure.plus(4000), along(r, 20), 0.5, 0.5, 4));
+  EXPECT_NE(jump[0].at("error").get<std::string>().find("time jump"), std::string::npos);
+  TrackFix stranger = fixAt(a, r.departure.plus(11), along(r, 11), 0.5, 0.5, 5);
+  stranger.flight = "F9";
+  auto unknown = tracker.process(stranger);
+  EXPECT_NE(unknown[0].at("error").get<std::string>().find("unknown flight \"F9\""), std::string::npos);
+  // A 6 s gap: the next fix first reports the flight stale (3 s), then is accepted.
+  auto late = tracker.process(fixAt(a, r.departure.plus(16), along(r, 16), 0.5, 0.5, 6));
+  ASSERT_EQ(ofType(late, "stale").size(), 1u);
+  EXPECT_DOUBLE_EQ(ofType(late, "stale")[0].at("gap_s").get<double>(), 6.0);
+  EXPECT_EQ(ofType(late, "fix").size(), 1u);
+  EXPECT_EQ(tracker.state("F1").fixes, 2u);
+}
+
+// --- NMEA and JSON lines give the same verdicts ---------------------------------------------
+
+std::string nmeaChecksummed(const std::string& body) {
+  unsigned char x = 0;
+  for (char ch : body) x ^= static_cast<unsigned char>(ch);
+  char tail[8];
+  std::snprintf(tail, sizeof tail, "*%02X", x);
+  return "$" + body + tail;
+}
+
+std::string nmeaAngle(double deg, bool lat) {
+  const double a = std::abs(deg);
+  const int d = static_cast<int>(a);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, lat ? "%02d%010.7f,%c" : "%03d%010.7f,%c", d, (a - d) * 60.0,
+                lat ? (deg >= 0 ? 'N' : 'S') : (deg >= 0 ? 'E' : 'W'));
+  return buf;
+}
+
+TEST_F(TrackerOnExample, NmeaAndJsonLinesGiveTheSameVerdicts) {
+  const ApprovalReport& r = example_->report;
+  const Eigen::Vector3d side = acrossFirstSegment(r);
+  const NmeaPlRisk risk;
+  const double k_h = std::sqrt(-2.0 * std::log(risk.p_h));
+  const double k_v = 5.3342;  // Q⁻¹(4.9e-8), from a normal table
+  int compared = 0;
+  // The same fixes through two trackers: JSON lines with the PLs of the NMEA rule, and NMEA
+  // sentences (RMC for the date, GGA, GST) built from them.
+  TrackerOptions opt;
+  opt.replan = false;  // verdicts only
+  Tracker a(opt), b(opt);
+  a.addFlight("F1", example_->flight, example_->approver);
+  b.addFlight("F1", example_->flight, example_->approver);
+  integrity::NmeaEpochAssembler asm2;
+  std::vector<json> va, vb;
+  for (int k = 0; k < 30; ++k) {
+    const double off = (k % 7) * 0.25;
+    const double sigma_h = 0.05 + 0.02 * (k % 5), sigma_v = 0.08 + 0.01 * (k % 3);
+    const Eigen::Vector3d p = along(r, 2 * k) + off * side;
+    const maps::GpsTime t = r.departure.plus(2 * k);
+    TrackFix jf = fixAt(*example_->approver, t, p, k_h * sigma_h, k_v * sigma_v, static_cast<std::size_t>(k + 1));
+    for (const json& e : a.process(jf)) {
+      if (e.at("event") == "fix") va.push_back(e);
+    }
+    const maps::CalendarTime c = maps::utcFromGps(t);
+    char hms[16];
+    std::snprintf(hms, sizeof hms, "%02d%02d%05.2f", c.hour, c.minute, c.second);
+    char tail[96];
+    std::snprintf(tail, sizeof tail, ",4,12,0.8,%.4f,M,47.35,M,,", p.z() - 47.35);
+    const Eigen::Vector2d q = example_->approver->frame().toLatLon(p.head<2>());
+    const std::string gga = nmeaChecksummed("GPGGA," + std::string(hms) + "," + nmeaAngle(maps::rad2deg(q.x()), true) + "," +
+                                            nmeaAngle(maps::rad2deg(q.y()), false) + tail);
+    char gst[96];
+    std::snprintf(gst, sizeof gst, "GPGST,%s,0.5,%.4f,%.4f,0.0,%.4f,%.4f,%.4f", hms, sigma_h, sigma_h * 0.8, sigma_h * 0.8,
+                  sigma_h * 0.6, sigma_v);
+    char rmc_date[8];
+    std::snprintf(rmc_date, sizeof rmc_date, "%02d%02d%02d", c.day, c.month, c.year % 100);
+    const std::string rmc = nmeaChecksummed("GPRMC," + std::string(hms) + ",A,4722.0000,N,00832.0000,E,0.0,0.0," + rmc_date + ",,,A");
+    for (const std::string& s : {rmc, gga, nmeaChecksummed(gst)}) {
+      if (auto nf = asm2.add(integrity::parseNmeaSentence(s, "fixes.nmea"))) {
+        for (const json& e : b.process(trackFixFromNmea(*nf, "fixes.nmea"))) {
+          if (e.at("event") == "fix") vb.push_back(e);
+        }
+      }
+    }
+  }
+  if (auto nf = asm2.flush()) {
+    for (const json& e : b.process(trackFixFromNmea(*nf, "fixes.nmea"))) {
+      if (e.at("event") == "fix") vb.push_back(e);
+    }
+  }
+  ASSERT_EQ(va.size(), 30u);
+  ASSERT_EQ(vb.size(), 30u);
+  int outside = 0;
+  for (std::size_t i = 0; i < va.size(); ++i) {
+    EXPECT_EQ(va[i].at("verdict"), vb[i].at("verdict")) << i;
+    EXPECT_EQ(va[i].at("violated"), vb[i].at("violated")) << i;
+    for (const char* level : {"level1", "level2"}) {
+      EXPECT_NEAR(va[i]["levels"][level]["margin_h_m"].get<double>(), vb[i]["levels"][level]["margin_h_m"].get<double>(), 0.002)
+          << i << " " << level;
+      EXPECT_NEAR(va[i]["levels"][level]["margin_v_m"].get<double>(), vb[i]["levels"][level]["margin_v_m"].get<double>(), 0.002)
+          << i << " " << level;
+    }
+    outside += va[i].at("verdict") != "inside";
+    ++compared;
+  }
+  EXPECT_GT(outside, 3);   // the table exercises both verdicts
+  EXPECT_LT(outside, 27);
+  EXPECT_EQ(compared, 30);
+}
+
+// --- a simulated flight with a satellite fault: the rerun excludes it -----------------------
+
+TEST(TrackerRaw, SatelliteFaultIsExcludedByTheRerunAndTheFlightRecoversWithoutAReplan) {
+  // GIVEN a large UAV (20 m span, 25 m long: HAL₁ = 24 m, VAL₁ = 30 m) on the example route, so
+  // that fault-free RAIM PLs (≈ 12–13 m here) fit level 1
+  Approved a = approveMission(exampleMission([](json& doc) {
+    doc["vehicle"]["lateral_m"] = 20.0;
+    doc["vehicle"]["longitudinal_m"] = 25.0;
+    doc["k2"] = 100;
+  }));
+  ASSERT_NEAR(a.report.limits.level1.hal_m, 24.0, 1e-9);
+  Tracker tracker;
+  tracker.addFlight("F1", a.flight, a.approver);
+  // AND the GNSS/INS simulator flying that route, with a 60 m step on one satellite from 60 s to 120 s
+  const ApprovalReport& r = a.report;
+  const maps::Geodetic origin{r.route.front().lat_rad, r.route.front().lon_rad, r.route.front().h_ell_m};
+  const maps::LocalFrame enu(origin);
+  std::vector<integrity::sim::Waypoint> wps;
+  for (const RoutePoint& p : r.route) {
+    wps.push_back({enu.toEnu({p.lat_rad, p.lon_rad, p.h_ell_m}), a.approver->mission().cruise_speed_mps});
+  }
+  const integrity::sim::Trajectory traj(origin, wps, 30.0);
+  integrity::sim::SensorSpec spec;
+  spec.model = a.approver->mission().model;
+  integrity::sim::FaultSpec fault;
+  fault.target = integrity::sim::FaultTarget::kSatellite;
+  fault.pick = 0.5;
+  fault.t_start_s = 60.0;
+  fault.t_end_s = 120.0;
+  fault.magnitude = 60.0;
+  integrity::sim::SensorSimulator sim(traj, a.approver->orbits(), r.departure, spec, {fault}, 11);
+  int reruns = 0, in_fault = 0, before = 0;
+  std::size_t line = 0;
+  std::vector<json> all;
+  while (sim.running()) {
+    (void)sim.stepImu();
+    if (!sim.gnssDue()) continue;
+    const integrity::sim::GnssEpoch ep = sim.gnss();
+    TrackFix f;
+    f.flight = "F1";
+    f.time = ep.time;
+    f.lat_rad = sim.truth().geodetic.lat_rad;  // the reported position only starts the WLS
+    f.lon_rad = sim.truth().geodetic.lon_rad;
+    f.h_ell_m = sim.truth().geodetic.h_ell_m + 5.0;
+    std::optional<integrity::SatId> faulty;
+    for (const integrity::sim::Pseudorange& pr : ep.ranges) {
+      f.ranges.push_back({pr.sat, pr.pseudorange_m, pr.sat_ecef_m});
+      if (pr.injected_m != 0.0) faulty = pr.sat;
+    }
+    f.pl_source = PlSource::kRaw;
+    f.line = ++line;
+    const auto ev = tracker.process(f);
+    ASSERT_FALSE(ev.empty());
+    const json& fix = ev.back();
+    ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
+    for (const json& e : ev) all.push_back(e);
+    const auto rr = ofType(ev, "monitoring_rerun");
+    if (faulty) {
+      ++in_fault;
+      // THEN the first pass's PL leaves level 1, the rerun excludes the faulty satellite and the
+      // PL after it fits again
+      ASSERT_EQ(rr.size(), 1u) << "t = " << ep.t_s << ": " << fix.dump();
+      ASSERT_EQ(rr[0].at("excluded").size(), 1u);
+      EXPECT_EQ(rr[0].at("excluded")[0], faulty->str());
+      EXPECT_GT(rr[0].at("hpl_before_m").get<double>(), 24.0);
+      EXPECT_LT(rr[0].at("hpl_after_m").get<double>(), 24.0);
+      EXPECT_EQ(rr[0].at("verdict_after"), "inside");
+      ++reruns;
+    } else {
+      ++before;
+      EXPECT_TRUE(rr.empty()) << "t = " << ep.t_s << ": " << rr[0].dump();
+    }
+    EXPECT_EQ(fix.at("verdict"), "inside") << "t = " << ep.t_s << ": " << fix.dump();
+  }
+  EXPECT_GE(in_fault, 59);
+  EXPECT_EQ(reruns, in_fault);
+  EXPECT_GT(before, 100);
+  EXPECT_TRUE(ofType(all, "replan").empty());
+  EXPECT_TRUE(ofType(all, "violation").empty());
+}
+
+// --- parsing ----------------------------------------------------------------------------------
+
+TEST(TrackFixJson, ErrorsNameTheFieldAndWhatWasExpected) {
+  auto err = [](const std::string& text) {
+    try {
+      (void)parseTrackFixJson(json::parse(text), "fixes.jsonl:7");
+    } catch (const maps::ParseError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string base = R"("time":"2020-01-01T14:00:00Z","lat":47.3,"lon":8.5,"h_ell_m":500)";
+  EXPECT_NE(err("{" + base + "}").find("a protection level"), std::string::npos);
+  EXPECT_NE(err("{" + base + R"(,"hpl_m":1})").find("both hpl_m and vpl_m"), std::string::npos);
+  EXPECT_NE(err("{" + base + R"(,"hpl_m":-1,"vpl_m":1})").find("$.hpl_m"), std::string::npos);
+  EXPECT_NE(err("{" + base + R"(,"hpl_m":1,"vpl_m":1,"speed":3})").find("$.speed"), std::string::npos);
+  EXPECT_NE(err(R"({"time":"yesterday","lat":47.3,"lon":8.5,"h_ell_m":500,"hpl_m":1,"vpl_m":1})").find("RFC 3339"), std::string::npos);
+  EXPECT_NE(err("{" + base + R"(,"pseudoranges":[{"sat":"X99","pr_m":2.1e7}]})").find("$.pseudoranges[0].sat"), std::string::npos);
+  EXPECT_NE(err("{" + base + R"(,"imu":{"grade":"toy","sigma_n_m":1,"sigma_e_m":1,"sigma_u_m":1}})").find("aviation, tactical or consumer"),
+            std::string::npos);
+  EXPECT_NE(err("{" + base + "}").find("fixes.jsonl:7"), std::string::npos);
+  const TrackFix ok = parseTrackFixJson(json::parse("{" + base + R"(,"vehicle":42,"hpl_m":1.5,"vpl_m":2})"), "x");
+  EXPECT_EQ(ok.flight, "42");
+  EXPECT_DOUBLE_EQ(*ok.hpl_m, 1.5);
+}
+
+TEST(TrackFixJson, InsBlockGivesSeed000NominalPl) {
+  // Consumer grade: λ = 9/12, P_nom = 0.5e-7 / 3: K = Q⁻¹(1.25e-8) = 5.5738 (normal table).
+  const auto [h, v] = insNominalPl({2, 0.3, 0.4, 1.0});
+  EXPECT_NEAR(h, 5.5738 * 0.5, 1e-3);
+  EXPECT_NEAR(v, 5.5738 * 1.0, 1e-3);
+}
+
+}  // namespace
+}  // namespace skylane::planner
