@@ -111,7 +111,9 @@ void runFenceCheck(const FenceCheckOptions& o) {
       ++checked;
     } catch (const std::exception& e) {  // ParseError, or a fix the checker refuses
       ++rejected;
-      std::cout << json{{"event", "rejected_input"}, {"line", line}, {"error", e.what()}}.dump() << "\n";
+      // The message quotes the line, which may hold bytes that are not UTF-8: replaced, not fatal.
+      std::cout << json{{"event", "rejected_input"}, {"line", line}, {"error", e.what()}}.dump(-1, ' ', false, json::error_handler_t::replace)
+                << "\n";
       std::cerr << "skylane: skipped: " << e.what() << "\n";
     }
   }

@@ -13,6 +13,7 @@
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -91,6 +92,8 @@ class LineSource {
     } else {
       fd_ = open(input.c_str(), O_RDONLY);
       if (fd_ < 0) throw ParseError(input, 0, "--input", input, std::string("a readable file (") + std::strerror(errno) + ")");
+      struct stat info {};
+      live_ = fstat(fd_, &info) == 0 && (S_ISFIFO(info.st_mode) || S_ISCHR(info.st_mode) || S_ISSOCK(info.st_mode));
     }
   }
   ~LineSource() {
@@ -192,7 +195,8 @@ void runTrack(const TrackOptions& o) {
   const std::size_t resume_line = store && o.input != "-" ? store->inputLine(o.input) : 0;
   auto emit = [&](const std::vector<planner::TrackEvent>& evs) {
     for (const planner::TrackEvent& e : evs) {
-      out << e.dump() << "\n";
+      // Quoted input may hold bytes that are not UTF-8: they are replaced, not fatal.
+      out << e.dump(-1, ' ', false, json::error_handler_t::replace) << "\n";
       ++events;
       if (e.at("event") == "rejected_input") ++rejected;
       if (e.at("event") == "fix") ++accepted;
@@ -212,7 +216,12 @@ void runTrack(const TrackOptions& o) {
   };
   auto process = [&](const planner::TrackFix& fix) {
     if (store) store->begin();
-    emit(tracker.process(fix));
+    try {
+      emit(tracker.process(fix));
+    } catch (const std::exception& e) {  // a fix the tracker cannot take never ends the stream
+      emit({tracker.rejectedInput(fix.source, fix.line, e.what())});
+      std::cerr << "skylane: track: skipped " << fix.source << ": " << e.what() << "\n";
+    }
     ++pending;
     checkpoint(false);
   };
@@ -223,8 +232,12 @@ void runTrack(const TrackOptions& o) {
     ++pending;
   };
 
-  std::signal(SIGTERM, onStopSignal);
-  std::signal(SIGINT, onStopSignal);
+  // Without SA_RESTART: a blocking read returns at once and the loop sees the stop flag.
+  struct sigaction stop {};
+  stop.sa_handler = onStopSignal;
+  sigemptyset(&stop.sa_mask);
+  sigaction(SIGTERM, &stop, nullptr);
+  sigaction(SIGINT, &stop, nullptr);
   if (resume_line > 0) std::cerr << "skylane: track: " << o.input << ": resuming after line " << resume_line << "\n";
 
   if (o.format == "rinex") {

@@ -154,7 +154,19 @@ std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) c
   const auto accept = [&](PieceOwner owner, std::size_t i) {
     return owner == PieceOwner::kObstacle || (zone_counts_[i] && airspace::isActiveDuring(zones_[i], v.t0, v.t1));
   };
-  const std::vector<SceneHit> hits = scene_.query(v.volume, horizon_m, accept);
+  // A volume taller than the scene's height band (a VPL of kilometres from a poor geometry) is
+  // cut to the band: every piece lies inside it, so the cut volume meets exactly the pieces the
+  // whole one meets; its vertical margins are then those of the cut volume.
+  ProtectionVolume volume = v.volume;
+  requireValid(volume);
+  const double lo = std::max(volume.p_map.z() - volume.vpl_m, kSceneFloor_h_ell_m);
+  const double hi = std::min(volume.p_map.z() + volume.vpl_m, kSceneCeiling_h_ell_m);
+  if (lo > volume.p_map.z() - volume.vpl_m || hi < volume.p_map.z() + volume.vpl_m) {
+    if (!(hi > lo)) return {};  // wholly above or below every zone and obstacle
+    volume.p_map.z() = 0.5 * (lo + hi);
+    volume.vpl_m = 0.5 * (hi - lo);
+  }
+  const std::vector<SceneHit> hits = scene_.query(volume, horizon_m, accept);
 
   // One check per zone or obstacle, from the piece that decides it.
   std::vector<Check> near;

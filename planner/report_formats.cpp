@@ -4,6 +4,7 @@
 #include "maps/json_node.hpp"
 
 #include <cmath>
+#include <filesystem>
 
 namespace skylane::planner {
 
@@ -42,6 +43,8 @@ nlohmann::json approvalReportJson(const ApprovalReport& r, const Mission& m) {
   json j;
   j["mission"] = m.name;
   j["source"] = m.source;
+  // Where the mission is for a tracker started in another directory.
+  if (!m.source.empty()) j["source_absolute"] = std::filesystem::absolute(m.source).lexically_normal().string();
   j["decision"] = r.approved ? "approved" : "rejected";
   j["reasons"] = json::array();
   for (const Reason& x : r.reasons) j["reasons"].push_back(reasonJson(x, r.departure));
@@ -212,6 +215,7 @@ ApprovedFlight parseApprovalReport(const nlohmann::json& doc, const std::string&
   f.report_source = source;
   f.mission_name = root.has("mission") ? root.at("mission").str() : std::string();
   f.mission_source = root.at("source").str();
+  if (root.has("source_absolute")) f.mission_source_absolute = root.at("source_absolute").str();
   const std::string decision = root.at("decision").str();
   if (decision != "approved" && decision != "rejected") root.at("decision").fail("\"approved\" or \"rejected\"");
   f.approved = decision == "approved";

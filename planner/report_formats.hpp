@@ -23,6 +23,7 @@ struct ApprovedFlight {
   std::string report_source;   ///< the report file
   std::string mission_name;
   std::string mission_source;  ///< the mission file as the report names it
+  std::string mission_source_absolute;  ///< its absolute path at approval time (may be empty)
   std::string mission_sha256;  ///< its digest at approval time (empty when the report has none)
   bool approved = false;
   maps::GpsTime departure;

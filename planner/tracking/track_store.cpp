@@ -128,7 +128,7 @@ void TrackStore::appendEvent(const nlohmann::json& e) {
   bindText(put_event_, 1, e.value("flight", std::string()));
   bindText(put_event_, 2, e.value("time", std::string()));
   bindText(put_event_, 3, e.value("event", std::string("?")));
-  bindText(put_event_, 4, e.dump());
+  bindText(put_event_, 4, e.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   if (sqlite3_step(put_event_) != SQLITE_DONE) fail("cannot store an event");
 }
 

@@ -93,11 +93,13 @@ void Tracker::addFlight(const std::string& id, const ApprovedFlight& approval, s
 std::string Tracker::addApprovalFile(const std::string& report_path, const std::string& id) {
   const ApprovedFlight plan = parseApprovalReport(maps::readJsonFile(report_path), report_path);
   namespace fs = std::filesystem;
+  // The mission as written (from here), where it was at approval time, or beside the report.
   fs::path mission = plan.mission_source;
+  if (!fs::exists(mission) && !plan.mission_source_absolute.empty()) mission = plan.mission_source_absolute;
   if (!fs::exists(mission)) mission = fs::path(report_path).parent_path() / fs::path(plan.mission_source).filename();
   if (!fs::exists(mission)) {
     throw maps::ParseError(report_path, 0, "$.source", plan.mission_source,
-                           "a mission file that exists (as written, or beside the report)");
+                           "a mission file that exists (as written, at $.source_absolute, or beside the report)");
   }
   const std::string key = fs::weakly_canonical(mission).string();
   if (!plan.mission_sha256.empty() && maps::fileSha256Hex(mission.string()) != plan.mission_sha256) {
@@ -252,16 +254,23 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
     out.push_back(std::move(e));
     return out;
   }
-  st.last_time = fix.time;
-  st.stale_reported = false;
-  ++st.fixes;
-
   auto volumeAt = [&](const maps::Geodetic& g, double h, double v) {
     const Eigen::Vector2d xy = frame.toPlane(g.lat_rad, g.lon_rad);
     return geofence::TimedVolume{fix.time, fix.time, {Eigen::Vector3d(xy.x(), xy.y(), g.h_ell_m), h, v}};
   };
   geofence::TimedVolume vol = volumeAt(pos, *hpl, *vpl);
-  geofence::FenceVerdict verdict = geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), vol);
+  geofence::FenceVerdict verdict;
+  try {
+    verdict = geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), vol);
+  } catch (const std::invalid_argument& e) {  // e.g. a volume beyond the modelled heights
+    json r = rejectedInput(fix.source, fix.line, std::string("the fix cannot be checked: ") + e.what());
+    r["flight"] = id;
+    out.push_back(std::move(r));
+    return out;
+  }
+  st.last_time = fix.time;
+  st.stale_reported = false;
+  ++st.fixes;
   auto levelVerdict = [](const geofence::FenceVerdict& v, geofence::Level l) {
     geofence::Verdict worst = geofence::Verdict::kInside;
     for (const geofence::Check& c : v.checks) {
@@ -289,8 +298,13 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       pos = again.position;
       hpl = again.pl.hpl_m;
       vpl = again.pl.vpl_m;
-      vol = volumeAt(pos, *hpl, *vpl);
-      verdict = geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), vol);
+      const geofence::TimedVolume vol2 = volumeAt(pos, *hpl, *vpl);
+      try {
+        verdict = geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), vol2);
+        vol = vol2;
+      } catch (const std::invalid_argument& err) {
+        e["note"] = std::string("the rerun's volume cannot be checked: ") + err.what();
+      }
       e["hpl_after_m"] = metres(*hpl);
       e["vpl_after_m"] = metres(*vpl);
       e["verdict_after"] = geofence::verdictName(levelVerdict(verdict, geofence::Level::kCorridor));

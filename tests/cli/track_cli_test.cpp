@@ -1,0 +1,260 @@
+// `skylane track` end to end (issue 8): garbage and truncated input lose no good fix; a tracker
+// killed mid-stream and restarted on its database loses no accepted fix; SIGTERM saves and
+// exits; NMEA, UDP and RINEX replay inputs; bad approvals exit 2.
+#include "planner/tracking/track_store.hpp"
+#include "tests/test_util.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <sys/wait.h>
+
+namespace skylane {
+namespace {
+
+using nlohmann::json;
+
+struct RunResult {
+  int status = -1;
+  std::string out;  ///< stdout (and stderr when asked)
+};
+
+RunResult sh(const std::string& script) {
+  static int n = 0;
+  const std::string file = test::scratchPath("script-" + std::to_string(++n) + ".sh");
+  std::ofstream(file) << script << "\n";
+  RunResult r;
+  FILE* p = popen(("bash " + file).c_str(), "r");
+  if (!p) return r;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+const std::string kBin = SKYLANE_BINARY;
+const std::string kExample = std::string(SKYLANE_TEST_DATA) + "/../../examples/approve/mission.json";
+
+std::vector<json> readEvents(const std::string& path) {
+  std::vector<json> out;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty()) out.push_back(json::parse(line));
+  }
+  return out;
+}
+
+std::vector<json> ofType(const std::vector<json>& all, const std::string& type) {
+  std::vector<json> out;
+  for (const json& e : all) {
+    if (e.at("event") == type) out.push_back(e);
+  }
+  return out;
+}
+
+/// The bundled example approved once for the suite, and good fixes along its route (1 per s).
+class TrackCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(test::scratchPath("track-cli"));
+    std::filesystem::create_directories(*dir_);
+    const RunResult r = sh(kBin + " approve " + kExample + " --out " + *dir_ + "/approve > /dev/null 2>&1");
+    ASSERT_EQ(r.status, 0) << r.out;
+    report_ = new json(json::parse(std::ifstream(*dir_ + "/approve/report.json")));
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    delete report_;
+  }
+  /// A fix k seconds after departure on the route (linear in lat/lon between route points).
+  static json goodFix(int k) {
+    const json& route = report_->at("route");
+    const double t = k;
+    std::size_t i = 1;
+    while (i + 1 < route.size() && t > route[i].at("eta_s").get<double>()) ++i;
+    const json& a = route[i - 1];
+    const json& b = route[i];
+    const double f = std::clamp((t - a.at("eta_s").get<double>()) / (b.at("eta_s").get<double>() - a.at("eta_s").get<double>()), 0.0, 1.0);
+    auto mix = [&](const char* key) { return a.at(key).get<double>() + f * (b.at(key).get<double>() - a.at(key).get<double>()); };
+    char time[32];
+    std::snprintf(time, sizeof time, "2020-01-01T14:%02d:%02dZ", k / 60, k % 60);
+    return {{"flight", "zrh"}, {"time", time}, {"lat", mix("lat")}, {"lon", mix("lon")}, {"h_ell_m", mix("h_ell_m")},
+            {"hpl_m", 0.5}, {"vpl_m", 0.5}};
+  }
+  static std::string approval() { return "zrh=" + *dir_ + "/approve/report.json"; }
+  static std::string* dir_;
+  static json* report_;
+};
+std::string* TrackCli::dir_ = nullptr;
+json* TrackCli::report_ = nullptr;
+
+TEST_F(TrackCli, GarbageAndTruncatedLinesAreReportedAndEveryGoodFixIsChecked) {
+  const std::string in = *dir_ + "/mixed.jsonl";
+  std::ofstream f(in);
+  std::set<int> bad_lines;
+  int line = 0;
+  for (int k = 0; k < 40; ++k) {
+    f << goodFix(k).dump() << "\n";
+    ++line;
+    if (k % 5 == 2) {
+      const std::string full = goodFix(100 + k).dump();
+      f << full.substr(0, full.size() / 2) << "\n";  // truncated
+      bad_lines.insert(++line);
+    }
+    if (k % 9 == 4) {
+      f << "\x01\xff garbage \"{\n";
+      bad_lines.insert(++line);
+      f << "\n";  // an empty line is no record
+      ++line;
+    }
+  }
+  f.close();
+  const RunResult r = sh(kBin + " track --approval " + approval() + " --input " + in + " --no-replan > " + *dir_ +
+                         "/mixed_events.jsonl 2> " + *dir_ + "/mixed_err.txt");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto events = readEvents(*dir_ + "/mixed_events.jsonl");
+  EXPECT_EQ(ofType(events, "fix").size(), 40u);
+  std::set<int> rejected;
+  for (const json& e : ofType(events, "rejected_input")) rejected.insert(e.at("line").get<int>());
+  EXPECT_EQ(rejected, bad_lines);
+  for (const json& e : ofType(events, "fix")) EXPECT_EQ(e.at("verdict"), "inside") << e.dump();
+}
+
+TEST_F(TrackCli, KilledAndRestartedTrackerLosesNoAcceptedFix) {
+  // GIVEN 200 good fixes fed through a FIFO, the writer pausing after the first 120
+  const std::string fifo = *dir_ + "/live.fifo", db = *dir_ + "/track.sqlite", all = *dir_ + "/all.jsonl";
+  std::filesystem::remove(db);
+  std::filesystem::remove(fifo);
+  {
+    std::ofstream f(all);
+    for (int k = 0; k < 200; ++k) f << goodFix(k).dump() << "\n";
+  }
+  // WHEN the tracker is killed (SIGKILL: no chance to save) while it waits for the rest …
+  const RunResult first = sh("mkfifo " + fifo + "; (head -n 120 " + all + "; sleep 3) > " + fifo + " & " + kBin +
+                             " track --approval " + approval() + " --input " + fifo + " --db " + db +
+                             " --batch 7 --no-replan > /dev/null 2>&1 & pid=$!; sleep 1.5; kill -9 $pid; wait $pid; echo killed");
+  ASSERT_NE(first.out.find("killed"), std::string::npos);
+  // … and restarted on the same database and input name, now a file with all 200 lines
+  std::filesystem::remove(fifo);
+  std::filesystem::copy_file(all, fifo);
+  const RunResult second = sh(kBin + " track --approval " + approval() + " --input " + fifo + " --db " + db +
+                              " --batch 7 --no-replan 2>&1 > /dev/null");
+  ASSERT_EQ(second.status, 0) << second.out;
+  EXPECT_NE(second.out.find("resumed flight zrh"), std::string::npos) << second.out;
+  EXPECT_NE(second.out.find("resuming after line"), std::string::npos) << second.out;
+  // THEN the database holds every accepted fix exactly once, lines 1–200
+  std::multiset<int> lines;
+  for (const json& e : planner::TrackStore(db).events("fix")) lines.insert(e.at("line").get<int>());
+  EXPECT_EQ(lines.size(), 200u);
+  for (int k = 1; k <= 200; ++k) EXPECT_EQ(lines.count(k), 1u) << "line " << k;
+}
+
+TEST_F(TrackCli, SigtermSavesTheStateAndExitsCleanly) {
+  const std::string fifo = *dir_ + "/term.fifo", db = *dir_ + "/term.sqlite", all = *dir_ + "/term.jsonl";
+  std::filesystem::remove(db);
+  std::filesystem::remove(fifo);
+  {
+    std::ofstream f(all);
+    for (int k = 0; k < 30; ++k) f << goodFix(k).dump() << "\n";
+  }
+  const RunResult r = sh("mkfifo " + fifo + "; (cat " + all + "; sleep 5) > " + fifo + " & " + kBin + " track --approval " +
+                         approval() + " --input " + fifo + " --db " + db + " --no-replan > " + *dir_ +
+                         "/term_events.jsonl 2> " + *dir_ + "/term_err.txt & pid=$!; sleep 1; kill -TERM $pid; wait $pid; echo status=$?");
+  EXPECT_NE(r.out.find("status=0"), std::string::npos) << r.out;
+  EXPECT_EQ(ofType(readEvents(*dir_ + "/term_events.jsonl"), "fix").size(), 30u);
+  std::ifstream err(*dir_ + "/term_err.txt");
+  const std::string text((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("stopped by a signal; state saved"), std::string::npos) << text;
+  EXPECT_EQ(planner::TrackStore(db).events("fix").size(), 30u);
+}
+
+TEST_F(TrackCli, UdpInputAndAStaleFlightOnAQuietLink) {
+  const std::string events = *dir_ + "/udp_events.jsonl";
+  std::string send;
+  for (int k = 0; k < 5; ++k) send += "echo \x27" + goodFix(k).dump() + "\x27 > /dev/udp/127.0.0.1/47811; sleep 0.05; ";
+  const RunResult r = sh(kBin + " track --approval " + approval() + " --input udp://127.0.0.1:47811 --stale-after 1 --no-replan > " +
+                         events + " 2>/dev/null & pid=$!; sleep 0.5; " + send + " sleep 2.5; kill -TERM $pid; wait $pid; echo status=$?");
+  EXPECT_NE(r.out.find("status=0"), std::string::npos) << r.out;
+  const auto ev = readEvents(events);
+  EXPECT_EQ(ofType(ev, "fix").size(), 5u);
+  ASSERT_EQ(ofType(ev, "stale").size(), 1u);
+  EXPECT_EQ(ofType(ev, "stale")[0].at("last_fix"), "2020-01-01T14:00:04.000Z");
+}
+
+TEST_F(TrackCli, BadApprovalsExitTwoNamingTheField) {
+  const std::string bad = *dir_ + "/bad_report.json";
+  json j = *report_;
+  j.erase("route");
+  std::ofstream(bad) << j.dump();
+  const RunResult r = sh(kBin + " track --approval " + bad + " --input /dev/null 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("$.route"), std::string::npos) << r.out;
+  // A mission changed since its approval is refused (the report keeps its SHA-256).
+  json changed = *report_;
+  for (json& in : changed.at("inputs")) {
+    if (in.at("role") == "mission") in["sha256"] = std::string(64, '0');
+  }
+  std::ofstream(*dir_ + "/changed_report.json") << changed.dump();
+  const RunResult c = sh(kBin + " track --approval " + *dir_ + "/changed_report.json --input /dev/null 2>&1");
+  EXPECT_EQ(c.status, 2) << c.out;
+  EXPECT_NE(c.out.find("the mission changed since it was approved"), std::string::npos) << c.out;
+  const RunResult fmt = sh(kBin + " track --approval " + approval() + " --input /dev/null --level1 5/3 2>&1");
+  EXPECT_EQ(fmt.status, 2) << fmt.out;
+  EXPECT_NE(fmt.out.find("--level1"), std::string::npos) << fmt.out;
+}
+
+TEST(TrackCliRinex, ObservationReplayGivesSkylanesOwnPls) {
+  // GIVEN a flight approved from GSI station 3040 (Japan) 1 km east, with the station's own
+  // broadcast ephemerides as orbits, departing at the first observation
+  const std::string dir = test::scratchPath("track-rinex");
+  std::filesystem::create_directories(dir);
+  const std::string data = SKYLANE_TEST_DATA;
+  const json mission{{"name", "GSI 3040 hop"},
+                     {"vehicle", {{"lateral_m", 20.0}, {"longitudinal_m", 25.0}, {"height_m", 2.0}, {"cruise_speed_mps", 12}}},
+                     {"k1", 1.2},
+                     {"k2", 100},
+                     {"start", {{"lat", 35.132066}, {"lon", 139.624302}}},
+                     {"goal", {{"lat", 35.132066}, {"lon", 139.635}}},
+                     {"altitude", {{"cruise_agl_m", 40}, {"min_agl_m", 20}, {"max_agl_m", 120}}},
+                     {"departure", "2005-04-02T00:00:00Z"},
+                     {"ground_amsl_m", 39.0},
+                     {"orbits", {data + "/gnss/30400920.05n"}},
+                     {"integrity", {{"method", "raim"}, {"mask_deg", 10}}},
+                     {"planner", {{"iterations", 300}, {"seed", 3}}}};
+  std::ofstream(dir + "/mission.json") << mission.dump(1);
+  const RunResult a = sh(kBin + " approve " + dir + "/mission.json --out " + dir + "/approve > /dev/null 2>&1");
+  ASSERT_EQ(a.status, 0) << a.out;
+  // WHEN the station's observations are replayed
+  const RunResult r = sh(kBin + " track --approval " + dir + "/approve/report.json --format rinex --input " + data +
+                         "/gnss/30400920.05o --nav " + data + "/gnss/30400920.05n --no-replan > " + dir + "/events.jsonl 2>/dev/null");
+  ASSERT_EQ(r.status, 0) << r.out;
+  // THEN every epoch of the hour (30 s) is a fix with skylane's PLs; where the geometry is
+  // good the volume lies in the airspace box, and a VPL of kilometres leaves it
+  const auto fixes = ofType(readEvents(dir + "/events.jsonl"), "fix");
+  EXPECT_EQ(fixes.size(), 120u);
+  int inside2 = 0;
+  for (const json& f : fixes) {
+    EXPECT_EQ(f.at("pl_source"), "raw");
+    EXPECT_GT(f.at("hpl_m").get<double>(), 1.0);
+    const bool in2 = f.at("levels").at("level2").at("verdict") == "inside";
+    if (f.at("vpl_m").get<double>() < 100.0) {
+      EXPECT_TRUE(in2) << f.dump();
+    }
+    if (f.at("vpl_m").get<double>() > 2600.0) {
+      EXPECT_FALSE(in2) << f.dump();  // VAL₂ = 2500 m
+    }
+    inside2 += in2;
+  }
+  EXPECT_GT(inside2, 100);
+}
+
+}  // namespace
+}  // namespace skylane
