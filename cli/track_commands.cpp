@@ -51,6 +51,7 @@ struct TrackOptions {
   bool no_replan = false;
   bool replan_on_pl = false;
   int batch = 200;
+  double horizon_m = 50.0;
 };
 
 std::pair<int, int> parseMofN(const std::string& text, const char* option) {
@@ -158,6 +159,7 @@ void runTrack(const TrackOptions& o) {
   topt.max_time_jump_s = o.max_jump_s;
   topt.replan = !o.no_replan;
   topt.replan_on_pl_exceedance = o.replan_on_pl;
+  topt.horizon_m = o.horizon_m;
   planner::Tracker tracker(topt);
 
   std::unique_ptr<planner::TrackStore> store;
@@ -195,12 +197,13 @@ void runTrack(const TrackOptions& o) {
   const std::size_t resume_line = store && o.input != "-" ? store->inputLine(o.input) : 0;
   auto emit = [&](const std::vector<planner::TrackEvent>& evs) {
     for (const planner::TrackEvent& e : evs) {
+      const json j = e.toJson();
       // Quoted input may hold bytes that are not UTF-8: they are replaced, not fatal.
-      out << e.dump(-1, ' ', false, json::error_handler_t::replace) << "\n";
+      out << j.dump(-1, ' ', false, json::error_handler_t::replace) << "\n";
       ++events;
-      if (e.at("event") == "rejected_input") ++rejected;
-      if (e.at("event") == "fix") ++accepted;
-      if (store) store->appendEvent(e);
+      if (e.is("rejected_input")) ++rejected;
+      if (e.is("fix")) ++accepted;
+      if (store) store->appendEvent(j);
     }
   };
   int pending = 0;
@@ -377,6 +380,7 @@ void addTrackCommands(CLI::App& app) {
   c->add_option("--max-time-jump", o->max_jump_s, "a fix more than this many seconds after the last is rejected (default 300)");
   c->add_flag("--no-replan", o->no_replan, "report violations without replanning");
   c->add_flag("--replan-on-pl", o->replan_on_pl, "also replan when level 1 is violated by the PLs alone");
+  c->add_option("--horizon", o->horizon_m, "list zones and obstacles within this distance of a volume in its fix event [m] (default 50)");
   c->add_option("--batch", o->batch, "fixes per database transaction (default 200)");
   c->callback([o]() { runTrack(*o); });
 }

@@ -214,11 +214,16 @@ Fence::Fence(Corridor level1, Corridor level2, Obstructions obstructions)
 
 FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions,
                          const TimedVolume& v) {
+  return checkVolume(level1, level2, obstructions, v, obstructions.options().horizon_m);
+}
+
+FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions,
+                         const TimedVolume& v, double horizon_m) {
   FenceVerdict out;
   const double tol = obstructions.options().tolerance_m;
   out.checks.push_back(boxCheck(Level::kCorridor, level1, v.volume, tol));
   out.checks.push_back(boxCheck(Level::kAirspace, level2, v.volume, tol));
-  std::vector<Check> near = obstructions.check(v);
+  std::vector<Check> near = obstructions.check(v, horizon_m);
   out.checks.insert(out.checks.end(), std::make_move_iterator(near.begin()), std::make_move_iterator(near.end()));
 
   for (int wanted : {2, 1}) {

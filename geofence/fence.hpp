@@ -145,6 +145,9 @@ class Obstructions {
 /// Fence::check does; for callers that own the pieces separately, such as route approval).
 [[nodiscard]] FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions,
                                        const TimedVolume& v);
+/// \brief The same, reporting zones and obstacles within `horizon_m` (a met one always).
+[[nodiscard]] FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions,
+                                       const TimedVolume& v, double horizon_m);
 
 /// \brief Both box levels, the zones and the obstacles, checked together.
 class Fence {

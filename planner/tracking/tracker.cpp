@@ -30,8 +30,12 @@ int pushWindow(std::vector<bool>& w, bool v, int n) {
   return static_cast<int>(std::count(w.begin(), w.end(), true));
 }
 
-json event(const char* type, const std::string& flight, const maps::GpsTime& t) {
-  return json{{"event", type}, {"flight", flight}, {"time", maps::formatRfc3339(t, 3)}};
+TrackEvent event(const char* type, const std::string& flight, const maps::GpsTime& t) {
+  TrackEvent e;
+  e.type = type;
+  e.flight = flight;
+  e.time = t;
+  return e;
 }
 
 }  // namespace
@@ -66,8 +70,9 @@ Tracker::Tracker(TrackerOptions options) : options_(options) {
                                 std::to_string(options_.level2_n) + ")");
   }
   if (options_.recover_after < 1) throw std::invalid_argument("tracker: recover_after must be ≥ 1");
-  if (!(options_.stale_after_s > 0) || !(options_.max_time_jump_s > 0) || !(options_.replan_cooldown_s >= 0)) {
-    throw std::invalid_argument("tracker: stale_after_s and max_time_jump_s must be > 0 s, replan_cooldown_s ≥ 0 s");
+  if (!(options_.stale_after_s > 0) || !(options_.max_time_jump_s > 0) || !(options_.replan_cooldown_s >= 0) ||
+      !(options_.horizon_m >= 0 && std::isfinite(options_.horizon_m))) {
+    throw std::invalid_argument("tracker: stale_after_s and max_time_jump_s must be > 0 s, replan_cooldown_s ≥ 0 s, horizon_m ≥ 0 m");
   }
 }
 
@@ -166,9 +171,58 @@ void Tracker::restore(const std::string& id, const FlightState& state, const jso
 }
 
 TrackEvent Tracker::rejectedInput(const std::string& source, std::size_t line, const std::string& why) const {
-  json e{{"event", "rejected_input"}, {"source", source}, {"error", why}};
+  TrackEvent e;
+  e.type = "rejected_input";
+  e["source"] = source;
+  e["error"] = why;
   if (line > 0) e["line"] = line;
   return e;
+}
+
+json TrackEvent::toJson() const {
+  json j = body;
+  j["event"] = type;
+  if (!flight.empty()) j["flight"] = flight;
+  if (time) j["time"] = maps::formatRfc3339(*time, 3);
+  if (!fix) return j;
+  const FixRecord& f = *fix;
+  j["line"] = f.line;
+  j["lat"] = roundDeg(f.lat_rad);
+  j["lon"] = roundDeg(f.lon_rad);
+  j["h_ell_m"] = roundMm(f.h_ell_m);
+  j["hpl_m"] = metres(f.hpl_m);
+  j["vpl_m"] = metres(f.vpl_m);
+  j["pl_source"] = plSourceName(f.pl_source);
+  if (f.fault_detected) j["fault_detected"] = *f.fault_detected;
+  j["verdict"] = geofence::verdictName(f.verdict.verdict);
+  j["violated"] = f.verdict.violated ? json(geofence::levelName(*f.verdict.violated)) : json(nullptr);
+  json levels = json::object();
+  json near = json::array();
+  for (const geofence::Check& c : f.verdict.checks) {
+    if (c.level == geofence::Level::kCorridor || c.level == geofence::Level::kAirspace) {
+      levels[geofence::levelName(c.level)] = {{"verdict", geofence::verdictName(c.verdict)},
+                                             {"margin_h_m", metres(c.margin_h_m)},
+                                             {"margin_v_m", metres(c.margin_v_m)},
+                                             {"segment", c.index}};
+    } else {
+      near.push_back({{"level", geofence::levelName(c.level)},
+                      {"subject", c.subject},
+                      {"verdict", geofence::verdictName(c.verdict)},
+                      {"clearance_m", metres(c.clearance_m.value_or(0.0))}});
+    }
+  }
+  j["levels"] = levels;
+  j["near"] = near;
+  j["route_version"] = f.route_version;
+  if (f.rerun) j["rerun"] = true;
+  if (!f.note.empty()) j["note"] = f.note;
+  return j;
+}
+
+std::vector<json> Tracker::processJson(const TrackFix& fix) {
+  std::vector<json> out;
+  for (const TrackEvent& e : process(fix)) out.push_back(e.toJson());
+  return out;
 }
 
 std::vector<TrackEvent> Tracker::sweepStale(const maps::GpsTime& now) {
@@ -178,7 +232,7 @@ std::vector<TrackEvent> Tracker::sweepStale(const maps::GpsTime& now) {
     const double gap = now - *f->st.last_time;
     if (gap <= options_.stale_after_s) continue;
     // A flight past its route's end and near its goal has landed: silence is expected.
-    json e = event("stale", id, now);
+    TrackEvent e = event("stale", id, now);
     e["last_fix"] = maps::formatRfc3339(*f->st.last_time, 3);
     e["gap_s"] = std::round(gap * 1e3) / 1e3;
     e["expected_within_s"] = options_.stale_after_s;
@@ -213,8 +267,8 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
             std::to_string(static_cast<long long>(options_.max_time_jump_s)) + " s)";
     }
     if (!why.empty()) {
-      json e = rejectedInput(fix.source, fix.line, why);
-      e["flight"] = id;
+      TrackEvent e = rejectedInput(fix.source, fix.line, why);
+      e.flight = id;
       out.push_back(std::move(e));
       return out;
     }
@@ -249,8 +303,8 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
     vpl = std::max(vpl.value_or(0.0), v);
   }
   if (!hpl || !vpl) {
-    json e = rejectedInput(fix.source, fix.line, "no protection level for the fix: " + (note.empty() ? "none given" : note));
-    e["flight"] = id;
+    TrackEvent e = rejectedInput(fix.source, fix.line, "no protection level for the fix: " + (note.empty() ? "none given" : note));
+    e.flight = id;
     out.push_back(std::move(e));
     return out;
   }
@@ -261,10 +315,10 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   geofence::TimedVolume vol = volumeAt(pos, *hpl, *vpl);
   geofence::FenceVerdict verdict;
   try {
-    verdict = geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), vol);
+    verdict = geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), vol, options_.horizon_m);
   } catch (const std::invalid_argument& e) {  // e.g. a volume beyond the modelled heights
-    json r = rejectedInput(fix.source, fix.line, std::string("the fix cannot be checked: ") + e.what());
-    r["flight"] = id;
+    TrackEvent r = rejectedInput(fix.source, fix.line, std::string("the fix cannot be checked: ") + e.what());
+    r.flight = id;
     out.push_back(std::move(r));
     return out;
   }
@@ -286,7 +340,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
     const integrity::LiveFix again = integrity::solveLiveFix(fix.ranges, pos, fix.time, f.live, true, &f.approver->orbits());
     rerun = true;
     ++st.rerun_count;
-    json e = event("monitoring_rerun", id, fix.time);
+    TrackEvent e = event("monitoring_rerun", id, fix.time);
     e["fault_detected"] = first->fault_detected;
     json excluded = json::array();
     for (const integrity::SatId& s : again.excluded) excluded.push_back(s.str());
@@ -300,7 +354,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       vpl = again.pl.vpl_m;
       const geofence::TimedVolume vol2 = volumeAt(pos, *hpl, *vpl);
       try {
-        verdict = geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), vol2);
+        verdict = geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), vol2, options_.horizon_m);
         vol = vol2;
       } catch (const std::invalid_argument& err) {
         e["note"] = std::string("the rerun's volume cannot be checked: ") + err.what();
@@ -311,7 +365,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
     } else {
       e["hpl_after_m"] = nullptr;
       e["vpl_after_m"] = nullptr;
-      e["verdict_after"] = e["verdict_before"];
+      e["verdict_after"] = e.body["verdict_before"];
       e["note"] = again.note + again.pl.reason;
     }
     e["line"] = fix.line;
@@ -335,7 +389,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       st.inside_streak[l] = 0;
       if (!st.violated[l]) {
         st.violated[l] = true;
-        json e = event("violation", id, fix.time);
+        TrackEvent e = event("violation", id, fix.time);
         e["level"] = geofence::levelName(level);
         e["verdict"] = geofence::verdictName(lv[l]);
         for (const geofence::Check& c : verdict.checks) {
@@ -357,7 +411,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       }
     } else if (st.violated[l] && ++st.inside_streak[l] >= options_.recover_after) {
       st.violated[l] = false;
-      json e = event("recovered", id, fix.time);
+      TrackEvent e = event("recovered", id, fix.time);
       e["level"] = geofence::levelName(level);
       e["after_fixes"] = st.inside_streak[l];
       e["line"] = fix.line;
@@ -380,37 +434,21 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   }
 
   // The fix event.
-  json e = event("fix", id, fix.time);
-  e["line"] = fix.line;
-  e["lat"] = roundDeg(pos.lat_rad);
-  e["lon"] = roundDeg(pos.lon_rad);
-  e["h_ell_m"] = roundMm(pos.h_ell_m);
-  e["hpl_m"] = metres(*hpl);
-  e["vpl_m"] = metres(*vpl);
-  e["pl_source"] = plSourceName(source);
-  if (first) e["fault_detected"] = first->fault_detected;
-  e["verdict"] = geofence::verdictName(verdict.verdict);
-  e["violated"] = verdict.violated ? json(geofence::levelName(*verdict.violated)) : json(nullptr);
-  json levels = json::object();
-  json near = json::array();
-  for (const geofence::Check& c : verdict.checks) {
-    if (c.level == geofence::Level::kCorridor || c.level == geofence::Level::kAirspace) {
-      levels[geofence::levelName(c.level)] = {{"verdict", geofence::verdictName(c.verdict)},
-                                             {"margin_h_m", metres(c.margin_h_m)},
-                                             {"margin_v_m", metres(c.margin_v_m)},
-                                             {"segment", c.index}};
-    } else {
-      near.push_back({{"level", geofence::levelName(c.level)},
-                      {"subject", c.subject},
-                      {"verdict", geofence::verdictName(c.verdict)},
-                      {"clearance_m", metres(c.clearance_m.value_or(0.0))}});
-    }
-  }
-  e["levels"] = levels;
-  e["near"] = near;
-  e["route_version"] = st.route_version;
-  if (rerun) e["rerun"] = true;
-  if (!note.empty()) e["note"] = note;
+  TrackEvent e = event("fix", id, fix.time);
+  FixRecord rec;
+  rec.line = fix.line;
+  rec.lat_rad = pos.lat_rad;
+  rec.lon_rad = pos.lon_rad;
+  rec.h_ell_m = pos.h_ell_m;
+  rec.hpl_m = *hpl;
+  rec.vpl_m = *vpl;
+  rec.pl_source = source;
+  if (first) rec.fault_detected = first->fault_detected;
+  rec.route_version = st.route_version;
+  rec.rerun = rerun;
+  rec.note = note;
+  rec.verdict = std::move(verdict);
+  e.fix = std::move(rec);
   out.push_back(std::move(e));
 
   // Replan from where the vehicle is.
@@ -418,12 +456,12 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
     st.last_replan = fix.time;
     ++st.replans;
     const ApprovalReport r = f.approver->replanFrom(p_map, fix.time, st.next_stop);
-    json rp = event("replan", id, fix.time);
+    TrackEvent rp = event("replan", id, fix.time);
     rp["trigger"] = geofence::levelName(*trigger);
     rp["from"] = {{"lat", roundDeg(pos.lat_rad)}, {"lon", roundDeg(pos.lon_rad)}, {"h_ell_m", roundMm(pos.h_ell_m)}};
     rp["decision"] = r.approved ? "approved" : "rejected";
     rp["report"] = approvalReportJson(r, f.approver->mission());
-    rp["report"].erase("predicted");  // the samples stay in the tracker's database with the route
+    rp.body["report"].erase("predicted");  // the samples stay in the tracker's database with the route
     if (r.approved) {
       rp["operational_intent"] = {{"volumes", operationalIntentVolumes(r, frame, 2, 30.0)},
                                   {"state", "Accepted"},

@@ -36,7 +36,9 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace skylane::planner {
@@ -52,10 +54,36 @@ struct TrackerOptions {
   double stale_after_s = 3.0;
   double max_time_jump_s = 300.0;
   double waypoint_radius_m = 30.0;  ///< a mission waypoint is passed once a fix comes this close
+  double horizon_m = 50.0;          ///< zones and obstacles this near a volume are listed in its fix event
 };
 
-/// \brief One event of the output stream: {"event": type, "flight", "time", …}.
-using TrackEvent = nlohmann::json;
+/// \brief What a `fix` event says (kept typed: the JSON is only made when it is written).
+struct FixRecord {
+  std::size_t line = 0;
+  double lat_rad = 0.0, lon_rad = 0.0, h_ell_m = 0.0;  ///< the position checked (skylane's own with raw ranges)
+  double hpl_m = 0.0, vpl_m = 0.0;
+  PlSource pl_source = PlSource::kOnboard;
+  std::optional<bool> fault_detected;  ///< raw ranges: the first pass's detection
+  geofence::FenceVerdict verdict;
+  int route_version = 0;
+  bool rerun = false;
+  std::string note;
+};
+
+/// \brief One event of the output stream: {"event": type, "flight", "time", …}. A `fix` event
+/// holds a FixRecord; the others their fields in `body`.
+struct TrackEvent {
+  const char* type = "";
+  std::string flight;             ///< empty: none (an unreadable record)
+  std::optional<maps::GpsTime> time;
+  std::optional<FixRecord> fix;
+  nlohmann::json body = nlohmann::json::object();
+  /// \brief A field of the body.
+  nlohmann::json& operator[](const char* key) { return body[key]; }
+  [[nodiscard]] bool is(const char* t) const { return std::string_view(type) == t; }
+  /// \brief The event as one JSON object.
+  [[nodiscard]] nlohmann::json toJson() const;
+};
 
 /// \brief A flight's persistent state (what a restarted tracker needs to go on).
 struct FlightState {
@@ -91,6 +119,8 @@ class Tracker {
 
   /// \brief Processes one fix; returns its events (the `fix` event last but for a replan).
   [[nodiscard]] std::vector<TrackEvent> process(const TrackFix& fix);
+  /// \brief process() with the events as JSON.
+  [[nodiscard]] std::vector<nlohmann::json> processJson(const TrackFix& fix);
   /// \brief A `rejected_input` event for a record that could not be read.
   [[nodiscard]] TrackEvent rejectedInput(const std::string& source, std::size_t line, const std::string& why) const;
   /// \brief `stale` events for flights silent for stale_after_s before `now` (stream time).

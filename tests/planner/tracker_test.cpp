@@ -103,7 +103,7 @@ TEST_F(TrackerOnExample, FixesOnTheRouteWithSmallPlsAreInsideEveryLevel) {
   tracker.addFlight("F1", example_->flight, example_->approver);
   const ApprovalReport& r = example_->report;
   for (int k = 0; k < 20; ++k) {
-    const auto ev = tracker.process(fixAt(*example_->approver, r.departure.plus(k), along(r, k), 0.5, 0.5, k + 1));
+    const auto ev = tracker.processJson(fixAt(*example_->approver, r.departure.plus(k), along(r, k), 0.5, 0.5, k + 1));
     ASSERT_EQ(ev.size(), 1u) << ev.front().dump();
     const json& fix = ev.back();
     EXPECT_EQ(fix.at("verdict"), "inside");
@@ -122,7 +122,7 @@ TEST_F(TrackerOnExample, OneNoisyFixRaisesAViolationButNoReplan) {
   for (int k = 0; k < 12; ++k) {
     Eigen::Vector3d p = along(r, k);
     if (k == 5) p += 3.0 * side;  // one fix 3 m off the centre line: outside HAL₁ = 1.44 m
-    for (json& e : tracker.process(fixAt(*example_->approver, r.departure.plus(k), p, 0.5, 0.5, k + 1))) all.push_back(e);
+    for (json& e : tracker.processJson(fixAt(*example_->approver, r.departure.plus(k), p, 0.5, 0.5, k + 1))) all.push_back(e);
   }
   const auto violations = ofType(all, "violation");
   ASSERT_EQ(violations.size(), 1u);
@@ -150,7 +150,7 @@ TEST_F(TrackerOnExample, PersistentDriftReplansFromTheVehicleWithACorridorClearO
   for (int k = 0; k < 50 && !replan; ++k) {
     Eigen::Vector3d p = along(r, k);
     if (k >= 40) p += 8.0 * side;
-    for (json& e : tracker.process(fixAt(*example_->approver, r.departure.plus(k), p, 0.5, 0.5, k + 1))) {
+    for (json& e : tracker.processJson(fixAt(*example_->approver, r.departure.plus(k), p, 0.5, 0.5, k + 1))) {
       if (e.at("event") == "replan") {
         replan = e;
         replan_from = p;
@@ -190,7 +190,7 @@ TEST_F(TrackerOnExample, PersistentDriftReplansFromTheVehicleWithACorridorClearO
     }
   }
   // AND the next fix at the drifted place is inside the new corridor
-  const auto next = tracker.process(fixAt(*example_->approver, r.departure.plus(43), replan_from, 0.5, 0.5, 44));
+  const auto next = tracker.processJson(fixAt(*example_->approver, r.departure.plus(43), replan_from, 0.5, 0.5, 44));
   EXPECT_EQ(next.back().at("levels").at("level1").at("verdict"), "inside") << next.back().dump();
   EXPECT_EQ(next.back().at("route_version"), 1);
 }
@@ -212,9 +212,9 @@ TEST_F(TrackerOnExample, ProtectionVolumeTouchingAProhibitedZoneIsReportedAtOnce
     return Eigen::Vector3d(p.x(), p.y(), h);
   };
   // 30 m from the edge with HPL 10 m: clear; the next fix, HPL 40 m: it touches.
-  const auto clear = tracker.process(fixAt(*example_->approver, r.departure.plus(1), at(30.0), 10.0, 5.0, 1));
+  const auto clear = tracker.processJson(fixAt(*example_->approver, r.departure.plus(1), at(30.0), 10.0, 5.0, 1));
   EXPECT_TRUE(ofType(clear, "violation").empty() || ofType(clear, "violation")[0].at("level") != "zone");
-  const auto touch = tracker.process(fixAt(*example_->approver, r.departure.plus(2), at(30.0), 40.0, 5.0, 2));
+  const auto touch = tracker.processJson(fixAt(*example_->approver, r.departure.plus(2), at(30.0), 40.0, 5.0, 2));
   const auto v = ofType(touch, "violation");
   const auto zone = std::find_if(v.begin(), v.end(), [](const json& e) { return e.at("level") == "zone"; });
   ASSERT_NE(zone, v.end());
@@ -233,21 +233,21 @@ TEST_F(TrackerOnExample, BadOrderUnknownFlightsAndStaleFlightsAreReportedAndSkip
   tracker.addFlight("F1", example_->flight, example_->approver);
   const ApprovalReport& r = example_->report;
   const Approver& a = *example_->approver;
-  EXPECT_EQ(ofType(tracker.process(fixAt(a, r.departure.plus(10), along(r, 10), 0.5, 0.5, 1)), "fix").size(), 1u);
-  auto dup = tracker.process(fixAt(a, r.departure.plus(10), along(r, 10), 0.5, 0.5, 2));
+  EXPECT_EQ(ofType(tracker.processJson(fixAt(a, r.departure.plus(10), along(r, 10), 0.5, 0.5, 1)), "fix").size(), 1u);
+  auto dup = tracker.processJson(fixAt(a, r.departure.plus(10), along(r, 10), 0.5, 0.5, 2));
   ASSERT_EQ(dup.size(), 1u);
   EXPECT_EQ(dup[0].at("event"), "rejected_input");
   EXPECT_NE(dup[0].at("error").get<std::string>().find("duplicate time"), std::string::npos);
-  auto back = tracker.process(fixAt(a, r.departure.plus(9), along(r, 9), 0.5, 0.5, 3));
+  auto back = tracker.processJson(fixAt(a, r.departure.plus(9), along(r, 9), 0.5, 0.5, 3));
   EXPECT_NE(back[0].at("error").get<std::string>().find("out of order"), std::string::npos);
-  auto jump = tracker.process(fixAt(a, r.departure.plus(4000), along(r, 20), 0.5, 0.5, 4));
+  auto jump = tracker.processJson(fixAt(a, r.departure.plus(4000), along(r, 20), 0.5, 0.5, 4));
   EXPECT_NE(jump[0].at("error").get<std::string>().find("time jump"), std::string::npos);
   TrackFix stranger = fixAt(a, r.departure.plus(11), along(r, 11), 0.5, 0.5, 5);
   stranger.flight = "F9";
-  auto unknown = tracker.process(stranger);
+  auto unknown = tracker.processJson(stranger);
   EXPECT_NE(unknown[0].at("error").get<std::string>().find("unknown flight \"F9\""), std::string::npos);
   // A 6 s gap: the next fix first reports the flight stale (3 s), then is accepted.
-  auto late = tracker.process(fixAt(a, r.departure.plus(16), along(r, 16), 0.5, 0.5, 6));
+  auto late = tracker.processJson(fixAt(a, r.departure.plus(16), along(r, 16), 0.5, 0.5, 6));
   ASSERT_EQ(ofType(late, "stale").size(), 1u);
   EXPECT_DOUBLE_EQ(ofType(late, "stale")[0].at("gap_s").get<double>(), 6.0);
   EXPECT_EQ(ofType(late, "fix").size(), 1u);
@@ -295,7 +295,7 @@ TEST_F(TrackerOnExample, NmeaAndJsonLinesGiveTheSameVerdicts) {
     const Eigen::Vector3d p = along(r, 2 * k) + off * side;
     const maps::GpsTime t = r.departure.plus(2 * k);
     TrackFix jf = fixAt(*example_->approver, t, p, k_h * sigma_h, k_v * sigma_v, static_cast<std::size_t>(k + 1));
-    for (const json& e : a.process(jf)) {
+    for (const json& e : a.processJson(jf)) {
       if (e.at("event") == "fix") va.push_back(e);
     }
     const maps::CalendarTime c = maps::utcFromGps(t);
@@ -314,14 +314,14 @@ TEST_F(TrackerOnExample, NmeaAndJsonLinesGiveTheSameVerdicts) {
     const std::string rmc = nmeaChecksummed("GPRMC," + std::string(hms) + ",A,4722.0000,N,00832.0000,E,0.0,0.0," + rmc_date + ",,,A");
     for (const std::string& s : {rmc, gga, nmeaChecksummed(gst)}) {
       if (auto nf = asm2.add(integrity::parseNmeaSentence(s, "fixes.nmea"))) {
-        for (const json& e : b.process(trackFixFromNmea(*nf, "fixes.nmea"))) {
+        for (const json& e : b.processJson(trackFixFromNmea(*nf, "fixes.nmea"))) {
           if (e.at("event") == "fix") vb.push_back(e);
         }
       }
     }
   }
   if (auto nf = asm2.flush()) {
-    for (const json& e : b.process(trackFixFromNmea(*nf, "fixes.nmea"))) {
+    for (const json& e : b.processJson(trackFixFromNmea(*nf, "fixes.nmea"))) {
       if (e.at("event") == "fix") vb.push_back(e);
     }
   }
@@ -396,7 +396,7 @@ TEST(TrackerRaw, SatelliteFaultIsExcludedByTheRerunAndTheFlightRecoversWithoutAR
     }
     f.pl_source = PlSource::kRaw;
     f.line = ++line;
-    const auto ev = tracker.process(f);
+    const auto ev = tracker.processJson(f);
     ASSERT_FALSE(ev.empty());
     const json& fix = ev.back();
     ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
