@@ -28,10 +28,10 @@ struct ApproveOptions {
   bool progress = false;
 };
 
-std::string mapSvg(const planner::ApprovalReport& r, const planner::Approver& a) {
-  const maps::PlaneFrame& frame = a.frame();
+}  // namespace
+
+std::vector<MapShape> obstructionShapes(const geofence::Obstructions& ob, const maps::PlaneFrame& frame) {
   std::vector<MapShape> shapes;
-  const geofence::Obstructions& ob = a.obstructions();
   for (std::size_t i = 0; i < ob.zones().size(); ++i) {
     const airspace::Zone& z = ob.zones()[i];
     const bool counted = ob.zoneCounts(i);
@@ -72,6 +72,14 @@ std::string mapSvg(const planner::ApprovalReport& r, const planner::Approver& a)
     sh.legend = "building";
     shapes.push_back(std::move(sh));
   }
+  return shapes;
+}
+
+namespace {
+
+std::string mapSvg(const planner::ApprovalReport& r, const planner::Approver& a) {
+  const maps::PlaneFrame& frame = a.frame();
+  std::vector<MapShape> shapes = obstructionShapes(a.obstructions(), frame);
   for (int level : {2, 1}) {
     const double hal = level == 1 ? r.limits.level1.hal_m : r.limits.level2.hal_m;
     for (std::size_t i = 1; i < r.route.size(); ++i) {

@@ -1,10 +1,14 @@
 #include "cli/track_commands.hpp"
 
+#include "cli/approve_commands.hpp"
+#include "cli/svg_plot.hpp"
+
 #include "integrity/gnss/nmea.hpp"
 #include "integrity/gnss/rinex_nav.hpp"
 #include "integrity/gnss/rinex_obs.hpp"
 #include "integrity/raim/spp.hpp"
 #include "maps/parse_error.hpp"
+#include "planner/report_formats.hpp"
 #include "planner/tracking/track_store.hpp"
 #include "planner/tracking/tracker.hpp"
 
@@ -52,6 +56,116 @@ struct TrackOptions {
   bool replan_on_pl = false;
   int batch = 200;
   double horizon_m = 50.0;
+  std::string map;
+};
+
+/// What the map of a run shows: each flight's routes (the approved one and every accepted
+/// replan), its track coloured by verdict, and the events that matter.
+class TrackMap {
+ public:
+  void route(const std::string& flight, const std::vector<Eigen::Vector2d>& lat_lon_rad) { routes_[flight].push_back(lat_lon_rad); }
+  void add(const planner::TrackEvent& e) {
+    if (e.fix) {
+      tracks_[e.flight].push_back({e.fix->lat_rad, e.fix->lon_rad, static_cast<int>(e.fix->verdict.verdict)});
+      return;
+    }
+    if (!e.time || e.flight.empty()) return;
+    if (e.is("replan") && e.body.value("decision", "") == "approved") {
+      std::vector<Eigen::Vector2d> pts;
+      for (const json& p : e.body.at("report").at("route")) {
+        pts.emplace_back(maps::deg2rad(p.at("lat").get<double>()), maps::deg2rad(p.at("lon").get<double>()));
+      }
+      route(e.flight, pts);
+      marks_.push_back({pts.front(), "replan " + std::to_string(e.body.value("route_version", 0)) + " (" +
+                                         e.body.value("trigger", "") + ")", "#9467bd"});
+    } else if (e.is("violation") && !tracks_[e.flight].empty()) {
+      const auto& last = tracks_[e.flight].back();
+      const std::string cause = e.body.value("cause", e.body.value("subject", ""));
+      marks_.push_back({{last.lat, last.lon}, e.body.value("level", "") + " (" + cause + ")", "#d62728"});
+    } else if (e.is("monitoring_rerun") && !e.body.at("excluded").empty() && reruns_++ == 0 && !tracks_[e.flight].empty()) {
+      const auto& last = tracks_[e.flight].back();
+      marks_.push_back({{last.lat, last.lon}, "rerun: excluded " + e.body.at("excluded")[0].get<std::string>(), "#17becf"});
+    }
+  }
+  std::string svg(const planner::Tracker& tracker) const {
+    const std::string first = tracker.flights().front();
+    const planner::Approver& a = tracker.approver(first);
+    const maps::PlaneFrame& frame = a.frame();
+    auto plane = [&frame](const Eigen::Vector2d& ll) {
+      const Eigen::Vector2d q = frame.toPlane(ll.x(), ll.y());
+      return std::pair<double, double>(q.x(), q.y());
+    };
+    std::vector<MapShape> shapes = obstructionShapes(a.obstructions(), frame);
+    std::vector<MapLine> lines;
+    for (const auto& [flight, versions] : routes_) {
+      const planner::Mission& m = tracker.approver(flight).mission();
+      const geofence::LevelLimits lim = geofence::alertLimits(m.vehicle, m.levels);
+      // Replanned routes first, the approved one drawn over them (they share their first part).
+      std::vector<std::size_t> order;
+      for (std::size_t v = 1; v < versions.size(); ++v) order.push_back(v);
+      order.push_back(0);
+      for (std::size_t v : order) {
+        MapLine l;
+        l.stroke = v == 0 ? "#000000" : "#9467bd";
+        l.width_px = v == 0 ? 1.5 : 3.0;
+        l.legend = v == 0 ? "approved route" : "replanned route";
+        for (const Eigen::Vector2d& ll : versions[v]) l.xy.push_back(plane(ll));
+        for (std::size_t i = 1; i < l.xy.size(); ++i) {
+          const Eigen::Vector3d p0(l.xy[i - 1].first, l.xy[i - 1].second, 0), p1(l.xy[i].first, l.xy[i].second, 0);
+          for (int level : {2, 1}) {
+            MapShape box;
+            const double hal = level == 1 ? lim.level1.hal_m : lim.level2.hal_m;
+            for (const Eigen::Vector2d& c : planner::segmentOutline(p0, p1, hal)) box.xy.emplace_back(c.x(), c.y());
+            box.fill = box.stroke = v == 0 ? (level == 1 ? "#1f77b4" : "#aec7e8") : (level == 1 ? "#9467bd" : "#c5b0d5");
+            box.fill_opacity = level == 1 ? 0.5 : 0.12;
+            box.legend = std::string(v == 0 ? "" : "new ") + (level == 1 ? "corridor (level 1)" : "airspace (level 2)");
+            shapes.push_back(std::move(box));
+          }
+        }
+        lines.push_back(std::move(l));
+      }
+    }
+    static const char* kColour[] = {"#2ca02c", "#d62728", "#ff7f0e"};
+    static const char* kLegend[] = {"track: inside", "track: outside", "track: indeterminate"};
+    for (const auto& [flight, pts] : tracks_) {
+      for (std::size_t i = 0; i < pts.size();) {
+        MapLine l;
+        l.stroke = kColour[pts[i].verdict];
+        l.legend = kLegend[pts[i].verdict];
+        l.width_px = 3.0;
+        if (i > 0) l.xy.push_back(plane({pts[i - 1].lat, pts[i - 1].lon}));
+        std::size_t j = i;
+        for (; j < pts.size() && pts[j].verdict == pts[i].verdict; ++j) l.xy.push_back(plane({pts[j].lat, pts[j].lon}));
+        lines.push_back(std::move(l));
+        i = j;
+      }
+    }
+    std::vector<MapMarker> markers;
+    for (const Mark& m : marks_) {
+      const auto [x, y] = plane(m.lat_lon);
+      markers.push_back({x, y, m.label, m.colour});
+    }
+    std::size_t fixes = 0;
+    for (const auto& [flight, pts] : tracks_) fixes += pts.size();
+    return renderPlanMapSvg("skylane track: " + std::to_string(tracks_.size()) + " flight(s), " + std::to_string(fixes) + " fixes",
+                            shapes, lines, markers, 150.0,
+                            {"track coloured by the fix verdict (corridor, airspace, zones, obstacles)",
+                             "purple: replans from where the vehicle was; red: violations"});
+  }
+
+ private:
+  struct Point {
+    double lat, lon;
+    int verdict;
+  };
+  struct Mark {
+    Eigen::Vector2d lat_lon;
+    std::string label, colour;
+  };
+  std::map<std::string, std::vector<std::vector<Eigen::Vector2d>>> routes_;
+  std::map<std::string, std::vector<Point>> tracks_;
+  std::vector<Mark> marks_;
+  int reruns_ = 0;
 };
 
 std::pair<int, int> parseMofN(const std::string& text, const char* option) {
@@ -182,6 +296,15 @@ void runTrack(const TrackOptions& o) {
     const std::string got = tracker.addApprovalFile(path, id);
     report_of[got] = path;
   }
+  TrackMap track_map;
+  for (const std::string& id : tracker.flights()) {
+    std::vector<Eigen::Vector2d> pts;
+    const json route = tracker.routeJson(id);  // named: a range over a temporary's member dangles
+    for (const json& p : route.at("route")) {
+      pts.emplace_back(maps::deg2rad(p.at("lat").get<double>()), maps::deg2rad(p.at("lon").get<double>()));
+    }
+    track_map.route(id, pts);
+  }
   if (tracker.flights().empty()) throw ParseError("--approval", 0, "--approval", "", "at least one approval report");
   if ((o.format == "nmea" || o.format == "rinex") && tracker.flights().size() != 1) {
     throw ParseError("--format", 0, "--format", o.format, "one approval (an NMEA or RINEX stream is one vehicle)");
@@ -204,6 +327,7 @@ void runTrack(const TrackOptions& o) {
       if (e.is("rejected_input")) ++rejected;
       if (e.is("fix")) ++accepted;
       if (store) store->appendEvent(j);
+      if (!o.map.empty()) track_map.add(e);
     }
   };
   int pending = 0;
@@ -249,7 +373,12 @@ void runTrack(const TrackOptions& o) {
     const integrity::ObservationData obs = integrity::loadRinexObs(o.input);
     integrity::NavigationData nav;
     for (const std::string& n : o.navs) nav.merge(integrity::loadRinexNav(n));
+    // The mission's integrity method, mask and error model, as for its approval.
+    const planner::Mission& m = tracker.approver(tracker.onlyFlight()).mission();
     integrity::SppConfig cfg;
+    cfg.method = m.method;
+    cfg.model = m.model;
+    cfg.elevation_mask_rad = maps::deg2rad(m.mask_deg);
     std::optional<Eigen::Vector3d> prior = obs.approx_position_ecef;
     for (const integrity::ObservationEpoch& ep : obs.epochs) {
       if (g_stop) break;
@@ -354,6 +483,10 @@ void runTrack(const TrackOptions& o) {
   if (tracker.streamTime()) emit(tracker.sweepStale(*tracker.streamTime()));
   checkpoint(true);
   out.flush();
+  if (!o.map.empty()) {
+    std::ofstream(o.map) << track_map.svg(tracker);
+    std::cerr << "skylane: track: wrote " << o.map << "\n";
+  }
   std::cerr << "skylane: track: " << accepted << " fix" << (accepted == 1 ? "" : "es") << " accepted, " << rejected
             << " rejected, " << events << " events" << (g_stop ? " (stopped by a signal; state saved)" : "") << "\n";
 }
@@ -381,6 +514,7 @@ void addTrackCommands(CLI::App& app) {
   c->add_flag("--no-replan", o->no_replan, "report violations without replanning");
   c->add_flag("--replan-on-pl", o->replan_on_pl, "also replan when level 1 is violated by the PLs alone");
   c->add_option("--horizon", o->horizon_m, "list zones and obstacles within this distance of a volume in its fix event [m] (default 50)");
+  c->add_option("--map", o->map, "write an SVG map: zones, buildings, routes and corridors (approved and replanned), the track by verdict, events");
   c->add_option("--batch", o->batch, "fixes per database transaction (default 200)");
   c->callback([o]() { runTrack(*o); });
 }

@@ -54,3 +54,18 @@ python3 -c 'import json; j=json.load(open("examples/out/approve/report.json")); 
 echo "--- a mission that is rejected (examples/out/approve_rejected/):"
 ./build/skylane approve examples/approve/mission_rejected.json --out examples/out/approve_rejected > /dev/null || true
 python3 -c 'import json; j=json.load(open("examples/out/approve_rejected/report.json")); print(j["decision"], "-", j["reasons"][0]["message"])'
+echo "--- live corridor tracking of the approved flight (examples/out/track/: events.jsonl, track.svg, track.sqlite):"
+mkdir -p examples/out/track
+rm -f examples/out/track/track.sqlite*
+python3 examples/track/make_fixes.py examples/out/approve/report.json examples/out/track
+./build/skylane track --approval zrh=examples/out/approve/report.json --input examples/out/track/fixes.jsonl \
+  --db examples/out/track/track.sqlite --map examples/out/track/track.svg > examples/out/track/events.jsonl 2> examples/out/track/stderr.txt
+tail -1 examples/out/track/stderr.txt
+python3 -c 'import json
+for l in open("examples/out/track/events.jsonl"):
+    e = json.loads(l)
+    if e["event"] == "fix": continue
+    print(" ", e["event"], "line", e.get("line", "-"), e.get("level", e.get("trigger", "")), e.get("cause", e.get("decision", "")), (e.get("error") or "")[:70])'
+./build/skylane track --approval zrh=examples/out/approve/report.json --format nmea --input examples/out/track/fixes.nmea \
+  > examples/out/track/events_nmea.jsonl 2> /dev/null
+echo "  NMEA (GGA + GST + RMC) replay: $(grep -c '"verdict":"inside"' examples/out/track/events_nmea.jsonl) of $(wc -l < examples/out/track/events_nmea.jsonl) fixes inside"

@@ -133,6 +133,8 @@ std::string Tracker::onlyFlight() const { return flights_.size() == 1 ? flights_
 
 const FlightState& Tracker::state(const std::string& id) const { return flights_.at(id)->st; }
 
+const Approver& Tracker::approver(const std::string& id) const { return *flights_.at(id)->approver; }
+
 json Tracker::routeJson(const std::string& id) const {
   const Flight& f = *flights_.at(id);
   json route = json::array();
@@ -378,9 +380,12 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   const bool bad1 = lv[0] != geofence::Verdict::kInside;
   const bool bad2 = lv[1] != geofence::Verdict::kInside || lv[2] != geofence::Verdict::kInside ||
                     lv[3] != geofence::Verdict::kInside;
-  const int count1 = pushWindow(st.level1_window, bad1, options_.level1_n);
-  const int count2 = pushWindow(st.level2_window, bad2, options_.level2_n);
   const bool pl_cause = *hpl > f.plan.level1.hal_m || *vpl > f.plan.level1.val_m;
+  // The level-1 window counts the violations a replan can mend (by the position; also by the
+  // PLs with replan_on_pl_exceedance), so PL excursions do not make a drift look persistent.
+  const bool mendable1 = bad1 && (!pl_cause || options_.replan_on_pl_exceedance);
+  const int count1 = pushWindow(st.level1_window, mendable1, options_.level1_n);
+  const int count2 = pushWindow(st.level2_window, bad2, options_.level2_n);
   std::optional<geofence::Level> trigger;
   for (int l = 0; l < kLevels; ++l) {
     const auto level = static_cast<geofence::Level>(l);
@@ -422,7 +427,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
     trigger = lv[1] != geofence::Verdict::kInside ? geofence::Level::kAirspace
               : lv[2] != geofence::Verdict::kInside ? geofence::Level::kZone
                                                     : geofence::Level::kObstacle;
-  } else if (count1 >= options_.level1_m && bad1 && (!pl_cause || options_.replan_on_pl_exceedance)) {
+  } else if (count1 >= options_.level1_m && mendable1) {
     trigger = geofence::Level::kCorridor;
   }
 
@@ -471,11 +476,10 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       f.plan.departure = r.departure;
       f.buildBoxes();
       ++st.route_version;
-      // The new corridor starts with a clean record: its violations are reported anew.
+      // The new corridor starts with empty persistence windows; a level still marked violated
+      // is `recovered` once the fixes are inside the new boxes.
       st.level1_window.clear();
       st.level2_window.clear();
-      st.violated.fill(false);
-      st.inside_streak.fill(0);
     }
     rp["route_version"] = st.route_version;
     rp["planning_time_s"] = std::round(r.elapsed_s * 1e4) / 1e4;

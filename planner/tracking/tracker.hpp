@@ -17,8 +17,8 @@
 ///    remaining geometry, the check again; the fix's verdict is the rerun's.
 /// 5. Persistence: a level counts as violated in a fix when its check is not inside
 ///    (indeterminate counts). Level 1 is persistent when violated in ≥ level1_m of the last
-///    level1_n fixes; level 2, zones and obstacles with level2_m of level2_n (default 1 of 1:
-///    at once). A `violation` event marks a level's first violated fix; `recovered` follows
+///    level1_n fixes by a cause a replan can mend (step 6); level 2, zones and obstacles with
+///    level2_m of level2_n (default 1 of 1: at once). A `violation` event marks a level's first violated fix; `recovered` follows
 ///    `recover_after` fixes in a row inside it.
 /// 6. Replan from the vehicle's estimated position (Approver::replanFrom) when level 2, a zone or
 ///    an obstacle is persistently violated, or level 1 is persistently violated because of the
@@ -134,6 +134,8 @@ class Tracker {
   [[nodiscard]] const FlightState& state(const std::string& id) const;
   [[nodiscard]] nlohmann::json routeJson(const std::string& id) const;
   void restore(const std::string& id, const FlightState& state, const nlohmann::json& route);
+  /// \brief The approver (mission, map frame, zones and obstacles) of a flight.
+  [[nodiscard]] const Approver& approver(const std::string& id) const;
   /// \brief The latest fix time over all flights (stream time).
   [[nodiscard]] std::optional<maps::GpsTime> streamTime() const { return stream_time_; }
   [[nodiscard]] const TrackerOptions& options() const { return options_; }

@@ -117,9 +117,14 @@ TEST_F(TrackCli, GarbageAndTruncatedLinesAreReportedAndEveryGoodFixIsChecked) {
     }
   }
   f.close();
-  const RunResult r = sh(kBin + " track --approval " + approval() + " --input " + in + " --no-replan > " + *dir_ +
-                         "/mixed_events.jsonl 2> " + *dir_ + "/mixed_err.txt");
+  const RunResult r = sh(kBin + " track --approval " + approval() + " --input " + in + " --no-replan --map " + *dir_ +
+                         "/mixed.svg > " + *dir_ + "/mixed_events.jsonl 2> " + *dir_ + "/mixed_err.txt");
   ASSERT_EQ(r.status, 0) << r.out;
+  std::ifstream svg(*dir_ + "/mixed.svg");
+  const std::string map((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
+  for (const char* legend : {"approved route", "corridor (level 1)", "airspace (level 2)", "track: inside", "40 fixes"}) {
+    EXPECT_NE(map.find(legend), std::string::npos) << legend;
+  }
   const auto events = readEvents(*dir_ + "/mixed_events.jsonl");
   EXPECT_EQ(ofType(events, "fix").size(), 40u);
   std::set<int> rejected;
