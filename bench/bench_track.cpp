@@ -236,7 +236,7 @@ void BM_TrackJsonLine(benchmark::State& state) {
     planner::TrackFix fix = planner::parseTrackFixJson(json::parse(c.lines[k]), source);
     fix.line = k + 1;
     std::vector<planner::TrackEvent> ev = t.process(fix);
-    for (const planner::TrackEvent& e : ev) out_bytes += e.toJson().dump().size();
+    for (const planner::TrackEvent& e : ev) out_bytes += e.jsonLine().size();
     return ev;
   });
   const double lines = std::max<double>(1.0, static_cast<double>(state.iterations()));

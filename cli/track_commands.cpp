@@ -320,13 +320,13 @@ void runTrack(const TrackOptions& o) {
   const std::size_t resume_line = store && o.input != "-" ? store->inputLine(o.input) : 0;
   auto emit = [&](const std::vector<planner::TrackEvent>& evs) {
     for (const planner::TrackEvent& e : evs) {
-      const json j = e.toJson();
       // Quoted input may hold bytes that are not UTF-8: they are replaced, not fatal.
-      out << j.dump(-1, ' ', false, json::error_handler_t::replace) << "\n";
+      const std::string line = e.jsonLine();
+      out << line << '\n';
       ++events;
       if (e.is("rejected_input")) ++rejected;
       if (e.is("fix")) ++accepted;
-      if (store) store->appendEvent(j);
+      if (store) store->appendEvent(e.type, e.flight, e.time ? maps::formatRfc3339(*e.time, 3) : std::string(), line);
       if (!o.map.empty()) track_map.add(e);
     }
   };

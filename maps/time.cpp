@@ -1,5 +1,6 @@
 #include "maps/time.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cmath>
@@ -31,12 +32,17 @@ double utcSecondsSinceGpsEpoch(const CalendarTime& c) {
 }
 
 int leapSecondsAtUtc(double utc_s) {
-  int offset = 0;
-  for (const LeapEntry& e : kLeapTable) {
-    if (utc_s >= utcSecondsSinceGpsEpoch({e.year, e.month, e.day, 0, 0, 0.0})) {
-      offset = e.gps_minus_utc_s;
+  // The table's instants in seconds, computed once (every time conversion asks).
+  static const std::array<double, kLeapTable.size()> kStarts = [] {
+    std::array<double, kLeapTable.size()> out{};
+    for (std::size_t i = 0; i < kLeapTable.size(); ++i) {
+      const LeapEntry& e = kLeapTable[i];
+      out[i] = utcSecondsSinceGpsEpoch({e.year, e.month, e.day, 0, 0, 0.0});
     }
-  }
+    return out;
+  }();
+  int offset = 0;
+  for (std::size_t i = 0; i < kLeapTable.size() && utc_s >= kStarts[i]; ++i) offset = kLeapTable[i].gps_minus_utc_s;
   return offset;
 }
 
@@ -164,20 +170,40 @@ std::optional<GpsTime> parseRfc3339(const std::string& text) {
 }
 
 std::string formatRfc3339(const GpsTime& t, int fraction_digits) {
-  const double scale = std::pow(10.0, fraction_digits);
+  const int digits = std::clamp(fraction_digits, 0, 9);
+  long long unit = 1;
+  for (int i = 0; i < digits; ++i) unit *= 10;
+  const double scale = static_cast<double>(unit);
   // Round once in seconds so that 59.9996 does not print as 60.000.
-  const double utc_s =
-      std::round((t.totalSeconds() - leapSecondsAtGps(t)) * scale) / scale;
+  const double utc_s = std::round((t.totalSeconds() - leapSecondsAtGps(t)) * scale) / scale;
   const CalendarTime c = calendarFromSeconds(utc_s);
-  char buf[64];
-  if (fraction_digits <= 0) {
-    std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02dZ", c.year, c.month, c.day, c.hour,
-                  c.minute, static_cast<int>(std::lround(c.second) % 60));
-  } else {
-    std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%0*.*fZ", c.year, c.month, c.day,
-                  c.hour, c.minute, fraction_digits + 3, fraction_digits, c.second);
+  // Digits written by hand: snprintf's "%0*.*f" was a third of the time of a tracker's fix event.
+  const long long units = std::llround(c.second * scale);
+  const long long whole = (units / unit) % 60;
+  long long frac = units % unit;
+  char buf[40];
+  char* p = buf;
+  auto put = [&p](long long v, int width) {
+    for (int i = width - 1; i >= 0; --i, v /= 10) p[i] = static_cast<char>('0' + v % 10);
+    p += width;
+  };
+  put(c.year, 4);
+  *p++ = '-';
+  put(c.month, 2);
+  *p++ = '-';
+  put(c.day, 2);
+  *p++ = 'T';
+  put(c.hour, 2);
+  *p++ = ':';
+  put(c.minute, 2);
+  *p++ = ':';
+  put(whole, 2);
+  if (digits > 0) {
+    *p++ = '.';
+    put(frac, digits);
   }
-  return buf;
+  *p++ = 'Z';
+  return std::string(buf, p);
 }
 
 std::optional<double> parseDuration(const std::string& text) {

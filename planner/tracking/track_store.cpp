@@ -123,12 +123,13 @@ void TrackStore::putFlight(const StoredFlight& f) {
   if (sqlite3_step(put_flight_) != SQLITE_DONE) fail("cannot store flight " + f.id);
 }
 
-void TrackStore::appendEvent(const nlohmann::json& e) {
+void TrackStore::appendEvent(const std::string& type, const std::string& flight, const std::string& time,
+                             const std::string& line) {
   sqlite3_reset(put_event_);
-  bindText(put_event_, 1, e.value("flight", std::string()));
-  bindText(put_event_, 2, e.value("time", std::string()));
-  bindText(put_event_, 3, e.value("event", std::string("?")));
-  bindText(put_event_, 4, e.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+  bindText(put_event_, 1, flight);
+  bindText(put_event_, 2, time);
+  bindText(put_event_, 3, type);
+  bindText(put_event_, 4, line);
   if (sqlite3_step(put_event_) != SQLITE_DONE) fail("cannot store an event");
 }
 

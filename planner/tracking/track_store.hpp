@@ -47,7 +47,8 @@ class TrackStore {
   /// \brief Starts a batch (a transaction); the writes below join it.
   void begin();
   void putFlight(const StoredFlight& f);
-  void appendEvent(const nlohmann::json& event);
+  /// \brief An event as written to the stream (one JSON line) with its type, flight and time.
+  void appendEvent(const std::string& type, const std::string& flight, const std::string& time, const std::string& line);
   void setInputLine(const std::string& name, std::size_t line);
   /// \brief Commits the batch.
   void commit();

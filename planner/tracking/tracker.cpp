@@ -7,6 +7,8 @@
 #include "maps/text_file.hpp"
 
 #include <algorithm>
+#include <charconv>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
@@ -219,6 +221,198 @@ json TrackEvent::toJson() const {
   if (f.rerun) j["rerun"] = true;
   if (!f.note.empty()) j["note"] = f.note;
   return j;
+}
+
+namespace {
+
+/// A JSON writer for the fix event: members in nlohmann's (sorted) order, numbers shortest
+/// round-trip (std::to_chars), ±∞ and NaN as null, strings escaped per RFC 8259 §7.
+class LineWriter {
+ public:
+  explicit LineWriter(std::string& out) : s_(out) {}
+  void key(const char* k) {
+    if (need_comma_) s_ += ',';
+    s_ += '"';
+    s_ += k;
+    s_ += "\":";
+    need_comma_ = false;
+  }
+  void open(char c) {
+    s_ += c;
+    need_comma_ = false;
+  }
+  void close(char c) {
+    s_ += c;
+    need_comma_ = true;
+  }
+  void item() {
+    if (need_comma_) s_ += ',';
+    need_comma_ = false;
+  }
+  void number(double v) {
+    if (!std::isfinite(v)) {
+      s_ += "null";
+    } else {
+      char buf[32];
+      const auto r = std::to_chars(buf, buf + sizeof buf, v);
+      s_.append(buf, r.ptr);
+    }
+    need_comma_ = true;
+  }
+  void integer(long long v) {
+    char buf[24];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    s_.append(buf, r.ptr);
+    need_comma_ = true;
+  }
+  void boolean(bool v) {
+    s_ += v ? "true" : "false";
+    need_comma_ = true;
+  }
+  void null() {
+    s_ += "null";
+    need_comma_ = true;
+  }
+  void string(std::string_view v) {
+    s_ += '"';
+    for (const char ch : v) {
+      const auto c = static_cast<unsigned char>(ch);
+      if (c == '"' || c == '\\') {
+        s_ += '\\';
+        s_ += ch;
+      } else if (c < 0x20) {
+        char buf[8];
+        std::snprintf(buf, sizeof buf, "\\u%04x", c);
+        s_ += buf;
+      } else {
+        s_ += ch;
+      }
+    }
+    s_ += '"';
+    need_comma_ = true;
+  }
+  void metres(double v) { number(std::isfinite(v) ? roundMm(v) : v); }
+
+ private:
+  std::string& s_;
+  bool need_comma_ = false;
+};
+
+/// Whether the text is UTF-8 by its byte pattern (RFC 3629 §3; overlong forms not checked),
+/// so it can be written as it is.
+bool validUtf8(std::string_view v) {
+  std::size_t i = 0;
+  while (i < v.size()) {
+    const auto c = static_cast<unsigned char>(v[i]);
+    std::size_t n = 0;
+    if (c < 0x80) n = 0;
+    else if ((c >> 5) == 0x6) n = 1;
+    else if ((c >> 4) == 0xE) n = 2;
+    else if ((c >> 3) == 0x1E) n = 3;
+    else return false;
+    if (i + n >= v.size()) return false;
+    for (std::size_t k = 1; k <= n; ++k) {
+      if ((static_cast<unsigned char>(v[i + k]) >> 6) != 0x2) return false;
+    }
+    i += n + 1;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::string TrackEvent::jsonLine() const {
+  const bool plain = fix && validUtf8(flight) && validUtf8(fix->note) &&
+                     std::all_of(fix->verdict.checks.begin(), fix->verdict.checks.end(),
+                                 [](const geofence::Check& c) { return validUtf8(c.subject); });
+  if (!plain) return toJson().dump(-1, ' ', false, json::error_handler_t::replace);
+  const FixRecord& f = *fix;
+  std::string out;
+  out.reserve(512);
+  LineWriter w(out);
+  w.open('{');
+  w.key("event");
+  w.string(type);
+  if (f.fault_detected) {
+    w.key("fault_detected");
+    w.boolean(*f.fault_detected);
+  }
+  if (!flight.empty()) {
+    w.key("flight");
+    w.string(flight);
+  }
+  w.key("h_ell_m");
+  w.number(roundMm(f.h_ell_m));
+  w.key("hpl_m");
+  w.metres(f.hpl_m);
+  w.key("lat");
+  w.number(roundDeg(f.lat_rad));
+  w.key("levels");
+  w.open('{');
+  for (const geofence::Check& c : f.verdict.checks) {
+    if (c.level != geofence::Level::kCorridor && c.level != geofence::Level::kAirspace) continue;
+    w.key(geofence::levelName(c.level));
+    w.open('{');
+    w.key("margin_h_m");
+    w.metres(c.margin_h_m);
+    w.key("margin_v_m");
+    w.metres(c.margin_v_m);
+    w.key("segment");
+    w.integer(static_cast<long long>(c.index));
+    w.key("verdict");
+    w.string(geofence::verdictName(c.verdict));
+    w.close('}');
+  }
+  w.close('}');
+  w.key("line");
+  w.integer(static_cast<long long>(f.line));
+  w.key("lon");
+  w.number(roundDeg(f.lon_rad));
+  w.key("near");
+  w.open('[');
+  for (const geofence::Check& c : f.verdict.checks) {
+    if (c.level == geofence::Level::kCorridor || c.level == geofence::Level::kAirspace) continue;
+    w.item();
+    w.open('{');
+    w.key("clearance_m");
+    w.metres(c.clearance_m.value_or(0.0));
+    w.key("level");
+    w.string(geofence::levelName(c.level));
+    w.key("subject");
+    w.string(c.subject);
+    w.key("verdict");
+    w.string(geofence::verdictName(c.verdict));
+    w.close('}');
+  }
+  w.close(']');
+  if (!f.note.empty()) {
+    w.key("note");
+    w.string(f.note);
+  }
+  w.key("pl_source");
+  w.string(plSourceName(f.pl_source));
+  if (f.rerun) {
+    w.key("rerun");
+    w.boolean(true);
+  }
+  w.key("route_version");
+  w.integer(f.route_version);
+  if (time) {
+    w.key("time");
+    w.string(maps::formatRfc3339(*time, 3));
+  }
+  w.key("verdict");
+  w.string(geofence::verdictName(f.verdict.verdict));
+  w.key("violated");
+  if (f.verdict.violated) {
+    w.string(geofence::levelName(*f.verdict.violated));
+  } else {
+    w.null();
+  }
+  w.key("vpl_m");
+  w.metres(f.vpl_m);
+  w.close('}');
+  return out;
 }
 
 std::vector<json> Tracker::processJson(const TrackFix& fix) {

@@ -83,6 +83,9 @@ struct TrackEvent {
   [[nodiscard]] bool is(const char* t) const { return std::string_view(type) == t; }
   /// \brief The event as one JSON object.
   [[nodiscard]] nlohmann::json toJson() const;
+  /// \brief toJson() written on one line, without building the object for a `fix` event (the
+  /// stream's hot path; the same members and numbers). Bytes that are not UTF-8 are replaced.
+  [[nodiscard]] std::string jsonLine() const;
 };
 
 /// \brief A flight's persistent state (what a restarted tracker needs to go on).

@@ -49,6 +49,15 @@ TEST(GnssTime, Rfc3339RoundTripAndOffsets) {
   }
 }
 
+TEST(GnssTime, Rfc3339FractionsRoundOnceAndCarryIntoTheMinute) {
+  const GpsTime t = parseRfc3339("2016-12-31T23:59:59.9996Z").value();
+  EXPECT_EQ(formatRfc3339(t, 3), "2017-01-01T00:00:00.000Z");  // rounded up across the year (and a leap second table row)
+  EXPECT_EQ(formatRfc3339(t, 4), "2016-12-31T23:59:59.9996Z");
+  EXPECT_EQ(formatRfc3339(t, 1), "2017-01-01T00:00:00.0Z");
+  EXPECT_EQ(formatRfc3339(parseRfc3339("2005-04-02T00:00:07.05Z").value(), 1), "2005-04-02T00:00:07.1Z");
+  EXPECT_EQ(formatRfc3339(parseRfc3339("2005-04-02T09:08:07.123456789Z").value(), 6), "2005-04-02T09:08:07.123457Z");
+}
+
 TEST(GnssTime, DurationsParseUnits) {
   EXPECT_DOUBLE_EQ(parseDuration("24h").value(), 86400.0);
   EXPECT_DOUBLE_EQ(parseDuration("10m").value(), 600.0);

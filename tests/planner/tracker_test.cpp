@@ -113,6 +113,29 @@ TEST_F(TrackerOnExample, FixesOnTheRouteWithSmallPlsAreInsideEveryLevel) {
   }
 }
 
+TEST_F(TrackerOnExample, JsonLineWritesTheSameEventAsTheJsonObject) {
+  // GIVEN fixes inside, outside, near zones, and one whose note and flight need escaping
+  TrackerOptions opt;
+  opt.replan = false;
+  opt.horizon_m = 500.0;
+  Tracker tracker(opt);
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  tracker.addFlight("quote\"and\\back\tslash", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  const Eigen::Vector3d side = acrossFirstSegment(r);
+  int fixes = 0;
+  for (int k = 0; k < 60; ++k) {
+    TrackFix f = fixAt(*example_->approver, r.departure.plus(k), along(r, 2 * k) + (k % 4) * side, 0.3 + 0.1 * (k % 7), 0.4, k + 1);
+    if (k % 3 == 0) f.flight = "quote\"and\\back\tslash";
+    for (const TrackEvent& e : tracker.process(f)) {
+      // THEN the line parses to the very object toJson builds (members, numbers, nulls)
+      EXPECT_EQ(json::parse(e.jsonLine()), e.toJson()) << e.jsonLine();
+      fixes += e.is("fix");
+    }
+  }
+  EXPECT_EQ(fixes, 60);
+}
+
 TEST_F(TrackerOnExample, OneNoisyFixRaisesAViolationButNoReplan) {
   Tracker tracker;  // level 1: 3 of 5
   tracker.addFlight("F1", example_->flight, example_->approver);
