@@ -244,19 +244,6 @@ void BM_TrackJsonLine(benchmark::State& state) {
 }
 BENCHMARK(BM_TrackJsonLine)->Unit(benchmark::kMicrosecond)->MinTime(2.0);
 
-/// The map-frame position of a route at `t_s` after departure (clamped to its ends).
-Eigen::Vector3d routeAt(const std::vector<planner::RoutePoint>& route, double t_s) {
-  if (t_s <= route.front().eta_s) return route.front().xyz;
-  for (std::size_t i = 1; i < route.size(); ++i) {
-    if (t_s <= route[i].eta_s) {
-      const double span = route[i].eta_s - route[i - 1].eta_s;
-      const double w = span > 0 ? (t_s - route[i - 1].eta_s) / span : 1.0;
-      return route[i - 1].xyz + w * (route[i].xyz - route[i - 1].xyz);
-    }
-  }
-  return route.back().xyz;
-}
-
 /// A replan of the bundled example from 20 m north of where the route is 30 s after departure.
 void BM_Replan(benchmark::State& state) {
   planner::Approver approver(planner::loadMission(kExample));
@@ -265,7 +252,7 @@ void BM_Replan(benchmark::State& state) {
     state.SkipWithError("the bundled example was not approved");
     return;
   }
-  const Eigen::Vector3d from = routeAt(approval.route, 30.0) + Eigen::Vector3d(0.0, 20.0, 0.0);
+  const Eigen::Vector3d from = planner::positionAlong(approval.route, 30.0) + Eigen::Vector3d(0.0, 20.0, 0.0);
   const maps::GpsTime now = approval.departure.plus(30.0);
   int approved = 0, n = 0;
   double length = 0.0;

@@ -99,13 +99,7 @@ void runFenceCheck(const FenceCheckOptions& o) {
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
     const std::string source = o.fixes + ":" + std::to_string(line);
     try {
-      json doc;
-      try {
-        doc = json::parse(text);
-      } catch (const json::parse_error& e) {
-        throw ParseError(source, 0, "$", text.substr(0, 60), std::string("one JSON object per line (") + e.what() + ")");
-      }
-      json out = checkFix(geofence::parseFix(doc, source), fence, boxes.frame);
+      json out = checkFix(geofence::parseFix(maps::parseJsonLine(text, source), source), fence, boxes.frame);
       out["line"] = line;
       std::cout << out.dump() << "\n";
       ++checked;

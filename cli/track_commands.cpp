@@ -7,6 +7,7 @@
 #include "integrity/gnss/rinex_nav.hpp"
 #include "integrity/gnss/rinex_obs.hpp"
 #include "integrity/raim/spp.hpp"
+#include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "planner/report_formats.hpp"
 #include "planner/tracking/track_store.hpp"
@@ -449,13 +450,7 @@ void runTrack(const TrackOptions& o) {
       if (o.format == "jsonl") {
         planner::TrackFix f;
         try {
-          json doc;
-          try {
-            doc = json::parse(text);
-          } catch (const json::parse_error& e) {
-            throw ParseError(source, 0, "$", text.substr(0, 60), std::string("one JSON object per line (") + e.what() + ")");
-          }
-          f = planner::parseTrackFixJson(doc, source);
+          f = planner::parseTrackFixJson(maps::parseJsonLine(text, source), source);
           f.line = line_no;
         } catch (const std::exception& e) {
           reject(source, line_no, e.what());

@@ -25,6 +25,16 @@ inline constexpr std::size_t kJsonQuoteChars = 60;
   return s.empty() ? std::string("\"\"") : s;
 }
 
+/// \brief One line of a JSON-lines stream parsed; `source` names it ("file:line").
+/// \throws ParseError quoting the line's start and the parser's message.
+[[nodiscard]] inline nlohmann::json parseJsonLine(const std::string& text, const std::string& source) {
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw ParseError(source, 0, "$", text.substr(0, kJsonQuoteChars), std::string("one JSON object per line (") + e.what() + ")");
+  }
+}
+
 /// \brief A JSON value with its path in the file (e.g. "features[3].properties.height");
 /// every accessor throws ParseError naming the source, the path, the value and what was
 /// expected. Holds references: the document and the source outlive it.

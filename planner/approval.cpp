@@ -230,19 +230,20 @@ struct Approver::Impl {
     return out;
   }
 
-  /// Position at t seconds after departure along the timed route.
-  static Eigen::Vector3d positionAt(const std::vector<RoutePoint>& route, double t) {
-    if (t <= 0.0) return route.front().xyz;
-    for (std::size_t i = 1; i < route.size(); ++i) {
-      if (t <= route[i].eta_s) {
-        const double span = route[i].eta_s - route[i - 1].eta_s;
-        const double f = span > 0 ? (t - route[i - 1].eta_s) / span : 1.0;
-        return route[i - 1].xyz + f * (route[i].xyz - route[i - 1].xyz);
-      }
-    }
-    return route.back().xyz;
-  }
 };
+
+Eigen::Vector3d positionAlong(const std::vector<RoutePoint>& route, double t_s) {
+  if (route.empty()) throw std::invalid_argument("positionAlong: an empty route");
+  if (t_s <= route.front().eta_s) return route.front().xyz;
+  for (std::size_t i = 1; i < route.size(); ++i) {
+    if (t_s <= route[i].eta_s) {
+      const double span = route[i].eta_s - route[i - 1].eta_s;
+      const double f = span > 0 ? (t_s - route[i - 1].eta_s) / span : 1.0;
+      return route[i - 1].xyz + f * (route[i].xyz - route[i - 1].xyz);
+    }
+  }
+  return route.back().xyz;
+}
 
 Approver::Approver(Mission mission) : impl_(std::make_unique<Impl>(std::move(mission))) {}
 Approver::~Approver() = default;
@@ -427,7 +428,7 @@ ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, co
       }
       say("predicting " + std::to_string(samples.t_s.size()) + " samples");
       for (double t : samples.t_s) {
-        const Eigen::Vector3d p = Impl::positionAt(route, t);
+        const Eigen::Vector3d p = positionAlong(route, t);
         samples.xyz.push_back(p);
         samples.geo.push_back(d.geodetic(p));
         samples.masks.push_back(masked ? std::optional(d.skyMaskAt(samples.geo.back())) : std::nullopt);

@@ -52,6 +52,10 @@ struct RoutePoint {
   double eta_s = 0.0;  ///< seconds after departure
 };
 
+/// \brief Where a timed route is t seconds after departure (map frame): linear between points
+/// by ETA, held at the ends.
+[[nodiscard]] Eigen::Vector3d positionAlong(const std::vector<RoutePoint>& route, double t_s);
+
 /// \brief One prediction sample along the route.
 struct PredictedSample {
   double t_s = 0.0;  ///< after departure

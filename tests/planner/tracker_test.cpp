@@ -47,15 +47,7 @@ Approved approveMission(Mission m) {
 }
 
 /// Position along the approved route t seconds after departure (map frame).
-Eigen::Vector3d along(const ApprovalReport& r, double t) {
-  for (std::size_t i = 1; i < r.route.size(); ++i) {
-    if (t <= r.route[i].eta_s) {
-      const double f = (t - r.route[i - 1].eta_s) / (r.route[i].eta_s - r.route[i - 1].eta_s);
-      return r.route[i - 1].xyz + f * (r.route[i].xyz - r.route[i - 1].xyz);
-    }
-  }
-  return r.route.back().xyz;
-}
+Eigen::Vector3d along(const ApprovalReport& r, double t) { return positionAlong(r.route, t); }
 
 TrackFix fixAt(const Approver& a, const maps::GpsTime& t, const Eigen::Vector3d& p_map, double hpl, double vpl,
                std::size_t line) {
