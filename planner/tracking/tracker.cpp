@@ -424,10 +424,10 @@ std::vector<json> Tracker::processJson(const TrackFix& fix) {
 std::vector<TrackEvent> Tracker::sweepStale(const maps::GpsTime& now) {
   std::vector<TrackEvent> out;
   for (auto& [id, f] : flights_) {
-    if (!f->st.last_time || f->st.stale_reported) continue;
+    // A flight whose last fix was at its goal has arrived: its silence is expected.
+    if (!f->st.last_time || f->st.stale_reported || f->st.arrived) continue;
     const double gap = now - *f->st.last_time;
     if (gap <= options_.stale_after_s) continue;
-    // A flight past its route's end and near its goal has landed: silence is expected.
     TrackEvent e = event("stale", id, now);
     e["last_fix"] = maps::formatRfc3339(*f->st.last_time, 3);
     e["gap_s"] = std::round(gap * 1e3) / 1e3;
@@ -631,6 +631,8 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
          (f.stops[st.next_stop] - p_map).head<2>().norm() <= options_.waypoint_radius_m) {
     ++st.next_stop;
   }
+  st.arrived = st.next_stop + 1 == f.stops.size() &&
+               (f.stops.back() - p_map).head<2>().norm() <= options_.waypoint_radius_m;
 
   // The fix event.
   TrackEvent e = event("fix", id, fix.time);
@@ -651,7 +653,9 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   out.push_back(std::move(e));
 
   // Replan from where the vehicle is.
-  if (trigger && options_.replan && (!st.last_replan || fix.time - *st.last_replan >= options_.replan_cooldown_s)) {
+  // (At the goal there is nowhere left to replan to: the violation stands.)
+  if (trigger && options_.replan && !st.arrived &&
+      (!st.last_replan || fix.time - *st.last_replan >= options_.replan_cooldown_s)) {
     st.last_replan = fix.time;
     ++st.replans;
     const ApprovalReport r = f.approver->replanFrom(p_map, fix.time, st.next_stop);
@@ -692,6 +696,7 @@ json flightStateJson(const FlightState& s) {
   j["inside_streak"] = s.inside_streak;
   j["last_replan"] = s.last_replan ? json(maps::formatRfc3339(*s.last_replan, 3)) : json(nullptr);
   j["stale_reported"] = s.stale_reported;
+  j["arrived"] = s.arrived;
   j["next_stop"] = s.next_stop;
   j["route_version"] = s.route_version;
   j["fixes"] = s.fixes;
@@ -717,6 +722,7 @@ FlightState parseFlightState(const json& j, const std::string& source) {
     s.violated = j.at("violated").get<std::array<bool, 4>>();
     s.inside_streak = j.at("inside_streak").get<std::array<int, 4>>();
     s.stale_reported = j.at("stale_reported").get<bool>();
+    s.arrived = j.value("arrived", false);
     s.next_stop = j.at("next_stop").get<std::size_t>();
     s.route_version = j.at("route_version").get<int>();
     s.fixes = j.at("fixes").get<std::uint64_t>();

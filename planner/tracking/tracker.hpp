@@ -26,7 +26,8 @@
 ///    the vehicle drifted. A level-1 violation by the PLs alone is not replanned unless
 ///    `replan_on_pl_exceedance`: no corridor of the same width can hold a PL wider than itself.
 ///    At most one replan per `replan_cooldown_s`. An approved replan replaces both box levels.
-/// 7. `stale`: a flight without a fix for `stale_after_s` of stream time (once per gap).
+/// 7. `stale`: a flight without a fix for `stale_after_s` of stream time (once per gap), unless
+///    its last fix was at its goal (it has arrived; nor is an arrived flight replanned).
 
 #include "planner/approval.hpp"
 #include "planner/report_formats.hpp"
@@ -96,6 +97,7 @@ struct FlightState {
   std::array<int, 4> inside_streak{};
   std::optional<maps::GpsTime> last_replan;
   bool stale_reported = false;
+  bool arrived = false;       ///< the last fix was within waypoint_radius_m of the goal
   std::size_t next_stop = 1;  ///< index into Mission::points of the next point to reach
   int route_version = 0;      ///< 0: the approved route; n: the n-th accepted replan
   std::uint64_t fixes = 0, rerun_count = 0, replans = 0;

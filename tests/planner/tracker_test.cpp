@@ -269,6 +269,41 @@ TEST_F(TrackerOnExample, BadOrderUnknownFlightsAndStaleFlightsAreReportedAndSkip
   EXPECT_EQ(tracker.state("F1").fixes, 2u);
 }
 
+TEST_F(TrackerOnExample, AFlightAtItsGoalIsNotStaleAndTheOthersAre) {
+  Tracker tracker;
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  tracker.addFlight("F2", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  const double end = r.route.back().eta_s;
+  // F1 flies to its goal and stops sending; F2 goes silent mid-route; a third flight's fixes
+  // carry the stream time on.
+  tracker.addFlight("F3", example_->flight, example_->approver);
+  std::vector<json> all;
+  for (int k = 0; k <= static_cast<int>(end); ++k) {
+    for (const char* id : {"F1", "F3"}) {
+      TrackFix f = fixAt(*example_->approver, r.departure.plus(k), along(r, k), 0.5, 0.5, k + 1);
+      f.flight = id;
+      for (json& e : tracker.processJson(f)) all.push_back(e);
+    }
+    if (k < 20) {
+      TrackFix f = fixAt(*example_->approver, r.departure.plus(k), along(r, k), 0.5, 0.5, k + 1);
+      f.flight = "F2";
+      for (json& e : tracker.processJson(f)) all.push_back(e);
+    }
+  }
+  for (int k = static_cast<int>(end) + 1; k < static_cast<int>(end) + 10; ++k) {
+    TrackFix f = fixAt(*example_->approver, r.departure.plus(k), along(r, k), 0.5, 0.5, k + 1);
+    f.flight = "F3";
+    for (json& e : tracker.processJson(f)) all.push_back(e);
+  }
+  const auto stale = ofType(all, "stale");
+  ASSERT_EQ(stale.size(), 1u);
+  EXPECT_EQ(stale[0].at("flight"), "F2");
+  EXPECT_TRUE(tracker.state("F1").arrived);
+  EXPECT_TRUE(tracker.state("F3").arrived);
+  EXPECT_FALSE(tracker.state("F2").arrived);
+}
+
 // --- NMEA and JSON lines give the same verdicts ---------------------------------------------
 
 std::string nmeaChecksummed(const std::string& body) {
