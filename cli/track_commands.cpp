@@ -57,6 +57,7 @@ struct TrackOptions {
   bool replan_on_pl = false;
   int batch = 200;
   double horizon_m = 50.0;
+  int jump_confirm = 3;
   std::string map;
 };
 
@@ -275,6 +276,7 @@ void runTrack(const TrackOptions& o) {
   topt.replan = !o.no_replan;
   topt.replan_on_pl_exceedance = o.replan_on_pl;
   topt.horizon_m = o.horizon_m;
+  topt.jump_confirm = o.jump_confirm;
   planner::Tracker tracker(topt);
 
   std::unique_ptr<planner::TrackStore> store;
@@ -506,6 +508,7 @@ void addTrackCommands(CLI::App& app) {
   c->add_option("--stale-after", o->stale_after_s, "seconds without a fix before 'stale' (default 3)");
   c->add_option("--cooldown", o->cooldown_s, "least seconds between two replans of a flight (default 10)");
   c->add_option("--max-time-jump", o->max_jump_s, "a fix more than this many seconds after the last is rejected (default 300)");
+  c->add_option("--jump-confirm", o->jump_confirm, "fixes in order on a jumped timeline before it is taken (default 3)");
   c->add_flag("--no-replan", o->no_replan, "report violations without replanning");
   c->add_flag("--replan-on-pl", o->replan_on_pl, "also replan when level 1 is violated by the PLs alone");
   c->add_option("--horizon", o->horizon_m, "list zones and obstacles within this distance of a volume in its fix event [m] (default 50)");

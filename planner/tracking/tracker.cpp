@@ -72,6 +72,7 @@ Tracker::Tracker(TrackerOptions options) : options_(options) {
                                 std::to_string(options_.level2_n) + ")");
   }
   if (options_.recover_after < 1) throw std::invalid_argument("tracker: recover_after must be ≥ 1");
+  if (options_.jump_confirm < 1) throw std::invalid_argument("tracker: jump_confirm must be ≥ 1");
   if (!(options_.stale_after_s > 0) || !(options_.max_time_jump_s > 0) || !(options_.replan_cooldown_s >= 0) ||
       !(options_.horizon_m >= 0 && std::isfinite(options_.horizon_m))) {
     throw std::invalid_argument("tracker: stale_after_s and max_time_jump_s must be > 0 s, replan_cooldown_s ≥ 0 s, horizon_m ≥ 0 m");
@@ -452,15 +453,34 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   }
   Flight& f = *it->second;
   FlightState& st = f.st;
+  std::string jump_note;
   if (st.last_time) {
     const double dt = fix.time - *st.last_time;
     std::string why;
     if (dt == 0.0) why = "duplicate time " + maps::formatRfc3339(fix.time, 3) + " (already accepted for flight " + id + ")";
     else if (dt < 0.0) why = "out of order: " + maps::formatRfc3339(fix.time, 3) + " is before the last accepted fix " +
                             maps::formatRfc3339(*st.last_time, 3);
-    else if (dt > options_.max_time_jump_s) {
-      why = "time jump of " + std::to_string(static_cast<long long>(dt)) + " s after the last accepted fix (more than " +
-            std::to_string(static_cast<long long>(options_.max_time_jump_s)) + " s)";
+    if (std::abs(dt) > options_.max_time_jump_s) {
+      // A jump of the receiver's clock, or a real gap: the fix is refused unless it continues a
+      // run of jump_confirm fixes in order on the new timeline (then that timeline is taken).
+      const bool continues = st.jump_candidate && fix.time - *st.jump_candidate > 0 &&
+                             fix.time - *st.jump_candidate <= options_.max_time_jump_s;
+      st.jump_count = continues ? st.jump_count + 1 : 1;
+      st.jump_candidate = fix.time;
+      why.clear();
+      if (st.jump_count < options_.jump_confirm) {
+        why = "time jump of " + std::to_string(static_cast<long long>(dt)) + " s from the last accepted fix (more than " +
+              std::to_string(static_cast<long long>(options_.max_time_jump_s)) + " s; " + std::to_string(st.jump_count) +
+              " of " + std::to_string(options_.jump_confirm) + " fixes in order to take the new timeline)";
+      } else {
+        jump_note = "a new timeline after a time jump of " + std::to_string(static_cast<long long>(dt)) + " s, confirmed by " +
+                    std::to_string(st.jump_count) + " fixes in order";
+        st.jump_candidate.reset();
+        st.jump_count = 0;
+      }
+    } else if (!why.empty() || dt > 0.0) {
+      st.jump_candidate.reset();
+      st.jump_count = 0;
     }
     if (!why.empty()) {
       TrackEvent e = rejectedInput(fix.source, fix.line, why);
@@ -647,7 +667,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   if (first) rec.fault_detected = first->fault_detected;
   rec.route_version = st.route_version;
   rec.rerun = rerun;
-  rec.note = note;
+  rec.note = jump_note.empty() ? note : (note.empty() ? jump_note : jump_note + "; " + note);
   rec.verdict = std::move(verdict);
   e.fix = std::move(rec);
   out.push_back(std::move(e));

@@ -8,7 +8,8 @@
 ///
 /// Per fix:
 /// 1. Order: a fix not after the flight's last accepted one (duplicate or out of order), or more
-///    than `max_time_jump_s` after it, is rejected (`rejected_input`), as is an unknown flight.
+///    than `max_time_jump_s` from it, is rejected (`rejected_input`), as is an unknown flight;
+///    after a jump, `jump_confirm` fixes in order on the new timeline make it the flight's.
 /// 2. Protection levels: raw pseudoranges → skylane's own position and PLs with the mission's
 ///    method, first pass detection only (integrity/raim/live_fix.hpp); else the onboard (or NMEA
 ///    GST) PLs; an INS block raises them to seed 000's nominal-INS PL when that is larger.
@@ -54,6 +55,7 @@ struct TrackerOptions {
   double replan_cooldown_s = 10.0;
   double stale_after_s = 3.0;
   double max_time_jump_s = 300.0;
+  int jump_confirm = 3;             ///< fixes in order on a jumped timeline before it is taken
   double waypoint_radius_m = 30.0;  ///< a mission waypoint is passed once a fix comes this close
   double horizon_m = 50.0;          ///< zones and obstacles this near a volume are listed in its fix event
 };
@@ -101,6 +103,8 @@ struct FlightState {
   std::size_t next_stop = 1;  ///< index into Mission::points of the next point to reach
   int route_version = 0;      ///< 0: the approved route; n: the n-th accepted replan
   std::uint64_t fixes = 0, rerun_count = 0, replans = 0;
+  std::optional<maps::GpsTime> jump_candidate;  ///< the last fix refused for a time jump (not stored)
+  int jump_count = 0;
 };
 
 /// \brief Tracks many flights in one process.

@@ -257,6 +257,7 @@ TEST_F(TrackerOnExample, BadOrderUnknownFlightsAndStaleFlightsAreReportedAndSkip
   EXPECT_NE(back[0].at("error").get<std::string>().find("out of order"), std::string::npos);
   auto jump = tracker.processJson(fixAt(a, r.departure.plus(4000), along(r, 20), 0.5, 0.5, 4));
   EXPECT_NE(jump[0].at("error").get<std::string>().find("time jump"), std::string::npos);
+  // A lone jumped fix is refused; the later fixes on the old timeline are taken as before.
   TrackFix stranger = fixAt(a, r.departure.plus(11), along(r, 11), 0.5, 0.5, 5);
   stranger.flight = "F9";
   auto unknown = tracker.processJson(stranger);
@@ -267,6 +268,32 @@ TEST_F(TrackerOnExample, BadOrderUnknownFlightsAndStaleFlightsAreReportedAndSkip
   EXPECT_DOUBLE_EQ(ofType(late, "stale")[0].at("gap_s").get<double>(), 6.0);
   EXPECT_EQ(ofType(late, "fix").size(), 1u);
   EXPECT_EQ(tracker.state("F1").fixes, 2u);
+}
+
+TEST_F(TrackerOnExample, AJumpedTimelineIsTakenAfterThreeFixesInOrder) {
+  TrackerOptions opt;
+  opt.replan = false;
+  Tracker tracker(opt);
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  const Approver& a = *example_->approver;
+  std::vector<std::string> kinds;
+  auto feed = [&](double t, std::size_t line) {
+    const auto ev = tracker.processJson(fixAt(a, r.departure.plus(t), along(r, 5), 0.5, 0.5, line));
+    kinds.push_back(ev.back().at("event").get<std::string>());
+    return ev.back();
+  };
+  feed(0, 1);
+  feed(1, 2);
+  // WHEN the receiver's clock jumps an hour ahead and stays there
+  EXPECT_NE(feed(3601, 3).at("error").get<std::string>().find("1 of 3"), std::string::npos);
+  EXPECT_NE(feed(3602, 4).at("error").get<std::string>().find("2 of 3"), std::string::npos);
+  const json taken = feed(3603, 5);
+  // THEN the third fix in order takes the new timeline, and it goes on from there
+  EXPECT_EQ(taken.at("event"), "fix");
+  EXPECT_NE(taken.at("note").get<std::string>().find("a new timeline after a time jump of 3602 s"), std::string::npos);
+  EXPECT_EQ(feed(3604, 6).at("event"), "fix");
+  EXPECT_NE(feed(2, 7).at("error").get<std::string>().find("1 of 3"), std::string::npos);  // the old time is now a jump back
 }
 
 TEST_F(TrackerOnExample, AFlightAtItsGoalIsNotStaleAndTheOthersAre) {
