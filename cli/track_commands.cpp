@@ -25,6 +25,8 @@
 #include <cerrno>
 #include <chrono>
 #include <csignal>
+#include <algorithm>
+#include <filesystem>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -180,6 +182,9 @@ std::pair<int, int> parseMofN(const std::string& text, const char* option) {
   return {m, n};
 }
 
+/// The longest input line taken [bytes]: a fix is a few hundred bytes, with pseudoranges a few kB.
+constexpr std::size_t kMaxLineBytes = 1 << 20;
+
 /// Lines from a file, stdin or UDP datagrams (one or more lines each), with a timeout so that a
 /// stop signal and stale flights are noticed while the input is quiet.
 class LineSource {
@@ -219,12 +224,26 @@ class LineSource {
   LineSource(const LineSource&) = delete;
   LineSource& operator=(const LineSource&) = delete;
 
-  enum class Status { kLine, kTimeout, kEnd };
-  /// Next line (without the line end); kTimeout after `timeout_ms` without one on a live input.
+  enum class Status { kLine, kTimeout, kEnd, kTooLong };
+  /// Next line (without the line end); kTimeout after `timeout_ms` without one on a live input;
+  /// kTooLong once for a line longer than kMaxLineBytes (the rest of it is dropped).
   Status next(std::string& line, int timeout_ms) {
     for (;;) {
       const auto nl = buffer_.find('\n');
-      if (nl != std::string::npos) {
+      if (skipping_) {
+        if (nl == std::string::npos) {
+          buffer_.clear();
+        } else {
+          buffer_.erase(0, nl + 1);
+          skipping_ = false;
+          continue;
+        }
+      } else if (nl == std::string::npos && buffer_.size() > kMaxLineBytes) {
+        buffer_.clear();
+        skipping_ = true;
+        return Status::kTooLong;
+      }
+      if (nl != std::string::npos && !skipping_) {
         line = buffer_.substr(0, nl);
         buffer_.erase(0, nl + 1);
         if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -258,7 +277,7 @@ class LineSource {
  private:
   std::string name_;
   int fd_ = -1;
-  bool live_ = false, udp_ = false, eof_ = false;
+  bool live_ = false, udp_ = false, eof_ = false, skipping_ = false;
   std::string buffer_;
 };
 
@@ -295,7 +314,13 @@ void runTrack(const TrackOptions& o) {
     const auto eq = a.find('=');
     const std::string id = eq == std::string::npos ? "" : a.substr(0, eq);
     const std::string path = eq == std::string::npos ? a : a.substr(eq + 1);
-    if (!id.empty() && report_of.count(id)) continue;  // resumed from the database
+    // Resumed from the database already: the same id, or (no id given) the same report.
+    const bool resumed = id.empty() ? std::any_of(report_of.begin(), report_of.end(), [&](const auto& kv) {
+      std::error_code ec;
+      return kv.second == path || std::filesystem::equivalent(kv.second, path, ec);
+    })
+                                    : report_of.count(id) > 0;
+    if (resumed) continue;
     const std::string got = tracker.addApprovalFile(path, id);
     report_of[got] = path;
   }
@@ -320,7 +345,12 @@ void runTrack(const TrackOptions& o) {
   }
   std::ostream& out = o.out.empty() ? std::cout : out_file;
   std::size_t accepted = 0, rejected = 0, events = 0, line_no = 0;
-  const std::size_t resume_line = store && o.input != "-" ? store->inputLine(o.input) : 0;
+  // A file input (not stdin, a FIFO or UDP: those cannot be read again) resumes where the last
+  // committed batch left it.
+  std::error_code fs_error;
+  const bool resumable = store && (o.format == "rinex" || std::filesystem::is_regular_file(o.input, fs_error));
+  const std::size_t resume_line = resumable ? store->inputLine(o.input) : 0;
+  std::size_t open_epoch_line = 0;  // NMEA: the GGA line of the epoch not yet released (0: none)
   auto emit = [&](const std::vector<planner::TrackEvent>& evs) {
     for (const planner::TrackEvent& e : evs) {
       // Quoted input may hold bytes that are not UTF-8: they are replaced, not fatal.
@@ -339,7 +369,8 @@ void runTrack(const TrackOptions& o) {
     for (const std::string& id : tracker.flights()) {
       store->putFlight({id, report_of[id], planner::flightStateJson(tracker.state(id)), tracker.routeJson(id)});
     }
-    if (o.input != "-") store->setInputLine(o.input, line_no);
+    // An NMEA epoch still open is read again after a restart: the position stays before it.
+    if (resumable) store->setInputLine(o.input, open_epoch_line > 0 ? std::min(line_no, open_epoch_line) : line_no);
     store->commit();
     out.flush();
     pending = 0;
@@ -417,15 +448,17 @@ void runTrack(const TrackOptions& o) {
     }
     integrity::NmeaEpochAssembler nmea(date);
     std::size_t epoch_line = 0;  // the line of the GGA that opened the NMEA epoch
-    auto nmeaFix = [&](const std::optional<integrity::NmeaFix>& nf) {
-      if (!nf) return;
-      const std::string source = o.input + ":" + std::to_string(epoch_line);
+    // On a resume, an NMEA file is read again from its start so that the epoch assembler has
+    // its date and open epoch back; the epochs opened before the resume line were processed then.
+    auto nmeaFix = [&](const std::optional<integrity::NmeaFix>& nf, std::size_t first_line) {
+      if (!nf || first_line < resume_line) return;
+      const std::string source = o.input + ":" + std::to_string(first_line);
       try {
         planner::TrackFix f = planner::trackFixFromNmea(*nf, source);
-        f.line = epoch_line;
+        f.line = first_line;
         process(f);
       } catch (const maps::ParseError& e) {
-        reject(source, epoch_line, e.what());
+        reject(source, first_line, e.what());
       }
     };
     auto last_wall = std::chrono::steady_clock::now();
@@ -434,6 +467,13 @@ void runTrack(const TrackOptions& o) {
       if (g_stop) break;
       const LineSource::Status st = in.next(text, 250);
       if (st == LineSource::Status::kEnd) break;
+      if (st == LineSource::Status::kTooLong) {
+        ++line_no;
+        if (line_no > resume_line) {
+          reject(o.input + ":" + std::to_string(line_no), line_no, "a line longer than " + std::to_string(kMaxLineBytes) + " bytes");
+        }
+        continue;
+      }
       if (st == LineSource::Status::kTimeout) {
         // A quiet live input: stream time runs on with the wall clock for the stale check.
         if (in.live() && tracker.streamTime()) {
@@ -446,7 +486,8 @@ void runTrack(const TrackOptions& o) {
       }
       last_wall = std::chrono::steady_clock::now();
       ++line_no;
-      if (line_no <= resume_line) continue;
+      const bool replaying = line_no <= resume_line;
+      if (replaying && o.format != "nmea") continue;
       if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
       const std::string source = o.input + ":" + std::to_string(line_no);
       if (o.format == "jsonl") {
@@ -463,18 +504,25 @@ void runTrack(const TrackOptions& o) {
         try {
           const integrity::NmeaSentence s = integrity::parseNmeaSentence(text, source);
           if (std::holds_alternative<integrity::NmeaGga>(s)) {
+            const std::size_t closed_line = epoch_line;
             std::optional<integrity::NmeaFix> closed = nmea.add(s);
-            nmeaFix(closed);
-            epoch_line = line_no;
+            epoch_line = open_epoch_line = line_no;  // before the checkpoint the closed fix may make
+            nmeaFix(closed, closed_line);
           } else {
-            nmeaFix(nmea.add(s));
+            std::optional<integrity::NmeaFix> closed = nmea.add(s);
+            if (closed) open_epoch_line = 0;
+            nmeaFix(closed, epoch_line);
           }
         } catch (const std::exception& e) {
-          reject(source, line_no, e.what());
+          if (!replaying) reject(source, line_no, e.what());
         }
       }
     }
-    if (o.format == "nmea" && !g_stop) nmeaFix(nmea.flush());
+    if (o.format == "nmea" && !g_stop) {
+      std::optional<integrity::NmeaFix> last = nmea.flush();
+      open_epoch_line = 0;
+      nmeaFix(last, epoch_line);
+    }
   }
   if (store) store->begin();
   if (tracker.streamTime()) emit(tracker.sweepStale(*tracker.streamTime()));

@@ -147,6 +147,10 @@ Obstructions::Obstructions(std::vector<airspace::Zone> zones, std::vector<maps::
   }
   zone_counts_.reserve(zones_.size());
   for (const airspace::Zone& z : zones_) zone_counts_.push_back(counts(z, policy_));
+  for (const ScenePiece& p : scene_.pieces()) {
+    pieces_in_band_ = pieces_in_band_ && p.prism.floor_h_ell_m >= kSceneFloor_h_ell_m &&
+                      p.prism.ceiling_h_ell_m <= kSceneCeiling_h_ell_m;
+  }
 }
 
 std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) const {
@@ -155,13 +159,14 @@ std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) c
     return owner == PieceOwner::kObstacle || (zone_counts_[i] && airspace::isActiveDuring(zones_[i], v.t0, v.t1));
   };
   // A volume taller than the scene's height band (a VPL of kilometres from a poor geometry) is
-  // cut to the band: every piece lies inside it, so the cut volume meets exactly the pieces the
-  // whole one meets; its vertical margins are then those of the cut volume.
+  // cut to the band when every piece lies inside it (unlimited limits are cut to the band; a
+  // finite one above 20 km is not): the cut volume then meets exactly the pieces the whole one
+  // meets, and its vertical margins are those of the cut volume. Otherwise Scene::query refuses it.
   ProtectionVolume volume = v.volume;
   requireValid(volume);
   const double lo = std::max(volume.p_map.z() - volume.vpl_m, kSceneFloor_h_ell_m);
   const double hi = std::min(volume.p_map.z() + volume.vpl_m, kSceneCeiling_h_ell_m);
-  if (lo > volume.p_map.z() - volume.vpl_m || hi < volume.p_map.z() + volume.vpl_m) {
+  if (pieces_in_band_ && (lo > volume.p_map.z() - volume.vpl_m || hi < volume.p_map.z() + volume.vpl_m)) {
     if (!(hi > lo)) return {};  // wholly above or below every zone and obstacle
     volume.p_map.z() = 0.5 * (lo + hi);
     volume.vpl_m = 0.5 * (hi - lo);

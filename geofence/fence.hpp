@@ -137,6 +137,7 @@ class Obstructions {
   std::vector<maps::Building> buildings_;
   std::vector<bool> zone_counts_;
   Scene scene_;
+  bool pieces_in_band_ = true;  ///< every piece within the scene's height band (volumes may be cut to it)
   ZonePolicy policy_;
   FenceOptions options_;
 };

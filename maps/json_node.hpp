@@ -25,11 +25,21 @@ inline constexpr std::size_t kJsonQuoteChars = 60;
   return s.empty() ? std::string("\"\"") : s;
 }
 
+/// \brief Deepest nesting of a JSON-lines record (a fix needs 3).
+inline constexpr int kMaxJsonLineDepth = 32;
+
 /// \brief One line of a JSON-lines stream parsed; `source` names it ("file:line").
 /// \throws ParseError quoting the line's start and the parser's message.
 [[nodiscard]] inline nlohmann::json parseJsonLine(const std::string& text, const std::string& source) {
+  // Nesting is bounded: the serializer that quotes a value in an error recurses per level.
+  const auto bounded = [&source](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+    if (depth > kMaxJsonLineDepth) {
+      throw ParseError(source, 0, "$", "", "JSON nested at most " + std::to_string(kMaxJsonLineDepth) + " levels deep");
+    }
+    return true;
+  };
   try {
-    return nlohmann::json::parse(text);
+    return nlohmann::json::parse(text, bounded);
   } catch (const nlohmann::json::parse_error& e) {
     throw ParseError(source, 0, "$", text.substr(0, kJsonQuoteChars), std::string("one JSON object per line (") + e.what() + ")");
   }

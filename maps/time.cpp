@@ -169,15 +169,38 @@ std::optional<GpsTime> parseRfc3339(const std::string& text) {
   return GpsTime::fromTotalSeconds(utc_s + leapSecondsAtUtc(utc_s));
 }
 
+namespace {
+
+/// The general form (any year, any number of digits), with snprintf.
+std::string formatRfc3339Printf(const GpsTime& t, int fraction_digits) {
+  const double scale = std::pow(10.0, fraction_digits);
+  const double utc_s = std::round((t.totalSeconds() - leapSecondsAtGps(t)) * scale) / scale;
+  const CalendarTime c = calendarFromSeconds(utc_s);
+  char buf[64];
+  if (fraction_digits <= 0) {
+    std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02dZ", c.year, c.month, c.day, c.hour, c.minute,
+                  static_cast<int>(std::lround(c.second) % 60));
+  } else {
+    std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%0*.*fZ", c.year, c.month, c.day, c.hour, c.minute,
+                  fraction_digits + 3, fraction_digits, c.second);
+  }
+  return buf;
+}
+
+}  // namespace
+
 std::string formatRfc3339(const GpsTime& t, int fraction_digits) {
-  const int digits = std::clamp(fraction_digits, 0, 9);
+  // 0–6 digits for years 1–9998 by hand (the common case: snprintf's "%0*.*f" was a third of a
+  // tracker fix event's time); anything else in the general form.
+  if (fraction_digits < 0 || fraction_digits > 6) return formatRfc3339Printf(t, fraction_digits);
+  const int digits = fraction_digits;
   long long unit = 1;
   for (int i = 0; i < digits; ++i) unit *= 10;
   const double scale = static_cast<double>(unit);
   // Round once in seconds so that 59.9996 does not print as 60.000.
   const double utc_s = std::round((t.totalSeconds() - leapSecondsAtGps(t)) * scale) / scale;
   const CalendarTime c = calendarFromSeconds(utc_s);
-  // Digits written by hand: snprintf's "%0*.*f" was a third of the time of a tracker's fix event.
+  if (c.year < 1 || c.year > 9998) return formatRfc3339Printf(t, fraction_digits);
   const long long units = std::llround(c.second * scale);
   const long long whole = (units / unit) % 60;
   long long frac = units % unit;

@@ -314,7 +314,9 @@ ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, co
   for (std::size_t i = 1; i < stops.size(); ++i) direct_m += (stops[i] - stops[i - 1]).head<2>().norm();
   const double direct_s = direct_m / m.cruise_speed_mps;
   const double flight_bound_s = 2.0 * direct_s + 120.0;
-  const maps::GpsTime latest_departure = departures.back();
+  // The zones' activity window reaches the mission's latest departure (a window whose length
+  // is not a multiple of its step has its last departure before it); a replan's is `now`.
+  const maps::GpsTime latest_departure = from_vehicle ? departures.back() : m.departure_latest;
 
   const bool masked = d.index || !m.terrain_file.empty();
   if (!cost_grid_built) {

@@ -7,6 +7,8 @@
 
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -77,6 +79,25 @@ std::string messageOf(const std::function<void()>& fn) {
     return e.what();
   }
   return "";
+}
+
+/// An NMEA 0183 sentence "$body*hh" with its checksum (XOR of the body's bytes).
+inline std::string nmeaSentence(const std::string& body) {
+  unsigned char x = 0;
+  for (char ch : body) x ^= static_cast<unsigned char>(ch);
+  char tail[8];
+  std::snprintf(tail, sizeof tail, "*%02X", x);
+  return "$" + body + tail;
+}
+
+/// Degrees as NMEA writes them: ddmm.mmmmmmm,N (latitude) or dddmm.mmmmmmm,E.
+inline std::string nmeaAngle(double deg, bool lat) {
+  const double a = std::abs(deg);
+  const int d = static_cast<int>(a);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, lat ? "%02d%010.7f,%c" : "%03d%010.7f,%c", d, (a - d) * 60.0,
+                lat ? (deg >= 0 ? 'N' : 'S') : (deg >= 0 ? 'E' : 'W'));
+  return buf;
 }
 
 }  // namespace skylane::test

@@ -21,6 +21,7 @@ const char* plSourceName(PlSource s) {
     case PlSource::kOnboard: return "onboard";
     case PlSource::kRaw: return "raw";
     case PlSource::kNmeaGst: return "nmea_gst";
+    case PlSource::kIns: return "ins";
   }
   return "?";
 }

@@ -37,9 +37,9 @@ struct InsUncertainty {
 };
 
 /// \brief Where a fix's protection levels came from.
-enum class PlSource { kOnboard, kRaw, kNmeaGst };
+enum class PlSource { kOnboard, kRaw, kNmeaGst, kIns };
 
-/// \brief "onboard", "raw", "nmea_gst".
+/// \brief "onboard", "raw", "nmea_gst", "ins" (the INS block alone).
 [[nodiscard]] const char* plSourceName(PlSource s);
 
 /// \brief One fix of a stream.

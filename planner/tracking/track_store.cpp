@@ -44,7 +44,9 @@ TrackStore::TrackStore(const std::string& path) : path_(path) {
 }
 
 TrackStore::~TrackStore() {
-  if (in_batch_) sqlite3_exec(db_, "COMMIT", nullptr, nullptr, nullptr);
+  // A batch still open here was cut short (an error unwound the run): it is not half-kept —
+  // its events without the states and input position would be stored twice after a restart.
+  if (in_batch_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
   sqlite3_finalize(put_flight_);
   sqlite3_finalize(put_event_);
   sqlite3_finalize(put_input_);

@@ -299,21 +299,31 @@ class LineWriter {
   bool need_comma_ = false;
 };
 
-/// Whether the text is UTF-8 by its byte pattern (RFC 3629 §3; overlong forms not checked),
-/// so it can be written as it is.
+/// Whether the text is well-formed UTF-8 (RFC 3629 §4: no overlong forms, no surrogates, nothing
+/// above U+10FFFF), so it can be written as it is.
 bool validUtf8(std::string_view v) {
+  const auto at = [&v](std::size_t i) { return static_cast<unsigned char>(v[i]); };
   std::size_t i = 0;
   while (i < v.size()) {
-    const auto c = static_cast<unsigned char>(v[i]);
+    const unsigned char c = at(i);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
     std::size_t n = 0;
-    if (c < 0x80) n = 0;
-    else if ((c >> 5) == 0x6) n = 1;
-    else if ((c >> 4) == 0xE) n = 2;
-    else if ((c >> 3) == 0x1E) n = 3;
+    unsigned char lo = 0x80, hi = 0xBF;  // the range of the second byte
+    if (c >= 0xC2 && c <= 0xDF) n = 1;
+    else if (c == 0xE0) n = 2, lo = 0xA0;
+    else if (c >= 0xE1 && c <= 0xEC) n = 2;
+    else if (c == 0xED) n = 2, hi = 0x9F;
+    else if (c >= 0xEE && c <= 0xEF) n = 2;
+    else if (c == 0xF0) n = 3, lo = 0x90;
+    else if (c >= 0xF1 && c <= 0xF3) n = 3;
+    else if (c == 0xF4) n = 3, hi = 0x8F;
     else return false;
-    if (i + n >= v.size()) return false;
-    for (std::size_t k = 1; k <= n; ++k) {
-      if ((static_cast<unsigned char>(v[i + k]) >> 6) != 0x2) return false;
+    if (i + n >= v.size() || at(i + 1) < lo || at(i + 1) > hi) return false;
+    for (std::size_t k = 2; k <= n; ++k) {
+      if (at(i + k) < 0x80 || at(i + k) > 0xBF) return false;
     }
     i += n + 1;
   }
@@ -453,34 +463,21 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   }
   Flight& f = *it->second;
   FlightState& st = f.st;
+  // Order: against the last accepted fix, or (the first fix) the approved departure and flight.
   std::string jump_note;
+  std::optional<double> jump_s;
+  std::string jump_from;
   if (st.last_time) {
     const double dt = fix.time - *st.last_time;
     std::string why;
-    if (dt == 0.0) why = "duplicate time " + maps::formatRfc3339(fix.time, 3) + " (already accepted for flight " + id + ")";
-    else if (dt < 0.0) why = "out of order: " + maps::formatRfc3339(fix.time, 3) + " is before the last accepted fix " +
-                            maps::formatRfc3339(*st.last_time, 3);
     if (std::abs(dt) > options_.max_time_jump_s) {
-      // A jump of the receiver's clock, or a real gap: the fix is refused unless it continues a
-      // run of jump_confirm fixes in order on the new timeline (then that timeline is taken).
-      const bool continues = st.jump_candidate && fix.time - *st.jump_candidate > 0 &&
-                             fix.time - *st.jump_candidate <= options_.max_time_jump_s;
-      st.jump_count = continues ? st.jump_count + 1 : 1;
-      st.jump_candidate = fix.time;
-      why.clear();
-      if (st.jump_count < options_.jump_confirm) {
-        why = "time jump of " + std::to_string(static_cast<long long>(dt)) + " s from the last accepted fix (more than " +
-              std::to_string(static_cast<long long>(options_.max_time_jump_s)) + " s; " + std::to_string(st.jump_count) +
-              " of " + std::to_string(options_.jump_confirm) + " fixes in order to take the new timeline)";
-      } else {
-        jump_note = "a new timeline after a time jump of " + std::to_string(static_cast<long long>(dt)) + " s, confirmed by " +
-                    std::to_string(st.jump_count) + " fixes in order";
-        st.jump_candidate.reset();
-        st.jump_count = 0;
-      }
-    } else if (!why.empty() || dt > 0.0) {
-      st.jump_candidate.reset();
-      st.jump_count = 0;
+      jump_s = dt;
+      jump_from = "the last accepted fix";
+    } else if (dt == 0.0) {
+      why = "duplicate time " + maps::formatRfc3339(fix.time, 3) + " (already accepted for flight " + id + ")";
+    } else if (dt < 0.0) {
+      why = "out of order: " + maps::formatRfc3339(fix.time, 3) + " is before the last accepted fix " +
+            maps::formatRfc3339(*st.last_time, 3);
     }
     if (!why.empty()) {
       TrackEvent e = rejectedInput(fix.source, fix.line, why);
@@ -488,17 +485,44 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       out.push_back(std::move(e));
       return out;
     }
+  } else {
+    const double from_departure = fix.time - f.plan.departure;
+    if (from_departure < -options_.max_time_jump_s ||
+        from_departure > f.plan.route.back().eta_s + options_.max_time_jump_s) {
+      jump_s = from_departure;
+      jump_from = "the approved departure " + maps::formatRfc3339(f.plan.departure);
+    }
   }
-  if (!stream_time_ || fix.time - *stream_time_ > 0) stream_time_ = fix.time;
-  if (!last_sweep_ || *stream_time_ - *last_sweep_ >= 1.0) {
-    for (TrackEvent& e : sweepStale(*stream_time_)) out.push_back(std::move(e));
+  if (jump_s) {
+    // A jump of the receiver's clock, a long outage, a late flight: the fix is refused unless it
+    // continues a run of jump_confirm fixes in order on the new timeline (then that is taken).
+    const bool continues = st.jump_candidate && fix.time - *st.jump_candidate > 0 &&
+                           fix.time - *st.jump_candidate <= options_.max_time_jump_s;
+    st.jump_count = continues ? st.jump_count + 1 : 1;
+    st.jump_candidate = fix.time;
+    const std::string size = "time jump of " + std::to_string(static_cast<long long>(*jump_s)) + " s from " + jump_from;
+    if (st.jump_count < options_.jump_confirm) {
+      TrackEvent e = rejectedInput(fix.source, fix.line,
+                                   size + " (more than " + std::to_string(static_cast<long long>(options_.max_time_jump_s)) +
+                                       " s; " + std::to_string(st.jump_count) + " of " +
+                                       std::to_string(options_.jump_confirm) + " fixes in order to take the new timeline)");
+      e.flight = id;
+      out.push_back(std::move(e));
+      return out;
+    }
+    jump_note = "a new timeline after a " + size + ", confirmed by " + std::to_string(st.jump_count) + " fixes in order";
   }
+  st.jump_candidate.reset();
+  st.jump_count = 0;
 
   // Protection levels and position.
   const maps::PlaneFrame& frame = f.approver->frame();
   maps::Geodetic pos{fix.lat_rad, fix.lon_rad, fix.h_ell_m};
   std::optional<double> hpl = fix.hpl_m, vpl = fix.vpl_m;
-  PlSource source = fix.hpl_m ? fix.pl_source : PlSource::kOnboard;
+  // The source of the PLs used: skylane's own (raw ranges solved), else what the fix gave.
+  // (A RINEX replay's fixes carry skylane's own PLs already: their source stays "raw".)
+  PlSource source = fix.ranges.empty() ? fix.pl_source : PlSource::kOnboard;
+  if (!fix.hpl_m && fix.ins) source = PlSource::kIns;
   std::optional<integrity::LiveFix> first;
   std::string note;
   if (!fix.ranges.empty()) {
@@ -537,6 +561,12 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
     r.flight = id;
     out.push_back(std::move(r));
     return out;
+  }
+  // Accepted. Stream time moves on with accepted fixes only (a refused one cannot push it
+  // ahead); the sweep sees this flight's gap before its time is updated.
+  if (!stream_time_ || fix.time - *stream_time_ > 0) stream_time_ = fix.time;
+  if (!last_sweep_ || *stream_time_ - *last_sweep_ >= 1.0 || *stream_time_ - *last_sweep_ < 0.0) {
+    for (TrackEvent& e : sweepStale(*stream_time_)) out.push_back(std::move(e));
   }
   st.last_time = fix.time;
   st.stale_reported = false;
@@ -678,12 +708,22 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       (!st.last_replan || fix.time - *st.last_replan >= options_.replan_cooldown_s)) {
     st.last_replan = fix.time;
     ++st.replans;
-    const ApprovalReport r = f.approver->replanFrom(p_map, fix.time, st.next_stop);
     TrackEvent rp = event("replan", id, fix.time);
     rp["trigger"] = geofence::levelName(*trigger);
     rp["from"] = {{"lat", roundDeg(pos.lat_rad)}, {"lon", roundDeg(pos.lon_rad)}, {"h_ell_m", roundMm(pos.h_ell_m)}};
+    rp["line"] = fix.line;
+    ApprovalReport r;
+    try {
+      r = f.approver->replanFrom(p_map, fix.time, st.next_stop);
+      rp["report"] = approvalReportJson(r, f.approver->mission());  // digests the input files again
+    } catch (const std::exception& err) {  // the fix stays accepted; the replan is what failed
+      rp["decision"] = "error";
+      rp["error"] = err.what();
+      rp["route_version"] = st.route_version;
+      out.push_back(std::move(rp));
+      return out;
+    }
     rp["decision"] = r.approved ? "approved" : "rejected";
-    rp["report"] = approvalReportJson(r, f.approver->mission());
     rp.body["report"].erase("predicted");  // the samples stay in the tracker's database with the route
     if (r.approved) {
       rp["operational_intent"] = {{"volumes", operationalIntentVolumes(r, frame, 2, 30.0)},
@@ -701,7 +741,6 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
     }
     rp["route_version"] = st.route_version;
     rp["planning_time_s"] = std::round(r.elapsed_s * 1e4) / 1e4;
-    rp["line"] = fix.line;
     out.push_back(std::move(rp));
   }
   return out;

@@ -1,6 +1,7 @@
 // `skylane track` end to end (issue 8): garbage and truncated input lose no good fix; a tracker
 // killed mid-stream and restarted on its database loses no accepted fix; SIGTERM saves and
 // exits; NMEA, UDP and RINEX replay inputs; bad approvals exit 2.
+#include "maps/time.hpp"
 #include "planner/tracking/track_store.hpp"
 #include "tests/test_util.hpp"
 
@@ -84,8 +85,7 @@ class TrackCli : public ::testing::Test {
     const json& b = route[i];
     const double f = std::clamp((t - a.at("eta_s").get<double>()) / (b.at("eta_s").get<double>() - a.at("eta_s").get<double>()), 0.0, 1.0);
     auto mix = [&](const char* key) { return a.at(key).get<double>() + f * (b.at(key).get<double>() - a.at(key).get<double>()); };
-    char time[32];
-    std::snprintf(time, sizeof time, "2020-01-01T14:%02d:%02dZ", k / 60, k % 60);
+    const std::string time = maps::formatRfc3339(maps::parseRfc3339("2020-01-01T14:00:00Z")->plus(k));
     return {{"flight", "zrh"}, {"time", time}, {"lat", mix("lat")}, {"lon", mix("lon")}, {"h_ell_m", mix("h_ell_m")},
             {"hpl_m", 0.5}, {"vpl_m", 0.5}};
   }
@@ -133,33 +133,88 @@ TEST_F(TrackCli, GarbageAndTruncatedLinesAreReportedAndEveryGoodFixIsChecked) {
   for (const json& e : ofType(events, "fix")) EXPECT_EQ(e.at("verdict"), "inside") << e.dump();
 }
 
+/// Runs `command` in the background, kills it with SIGKILL (no chance to save) after `seconds`.
+RunResult killAfter(const std::string& command, double seconds) {
+  return sh(command + " > /dev/null 2>&1 & pid=$!; sleep " + std::to_string(seconds) + "; kill -9 $pid 2>/dev/null; wait $pid; echo status=$?");
+}
+
 TEST_F(TrackCli, KilledAndRestartedTrackerLosesNoAcceptedFix) {
-  // GIVEN 200 good fixes fed through a FIFO, the writer pausing after the first 120
-  const std::string fifo = *dir_ + "/live.fifo", db = *dir_ + "/track.sqlite", all = *dir_ + "/all.jsonl";
+  // GIVEN a long file of good fixes (a few seconds of work with the database)
+  constexpr int kFixes = 60000;
+  const std::string db = *dir_ + "/track.sqlite", all = *dir_ + "/all.jsonl";
   std::filesystem::remove(db);
-  std::filesystem::remove(fifo);
   {
     std::ofstream f(all);
-    for (int k = 0; k < 200; ++k) f << goodFix(k).dump() << "\n";
+    for (int k = 0; k < kFixes; ++k) f << goodFix(k).dump() << "\n";
   }
-  // WHEN the tracker is killed (SIGKILL: no chance to save) while it waits for the rest …
-  const RunResult first = sh("mkfifo " + fifo + "; (head -n 120 " + all + "; sleep 3) > " + fifo + " & " + kBin +
-                             " track --approval " + approval() + " --input " + fifo + " --db " + db +
-                             " --batch 7 --no-replan > /dev/null 2>&1 & pid=$!; sleep 1.5; kill -9 $pid; wait $pid; echo killed");
-  ASSERT_NE(first.out.find("killed"), std::string::npos);
-  // … and restarted on the same database and input name, now a file with all 200 lines
-  std::filesystem::remove(fifo);
-  std::filesystem::copy_file(all, fifo);
-  const RunResult second = sh(kBin + " track --approval " + approval() + " --input " + fifo + " --db " + db +
-                              " --batch 7 --no-replan 2>&1 > /dev/null");
+  const std::string cmd = kBin + " track --approval " + approval() + " --input " + all + " --db " + db + " --batch 50 --no-replan";
+  // WHEN the tracker is killed mid-stream and restarted with the same database and input
+  const RunResult first = killAfter(cmd, 1.0);
+  ASSERT_NE(first.out.find("status=137"), std::string::npos) << "the first run ended before the kill: " << first.out;
+  const RunResult second = sh(cmd + " 2>&1 > /dev/null");
   ASSERT_EQ(second.status, 0) << second.out;
   EXPECT_NE(second.out.find("resumed flight zrh"), std::string::npos) << second.out;
   EXPECT_NE(second.out.find("resuming after line"), std::string::npos) << second.out;
-  // THEN the database holds every accepted fix exactly once, lines 1–200
-  std::multiset<int> lines;
-  for (const json& e : planner::TrackStore(db).events("fix")) lines.insert(e.at("line").get<int>());
-  EXPECT_EQ(lines.size(), 200u);
-  for (int k = 1; k <= 200; ++k) EXPECT_EQ(lines.count(k), 1u) << "line " << k;
+  // THEN the database holds every accepted fix exactly once, and nothing was rejected
+  std::vector<int> count(kFixes + 1, 0);
+  for (const json& e : planner::TrackStore(db).events("fix")) ++count[static_cast<std::size_t>(e.at("line").get<int>())];
+  int missing = 0, twice = 0;
+  for (int k = 1; k <= kFixes; ++k) {
+    missing += count[static_cast<std::size_t>(k)] == 0;
+    twice += count[static_cast<std::size_t>(k)] > 1;
+  }
+  EXPECT_EQ(missing, 0);
+  EXPECT_EQ(twice, 0);
+  EXPECT_TRUE(planner::TrackStore(db).events("rejected_input").empty());
+}
+
+TEST_F(TrackCli, KilledNmeaTrackerRestartedWithoutAnIdLosesNoEpoch) {
+  // GIVEN 150 NMEA epochs (RMC, GGA, GST) along the route through a FIFO, the approval given
+  // without an ID (the flight takes the mission's name)
+  constexpr int kEpochs = 40000;
+  const std::string db = *dir_ + "/nmea.sqlite", all = *dir_ + "/all.nmea";
+  std::filesystem::remove(db);
+  int lines = 0;
+  {
+    std::ofstream f(all);
+    for (int k = 0; k < kEpochs; ++k) {
+      const json fix = goodFix(k);
+      const maps::CalendarTime c = maps::utcFromGps(maps::parseRfc3339("2020-01-01T14:00:00Z")->plus(k));
+      char hms[16];
+      std::snprintf(hms, sizeof hms, "%02d%02d%02d.00", c.hour, c.minute, static_cast<int>(c.second));
+      char date[8];
+      std::snprintf(date, sizeof date, "%02d%02d%02d", c.day, c.month, c.year % 100);
+      const std::string lat = test::nmeaAngle(fix.at("lat").get<double>(), true);
+      const std::string lon = test::nmeaAngle(fix.at("lon").get<double>(), false);
+      char alt[64];
+      std::snprintf(alt, sizeof alt, ",4,12,0.8,%.3f,M,47.35,M,,", fix.at("h_ell_m").get<double>() - 47.35);
+      f << test::nmeaSentence(std::string("GPRMC,") + hms + ",A," + lat + "," + lon + ",0.0,0.0," + date + ",,,D") << "\r\n";
+      f << test::nmeaSentence(std::string("GPGGA,") + hms + "," + lat + "," + lon + alt) << "\r\n";
+      f << test::nmeaSentence(std::string("GPGST,") + hms + ",0.5,0.060,0.040,30.0,0.050,0.045,0.090") << "\r\n";
+      lines += 3;
+    }
+  }
+  const std::string report = *dir_ + "/approve/report.json";
+  // WHEN the tracker is killed mid-stream and restarted on the same database and file
+  const std::string cmd = kBin + " track --approval " + report + " --format nmea --input " + all + " --db " + db +
+                          " --batch 9 --no-replan";
+  const RunResult first = killAfter(cmd, 1.0);
+  ASSERT_NE(first.out.find("status=137"), std::string::npos) << "the first run ended before the kill: " << first.out;
+  const RunResult second = sh(cmd + " 2>&1 > /dev/null");
+  ASSERT_EQ(second.status, 0) << second.out;
+  EXPECT_NE(second.out.find("resumed flight"), std::string::npos) << second.out;
+  EXPECT_NE(second.out.find("resuming after line"), std::string::npos) << second.out;
+  // THEN every epoch is in the database once (its GGA line), and none was rejected
+  std::vector<int> count(static_cast<std::size_t>(lines) + 1, 0);
+  for (const json& e : planner::TrackStore(db).events("fix")) ++count[static_cast<std::size_t>(e.at("line").get<int>())];
+  int missing = 0, twice = 0;
+  for (int k = 0; k < kEpochs; ++k) {
+    missing += count[static_cast<std::size_t>(3 * k + 2)] == 0;
+    twice += count[static_cast<std::size_t>(3 * k + 2)] > 1;
+  }
+  EXPECT_EQ(missing, 0);
+  EXPECT_EQ(twice, 0);
+  EXPECT_TRUE(planner::TrackStore(db).events("rejected_input").empty());
 }
 
 TEST_F(TrackCli, SigtermSavesTheStateAndExitsCleanly) {

@@ -6,7 +6,9 @@
 #include "integrity/sim/sensors.hpp"
 #include "integrity/sim/trajectory.hpp"
 #include "maps/parse_error.hpp"
+#include "maps/json_node.hpp"
 #include "maps/text_file.hpp"
+#include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -296,6 +298,59 @@ TEST_F(TrackerOnExample, AJumpedTimelineIsTakenAfterThreeFixesInOrder) {
   EXPECT_NE(feed(2, 7).at("error").get<std::string>().find("1 of 3"), std::string::npos);  // the old time is now a jump back
 }
 
+TEST_F(TrackerOnExample, AFirstFixFarFromTheApprovedDepartureNeedsItsTimelineConfirmed) {
+  TrackerOptions opt;
+  opt.replan = false;
+  Tracker tracker(opt);
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  const Approver& a = *example_->approver;
+  // A bogus time a day ahead is refused and does not move stream time (no flight goes stale).
+  const auto bogus = tracker.processJson(fixAt(a, r.departure.plus(86400), along(r, 0), 0.5, 0.5, 1));
+  EXPECT_NE(bogus.back().at("error").get<std::string>().find("from the approved departure"), std::string::npos);
+  EXPECT_FALSE(tracker.streamTime());
+  // The flight's real first fix is taken.
+  EXPECT_EQ(tracker.processJson(fixAt(a, r.departure.plus(1), along(r, 1), 0.5, 0.5, 2)).back().at("event"), "fix");
+  EXPECT_DOUBLE_EQ(*tracker.streamTime() - r.departure, 1.0);
+}
+
+TEST_F(TrackerOnExample, PlSourceSaysWhereThePlsCameFrom) {
+  Tracker tracker;
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  const Approver& a = *example_->approver;
+  // Onboard PLs with two pseudoranges (too few for a position): the onboard PLs are used.
+  TrackFix f = fixAt(a, r.departure.plus(1), along(r, 1), 0.5, 0.5, 1);
+  f.ranges = {{integrity::SatId{integrity::Constellation::kGps, 5}, 2.1e7, std::nullopt},
+              {integrity::SatId{integrity::Constellation::kGps, 7}, 2.2e7, std::nullopt}};
+  f.pl_source = PlSource::kRaw;
+  const json fix = tracker.processJson(f).back();
+  EXPECT_EQ(fix.at("pl_source"), "onboard");
+  EXPECT_NE(fix.at("note").get<std::string>().find("raw pseudoranges gave no PL"), std::string::npos);
+  // An INS block alone: seed 000's nominal-INS PLs.
+  TrackFix g = fixAt(a, r.departure.plus(2), along(r, 2), 0.5, 0.5, 2);
+  g.hpl_m.reset();
+  g.vpl_m.reset();
+  g.ins = InsUncertainty{1, 0.05, 0.05, 0.1};
+  const json ins = tracker.processJson(g).back();
+  EXPECT_EQ(ins.at("pl_source"), "ins");
+  EXPECT_NEAR(ins.at("hpl_m").get<double>(), insNominalPl(*g.ins).first, 1e-3);
+}
+
+TEST(TrackJsonLine, DeepNestingAndBadUtf8AreErrorsNotCrashes) {
+  const std::string deep(100000, '[');
+  const std::string msg = test::messageOf<maps::ParseError>([&] { (void)maps::parseJsonLine(deep, "fixes.jsonl:3"); });
+  EXPECT_NE(msg.find("nested at most 32 levels"), std::string::npos) << msg;
+  // A flight id with an overlong form and a surrogate: the line is still valid JSON.
+  TrackEvent e;
+  e.type = "fix";
+  e.flight = std::string("F\xC0\xAF-\xED\xA0\x80");
+  e.fix = FixRecord{};
+  json parsed;
+  EXPECT_NO_THROW(parsed = json::parse(e.jsonLine()));
+  EXPECT_EQ(parsed.at("event"), "fix");
+}
+
 TEST_F(TrackerOnExample, AFlightAtItsGoalIsNotStaleAndTheOthersAre) {
   Tracker tracker;
   tracker.addFlight("F1", example_->flight, example_->approver);
@@ -333,23 +388,6 @@ TEST_F(TrackerOnExample, AFlightAtItsGoalIsNotStaleAndTheOthersAre) {
 
 // --- NMEA and JSON lines give the same verdicts ---------------------------------------------
 
-std::string nmeaChecksummed(const std::string& body) {
-  unsigned char x = 0;
-  for (char ch : body) x ^= static_cast<unsigned char>(ch);
-  char tail[8];
-  std::snprintf(tail, sizeof tail, "*%02X", x);
-  return "$" + body + tail;
-}
-
-std::string nmeaAngle(double deg, bool lat) {
-  const double a = std::abs(deg);
-  const int d = static_cast<int>(a);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, lat ? "%02d%010.7f,%c" : "%03d%010.7f,%c", d, (a - d) * 60.0,
-                lat ? (deg >= 0 ? 'N' : 'S') : (deg >= 0 ? 'E' : 'W'));
-  return buf;
-}
-
 TEST_F(TrackerOnExample, NmeaAndJsonLinesGiveTheSameVerdicts) {
   const ApprovalReport& r = example_->report;
   const Eigen::Vector3d side = acrossFirstSegment(r);
@@ -381,15 +419,15 @@ TEST_F(TrackerOnExample, NmeaAndJsonLinesGiveTheSameVerdicts) {
     char tail[96];
     std::snprintf(tail, sizeof tail, ",4,12,0.8,%.4f,M,47.35,M,,", p.z() - 47.35);
     const Eigen::Vector2d q = example_->approver->frame().toLatLon(p.head<2>());
-    const std::string gga = nmeaChecksummed("GPGGA," + std::string(hms) + "," + nmeaAngle(maps::rad2deg(q.x()), true) + "," +
-                                            nmeaAngle(maps::rad2deg(q.y()), false) + tail);
+    const std::string gga = test::nmeaSentence("GPGGA," + std::string(hms) + "," + test::nmeaAngle(maps::rad2deg(q.x()), true) + "," +
+                                            test::nmeaAngle(maps::rad2deg(q.y()), false) + tail);
     char gst[96];
     std::snprintf(gst, sizeof gst, "GPGST,%s,0.5,%.4f,%.4f,0.0,%.4f,%.4f,%.4f", hms, sigma_h, sigma_h * 0.8, sigma_h * 0.8,
                   sigma_h * 0.6, sigma_v);
     char rmc_date[8];
     std::snprintf(rmc_date, sizeof rmc_date, "%02d%02d%02d", c.day, c.month, c.year % 100);
-    const std::string rmc = nmeaChecksummed("GPRMC," + std::string(hms) + ",A,4722.0000,N,00832.0000,E,0.0,0.0," + rmc_date + ",,,A");
-    for (const std::string& s : {rmc, gga, nmeaChecksummed(gst)}) {
+    const std::string rmc = test::nmeaSentence("GPRMC," + std::string(hms) + ",A,4722.0000,N,00832.0000,E,0.0,0.0," + rmc_date + ",,,A");
+    for (const std::string& s : {rmc, gga, test::nmeaSentence(gst)}) {
       if (auto nf = asm2.add(integrity::parseNmeaSentence(s, "fixes.nmea"))) {
         for (const json& e : b.processJson(trackFixFromNmea(*nf, "fixes.nmea"))) {
           if (e.at("event") == "fix") vb.push_back(e);
