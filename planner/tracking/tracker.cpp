@@ -582,10 +582,16 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
 
   // Monitoring rerun: FDE over the raw measurements when level 1 is not held.
   bool rerun = false;
+  // Without a detected fault the FDE would give the first pass back (nothing to exclude), so it
+  // is not computed again; its event is written on a detection and at the start of a level-1
+  // episode (a PL that never fits HAL₁ would otherwise repeat it at every fix).
   if (first && levelVerdict(verdict, geofence::Level::kCorridor) != geofence::Verdict::kInside) {
-    const integrity::LiveFix again = integrity::solveLiveFix(fix.ranges, pos, fix.time, f.live, true, &f.approver->orbits());
+    const integrity::LiveFix again = first->fault_detected
+                                         ? integrity::solveLiveFix(fix.ranges, pos, fix.time, f.live, true, &f.approver->orbits())
+                                         : *first;
     rerun = true;
     ++st.rerun_count;
+    const bool write = first->fault_detected || !st.violated[static_cast<int>(geofence::Level::kCorridor)];
     TrackEvent e = event("monitoring_rerun", id, fix.time);
     e["fault_detected"] = first->fault_detected;
     json excluded = json::array();
@@ -615,7 +621,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       e["note"] = again.note + again.pl.reason;
     }
     e["line"] = fix.line;
-    out.push_back(std::move(e));
+    if (write) out.push_back(std::move(e));
   }
 
   // Persistence per level.

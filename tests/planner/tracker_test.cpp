@@ -462,6 +462,55 @@ TEST_F(TrackerOnExample, NmeaAndJsonLinesGiveTheSameVerdicts) {
 
 // --- a simulated flight with a satellite fault: the rerun excludes it -----------------------
 
+TEST_F(TrackerOnExample, RawFixesWhosePlNeverFitsHal1RerunOnceAndAreNotReplanned) {
+  // GIVEN the bundled example (HAL₁ = 1.44 m) flown by the simulator without a fault: RAIM's
+  // fault-free HPL (≈ 12 m) never fits the corridor
+  Tracker tracker;
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  const maps::Geodetic origin{r.route.front().lat_rad, r.route.front().lon_rad, r.route.front().h_ell_m};
+  const maps::LocalFrame enu(origin);
+  std::vector<integrity::sim::Waypoint> wps;
+  for (const RoutePoint& p : r.route) {
+    wps.push_back({enu.toEnu({p.lat_rad, p.lon_rad, p.h_ell_m}), example_->approver->mission().cruise_speed_mps});
+  }
+  const integrity::sim::Trajectory traj(origin, wps, 30.0);
+  integrity::sim::SensorSpec spec;
+  spec.model = example_->approver->mission().model;
+  integrity::sim::SensorSimulator sim(traj, example_->approver->orbits(), r.departure, spec, {}, 5);
+  std::vector<json> all;
+  std::size_t line = 0;
+  while (sim.running() && line < 40) {
+    (void)sim.stepImu();
+    if (!sim.gnssDue()) continue;
+    const integrity::sim::GnssEpoch ep = sim.gnss();
+    TrackFix f;
+    f.flight = "F1";
+    f.time = ep.time;
+    f.lat_rad = sim.truth().geodetic.lat_rad;
+    f.lon_rad = sim.truth().geodetic.lon_rad;
+    f.h_ell_m = sim.truth().geodetic.h_ell_m;
+    for (const integrity::sim::Pseudorange& pr : ep.ranges) f.ranges.push_back({pr.sat, pr.pseudorange_m, pr.sat_ecef_m});
+    f.line = ++line;
+    for (json& e : tracker.processJson(f)) all.push_back(e);
+  }
+  // THEN one violation by the PL and one rerun event, every fix rerun and outside level 1,
+  // and no replan (a corridor of the same width cannot hold the PL)
+  ASSERT_EQ(ofType(all, "violation").size(), 1u);
+  EXPECT_EQ(ofType(all, "violation")[0].at("cause"), "protection_level");
+  EXPECT_EQ(ofType(all, "monitoring_rerun").size(), 1u);
+  EXPECT_TRUE(ofType(all, "replan").empty());
+  const auto fixes = ofType(all, "fix");
+  ASSERT_EQ(fixes.size(), 40u);
+  for (const json& fix : fixes) {
+    EXPECT_EQ(fix.at("pl_source"), "raw");
+    EXPECT_TRUE(fix.value("rerun", false));
+    EXPECT_GT(fix.at("hpl_m").get<double>(), r.limits.level1.hal_m);
+    EXPECT_EQ(fix.at("levels").at("level1").at("verdict"), "outside");
+    EXPECT_EQ(fix.at("levels").at("level2").at("verdict"), "inside");
+  }
+}
+
 TEST(TrackerRaw, SatelliteFaultIsExcludedByTheRerunAndTheFlightRecoversWithoutAReplan) {
   // GIVEN a large UAV (20 m span, 25 m long: HAL₁ = 24 m, VAL₁ = 30 m) on the example route, so
   // that fault-free RAIM PLs (≈ 12–13 m here) fit level 1
