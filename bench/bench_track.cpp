@@ -13,6 +13,8 @@
 #include "planner/report_formats.hpp"
 #include "planner/tracking/track_fix.hpp"
 #include "planner/tracking/tracker.hpp"
+#include "integrity/sim/sensors.hpp"
+#include "integrity/sim/trajectory.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -266,5 +268,84 @@ void BM_Replan(benchmark::State& state) {
   state.counters["route_m"] = length / std::max(n, 1);
 }
 BENCHMARK(BM_Replan)->Unit(benchmark::kMillisecond)->Iterations(5);
+
+/// Fixes with raw pseudoranges (skylane's own position and RAIM PLs) on the bundled example,
+/// flown by the simulator with a 60 m fault on one satellite half of the time: the first pass,
+/// and on a detection the FDE rerun and the second check. Vehicle of 20 m span so that the
+/// fault-free PLs fit level 1 and a detection is what triggers the rerun.
+void BM_TrackRawFixes(benchmark::State& state) {
+  planner::Mission m = planner::loadMission(kExample);
+  m.vehicle.lateral_m = 20.0;
+  m.vehicle.longitudinal_m = 25.0;
+  m.levels.k2 = 100.0;
+  auto approver = std::make_shared<planner::Approver>(m);
+  const planner::ApprovalReport r = approver->approve();
+  if (!r.approved) {
+    state.SkipWithError("the example with a 20 m vehicle was not approved");
+    return;
+  }
+  planner::ApprovedFlight flight;
+  flight.approved = true;
+  flight.departure = r.departure;
+  flight.route = r.route;
+  flight.level1 = r.limits.level1;
+  flight.level2 = r.limits.level2;
+  const maps::Geodetic origin{r.route.front().lat_rad, r.route.front().lon_rad, r.route.front().h_ell_m};
+  const maps::LocalFrame enu(origin);
+  std::vector<integrity::sim::Waypoint> wps;
+  for (const planner::RoutePoint& p : r.route) wps.push_back({enu.toEnu({p.lat_rad, p.lon_rad, p.h_ell_m}), m.cruise_speed_mps});
+  const integrity::sim::Trajectory traj(origin, wps, 30.0);
+  integrity::sim::SensorSpec spec;
+  spec.model = m.model;
+  integrity::sim::FaultSpec fault;
+  fault.target = integrity::sim::FaultTarget::kSatellite;
+  fault.pick = 0.5;
+  fault.t_start_s = traj.duration_s() / 2.0;
+  fault.t_end_s = traj.duration_s();
+  fault.magnitude = 60.0;
+  integrity::sim::SensorSimulator sim(traj, approver->orbits(), r.departure, spec, {fault}, 3);
+  std::vector<planner::TrackFix> fixes;
+  while (sim.running()) {
+    (void)sim.stepImu();
+    if (!sim.gnssDue()) continue;
+    const integrity::sim::GnssEpoch ep = sim.gnss();
+    planner::TrackFix f;
+    f.flight = "F1";
+    f.time = ep.time;
+    f.lat_rad = sim.truth().geodetic.lat_rad;
+    f.lon_rad = sim.truth().geodetic.lon_rad;
+    f.h_ell_m = sim.truth().geodetic.h_ell_m;
+    for (const integrity::sim::Pseudorange& pr : ep.ranges) f.ranges.push_back({pr.sat, pr.pseudorange_m, pr.sat_ecef_m});
+    f.line = fixes.size() + 1;
+    fixes.push_back(std::move(f));
+  }
+  planner::TrackerOptions options;
+  options.replan = false;
+  std::unique_ptr<planner::Tracker> tracker;
+  std::size_t k = fixes.size(), reruns = 0, n = 0, sats = 0;
+  std::vector<double> latency_us;
+  for (auto _ : state) {
+    if (k == fixes.size()) {
+      state.PauseTiming();
+      tracker = std::make_unique<planner::Tracker>(options);
+      tracker->addFlight("F1", flight, approver);
+      k = 0;
+      state.ResumeTiming();
+    }
+    const auto t0 = Clock::now();
+    const std::vector<planner::TrackEvent> ev = tracker->process(fixes[k]);
+    latency_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+    for (const planner::TrackEvent& e : ev) reruns += e.fix && e.fix->rerun;
+    sats += fixes[k].ranges.size();
+    ++k;
+    ++n;
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["p50_us"] = percentile(latency_us, 0.50);
+  state.counters["p99_us"] = percentile(latency_us, 0.99);
+  state.counters["reruns_per_fix"] = static_cast<double>(reruns) / std::max<std::size_t>(n, 1);
+  state.counters["satellites"] = static_cast<double>(sats) / std::max<std::size_t>(n, 1);
+}
+BENCHMARK(BM_TrackRawFixes)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 
 }  // namespace
