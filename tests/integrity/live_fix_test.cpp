@@ -218,6 +218,43 @@ TEST(LiveFix, MonteCarloFaultFreePlBoundsTheErrorAndFalseAlertsAreRare) {
   EXPECT_LE(false_alerts, kMaxFalseAlerts);
 }
 
+TEST(LiveFix, AraimDetectsAndExcludesAnInjectedFaultBySolutionSeparation) {
+  // GIVEN the ARAIM method (MHSS solution separation) and a 80 m bias on each satellite in turn
+  LiveFixConfig cfg;
+  cfg.method = IntegrityMethod::kAraim;
+  constexpr double kFault_m = 80.0;
+  int cases = 0, excluded_right = 0;
+  for (const Sky& s : skies(cfg)) {
+    const LiveFix clean = solveLiveFix(rangesOf(s, Eigen::VectorXd::Zero(s.g.numSats())), s.truth, s.t, cfg, false, nullptr);
+    ASSERT_TRUE(clean.solved && clean.pl.pl_computed) << clean.note << clean.pl.reason;
+    EXPECT_FALSE(clean.fault_detected);
+    for (int i = 0; i < s.g.numSats(); ++i) {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(s.g.numSats());
+      e[i] = kFault_m;
+      const std::vector<RawRange> ranges = rangesOf(s, e);
+      // WHEN the first pass and the rerun solve it
+      const LiveFix first = solveLiveFix(ranges, s.truth, s.t, cfg, false, nullptr);
+      const LiveFix rerun = solveLiveFix(ranges, s.truth, s.t, cfg, true, nullptr);
+      ASSERT_TRUE(first.solved && rerun.solved);
+      const Eigen::Vector3d err_first = enuError(s, first), err_rerun = enuError(s, rerun);
+      // THEN every PL the passes give bounds their own error (a noiseless bias: the PL must
+      // hold it deterministically), and a detected fault is excluded and named
+      EXPECT_LE(err_first.head<2>().norm(), first.pl.hpl_m) << "sat " << s.g.sats[static_cast<std::size_t>(i)].str();
+      EXPECT_LE(std::abs(err_first.z()), first.pl.vpl_m);
+      if (!first.fault_detected) continue;
+      ++cases;
+      EXPECT_GT(first.pl.hpl_m, clean.pl.hpl_m);  // PL_det grows with the fault
+      if (rerun.fault_excluded && rerun.excluded.size() == 1 && rerun.excluded[0] == s.g.sats[static_cast<std::size_t>(i)]) {
+        ++excluded_right;
+        EXPECT_LT(err_rerun.norm(), 1e-3);  // noiseless: the remaining satellites give the truth
+        EXPECT_LE(err_rerun.head<2>().norm(), rerun.pl.hpl_m);
+      }
+    }
+  }
+  EXPECT_GT(cases, 20);
+  EXPECT_EQ(excluded_right, cases);
+}
+
 TEST(LiveFix, MonteCarloWithFaultInjection) {
   // 15,000 epochs, each with a bias uniform in [0, 150] m on one satellite drawn at random, the
   // same pseudoranges solved by the first pass (detection only) and by the FDE rerun.
