@@ -9,6 +9,7 @@
 #include "integrity/raim/spp.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
+#include "maps/text_file.hpp"
 #include "planner/report_formats.hpp"
 #include "planner/tracking/track_store.hpp"
 #include "planner/tracking/tracker.hpp"
@@ -31,6 +32,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <set>
 
 namespace skylane::cli {
 namespace {
@@ -303,7 +305,9 @@ void runTrack(const TrackOptions& o) {
   if (!o.db.empty()) {
     store = std::make_unique<planner::TrackStore>(o.db);
     for (const planner::StoredFlight& f : store->flights()) {
-      const std::string id = tracker.addApprovalFile(f.report, f.id);
+      // The approval comes from the database (the report file may have gone); the mission must
+      // still be there, unchanged.
+      const std::string id = tracker.addApproval(f.approval, f.report, f.id);
       tracker.restore(id, planner::parseFlightState(f.state, o.db + ": flight " + id), f.route);
       report_of[id] = f.report;
       std::cerr << "skylane: track: resumed flight " << id << " (" << tracker.state(id).fixes << " fixes so far, route version "
@@ -321,8 +325,14 @@ void runTrack(const TrackOptions& o) {
     })
                                     : report_of.count(id) > 0;
     if (resumed) continue;
-    const std::string got = tracker.addApprovalFile(path, id);
+    const json report = maps::readJsonFile(path);
+    const std::string got = tracker.addApproval(report, path, id);
     report_of[got] = path;
+    if (store) {  // kept once; the checkpoints update the state and the route
+      store->begin();
+      store->putFlight({got, path, report, planner::flightStateJson(tracker.state(got)), tracker.routeJson(got)});
+      store->commit();
+    }
   }
   TrackMap track_map;
   for (const std::string& id : tracker.flights()) {
@@ -351,6 +361,7 @@ void runTrack(const TrackOptions& o) {
   const bool resumable = store && (o.format == "rinex" || std::filesystem::is_regular_file(o.input, fs_error));
   const std::size_t resume_line = resumable ? store->inputLine(o.input) : 0;
   std::size_t open_epoch_line = 0;  // NMEA: the GGA line of the epoch not yet released (0: none)
+  std::set<std::string> touched;  // flights whose state changed since the last checkpoint
   auto emit = [&](const std::vector<planner::TrackEvent>& evs) {
     for (const planner::TrackEvent& e : evs) {
       // Quoted input may hold bytes that are not UTF-8: they are replaced, not fatal.
@@ -360,15 +371,15 @@ void runTrack(const TrackOptions& o) {
       if (e.is("rejected_input")) ++rejected;
       if (e.is("fix")) ++accepted;
       if (store) store->appendEvent(e.type, e.flight, e.time ? maps::formatRfc3339(*e.time, 3) : std::string(), line);
+      if (!e.flight.empty() && !e.is("rejected_input")) touched.insert(e.flight);
       if (!o.map.empty()) track_map.add(e);
     }
   };
   int pending = 0;
   auto checkpoint = [&](bool force) {
     if (!store || (!force && pending < o.batch)) return;
-    for (const std::string& id : tracker.flights()) {
-      store->putFlight({id, report_of[id], planner::flightStateJson(tracker.state(id)), tracker.routeJson(id)});
-    }
+    for (const std::string& id : touched) store->putState(id, planner::flightStateJson(tracker.state(id)), tracker.routeJson(id));
+    touched.clear();
     // An NMEA epoch still open is read again after a restart: the position stays before it.
     if (resumable) store->setInputLine(o.input, open_epoch_line > 0 ? std::min(line_no, open_epoch_line) : line_no);
     store->commit();

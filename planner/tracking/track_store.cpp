@@ -32,13 +32,15 @@ TrackStore::TrackStore(const std::string& path) : path_(path) {
   // against a process kill (the case a restart resumes from), not against power loss.
   exec("PRAGMA journal_mode=WAL");
   exec("PRAGMA synchronous=NORMAL");
-  exec("CREATE TABLE IF NOT EXISTS flights (id TEXT PRIMARY KEY, report TEXT NOT NULL, state TEXT NOT NULL, route TEXT NOT NULL)");
+  exec("CREATE TABLE IF NOT EXISTS flights (id TEXT PRIMARY KEY, report TEXT NOT NULL, approval TEXT NOT NULL, "
+       "state TEXT NOT NULL, route TEXT NOT NULL)");
   exec("CREATE TABLE IF NOT EXISTS events (seq INTEGER PRIMARY KEY AUTOINCREMENT, flight TEXT, time TEXT, type TEXT NOT NULL, json TEXT NOT NULL)");
   exec("CREATE TABLE IF NOT EXISTS inputs (name TEXT PRIMARY KEY, line INTEGER NOT NULL)");
   auto prepare = [this](const char* sql, sqlite3_stmt** out) {
     if (sqlite3_prepare_v2(db_, sql, -1, out, nullptr) != SQLITE_OK) fail("cannot prepare a statement");
   };
-  prepare("INSERT OR REPLACE INTO flights (id, report, state, route) VALUES (?, ?, ?, ?)", &put_flight_);
+  prepare("INSERT OR REPLACE INTO flights (id, report, approval, state, route) VALUES (?, ?, ?, ?, ?)", &put_flight_);
+  prepare("UPDATE flights SET state = ?, route = ? WHERE id = ?", &put_state_);
   prepare("INSERT INTO events (flight, time, type, json) VALUES (?, ?, ?, ?)", &put_event_);
   prepare("INSERT OR REPLACE INTO inputs (name, line) VALUES (?, ?)", &put_input_);
 }
@@ -48,6 +50,7 @@ TrackStore::~TrackStore() {
   // its events without the states and input position would be stored twice after a restart.
   if (in_batch_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
   sqlite3_finalize(put_flight_);
+  sqlite3_finalize(put_state_);
   sqlite3_finalize(put_event_);
   sqlite3_finalize(put_input_);
   sqlite3_close(db_);
@@ -69,7 +72,8 @@ void TrackStore::exec(const char* sql) const {
 std::vector<StoredFlight> TrackStore::flights() const {
   std::vector<StoredFlight> out;
   Statement st;
-  if (sqlite3_prepare_v2(db_, "SELECT id, report, state, route FROM flights ORDER BY id", -1, &st.s, nullptr) != SQLITE_OK) {
+  if (sqlite3_prepare_v2(db_, "SELECT id, report, approval, state, route FROM flights ORDER BY id", -1, &st.s, nullptr) !=
+      SQLITE_OK) {
     fail("cannot read flights");
   }
   while (sqlite3_step(st.s) == SQLITE_ROW) {
@@ -77,8 +81,9 @@ std::vector<StoredFlight> TrackStore::flights() const {
     f.id = columnText(st.s, 0);
     f.report = columnText(st.s, 1);
     try {
-      f.state = nlohmann::json::parse(columnText(st.s, 2));
-      f.route = nlohmann::json::parse(columnText(st.s, 3));
+      f.approval = nlohmann::json::parse(columnText(st.s, 2));
+      f.state = nlohmann::json::parse(columnText(st.s, 3));
+      f.route = nlohmann::json::parse(columnText(st.s, 4));
     } catch (const nlohmann::json::exception& e) {
       fail("flight " + f.id + " has a damaged record (" + e.what() + ")");
     }
@@ -120,9 +125,19 @@ void TrackStore::putFlight(const StoredFlight& f) {
   sqlite3_reset(put_flight_);
   bindText(put_flight_, 1, f.id);
   bindText(put_flight_, 2, f.report);
-  bindText(put_flight_, 3, f.state.dump());
-  bindText(put_flight_, 4, f.route.dump());
+  bindText(put_flight_, 3, f.approval.dump());
+  bindText(put_flight_, 4, f.state.dump());
+  bindText(put_flight_, 5, f.route.dump());
   if (sqlite3_step(put_flight_) != SQLITE_DONE) fail("cannot store flight " + f.id);
+}
+
+void TrackStore::putState(const std::string& id, const nlohmann::json& state, const nlohmann::json& route) {
+  sqlite3_reset(put_state_);
+  bindText(put_state_, 1, state.dump());
+  bindText(put_state_, 2, route.dump());
+  bindText(put_state_, 3, id);
+  if (sqlite3_step(put_state_) != SQLITE_DONE) fail("cannot store the state of flight " + id);
+  if (sqlite3_changes(db_) != 1) fail("flight " + id + " is not in the database");
 }
 
 void TrackStore::appendEvent(const std::string& type, const std::string& flight, const std::string& time,

@@ -6,8 +6,8 @@
 /// committed batch left it and re-reads the input from there: no accepted fix is lost (a fix
 /// of the batch that was not committed is processed again).
 ///
-/// Tables: flights(id, report, state JSON, route JSON), events(seq, flight, time, type, JSON),
-/// inputs(name, line).
+/// Tables: flights(id, report file, approval report JSON, state JSON, route JSON),
+/// events(seq, flight, time, type, JSON), inputs(name, line).
 
 #include <nlohmann/json.hpp>
 
@@ -24,6 +24,7 @@ namespace skylane::planner {
 struct StoredFlight {
   std::string id;
   std::string report;  ///< the approval report file
+  nlohmann::json approval;  ///< the report itself (a restart does not need the file)
   nlohmann::json state;
   nlohmann::json route;
 };
@@ -46,7 +47,10 @@ class TrackStore {
 
   /// \brief Starts a batch (a transaction); the writes below join it.
   void begin();
+  /// \brief Adds (or replaces) a flight with its approval.
   void putFlight(const StoredFlight& f);
+  /// \brief Updates a stored flight's state and route.
+  void putState(const std::string& id, const nlohmann::json& state, const nlohmann::json& route);
   /// \brief An event as written to the stream (one JSON line) with its type, flight and time.
   void appendEvent(const std::string& type, const std::string& flight, const std::string& time, const std::string& line);
   void setInputLine(const std::string& name, std::size_t line);
@@ -60,6 +64,7 @@ class TrackStore {
   std::string path_;
   sqlite3* db_ = nullptr;
   sqlite3_stmt* put_flight_ = nullptr;
+  sqlite3_stmt* put_state_ = nullptr;
   sqlite3_stmt* put_event_ = nullptr;
   sqlite3_stmt* put_input_ = nullptr;
   bool in_batch_ = false;

@@ -99,7 +99,11 @@ void Tracker::addFlight(const std::string& id, const ApprovedFlight& approval, s
 }
 
 std::string Tracker::addApprovalFile(const std::string& report_path, const std::string& id) {
-  const ApprovedFlight plan = parseApprovalReport(maps::readJsonFile(report_path), report_path);
+  return addApproval(maps::readJsonFile(report_path), report_path, id);
+}
+
+std::string Tracker::addApproval(const json& report, const std::string& report_path, const std::string& id) {
+  const ApprovedFlight plan = parseApprovalReport(report, report_path);
   namespace fs = std::filesystem;
   // The mission as written (from here), where it was at approval time, or beside the report.
   fs::path mission = plan.mission_source;

@@ -125,6 +125,9 @@ class Tracker {
   /// empty, the mission's name. Approvers are shared by mission file. Returns the id.
   /// \throws maps::ParseError naming the report, the field and what was expected.
   std::string addApprovalFile(const std::string& report_path, const std::string& id = {});
+  /// \brief The same from the report's JSON (`report_path` names it in errors and places the
+  /// mission beside it) — a restarted tracker takes its approvals from its database.
+  std::string addApproval(const nlohmann::json& report, const std::string& report_path, const std::string& id = {});
 
   /// \brief Processes one fix; returns its events (the `fix` event last but for a replan).
   [[nodiscard]] std::vector<TrackEvent> process(const TrackFix& fix);
