@@ -13,8 +13,7 @@
 #include "planner/report_formats.hpp"
 #include "planner/tracking/track_fix.hpp"
 #include "planner/tracking/tracker.hpp"
-#include "integrity/sim/sensors.hpp"
-#include "integrity/sim/trajectory.hpp"
+#include "tests/planner/simulated_flight.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -290,35 +289,14 @@ void BM_TrackRawFixes(benchmark::State& state) {
   flight.route = r.route;
   flight.level1 = r.limits.level1;
   flight.level2 = r.limits.level2;
-  const maps::Geodetic origin{r.route.front().lat_rad, r.route.front().lon_rad, r.route.front().h_ell_m};
-  const maps::LocalFrame enu(origin);
-  std::vector<integrity::sim::Waypoint> wps;
-  for (const planner::RoutePoint& p : r.route) wps.push_back({enu.toEnu({p.lat_rad, p.lon_rad, p.h_ell_m}), m.cruise_speed_mps});
-  const integrity::sim::Trajectory traj(origin, wps, 30.0);
-  integrity::sim::SensorSpec spec;
-  spec.model = m.model;
   integrity::sim::FaultSpec fault;
   fault.target = integrity::sim::FaultTarget::kSatellite;
   fault.pick = 0.5;
-  fault.t_start_s = traj.duration_s() / 2.0;
-  fault.t_end_s = traj.duration_s();
+  fault.t_start_s = r.route.back().eta_s / 2.0;
+  fault.t_end_s = r.route.back().eta_s + 60.0;
   fault.magnitude = 60.0;
-  integrity::sim::SensorSimulator sim(traj, approver->orbits(), r.departure, spec, {fault}, 3);
   std::vector<planner::TrackFix> fixes;
-  while (sim.running()) {
-    (void)sim.stepImu();
-    if (!sim.gnssDue()) continue;
-    const integrity::sim::GnssEpoch ep = sim.gnss();
-    planner::TrackFix f;
-    f.flight = "F1";
-    f.time = ep.time;
-    f.lat_rad = sim.truth().geodetic.lat_rad;
-    f.lon_rad = sim.truth().geodetic.lon_rad;
-    f.h_ell_m = sim.truth().geodetic.h_ell_m;
-    for (const integrity::sim::Pseudorange& pr : ep.ranges) f.ranges.push_back({pr.sat, pr.pseudorange_m, pr.sat_ecef_m});
-    f.line = fixes.size() + 1;
-    fixes.push_back(std::move(f));
-  }
+  for (test::SimulatedFix& sf : test::simulateRoute(r, *approver, {fault}, 3)) fixes.push_back(std::move(sf.fix));
   planner::TrackerOptions options;
   options.replan = false;
   std::unique_ptr<planner::Tracker> tracker;

@@ -3,11 +3,10 @@
 // events, and NMEA / JSON-lines agreement.
 #include "planner/tracking/tracker.hpp"
 
-#include "integrity/sim/sensors.hpp"
-#include "integrity/sim/trajectory.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/json_node.hpp"
 #include "maps/text_file.hpp"
+#include "tests/planner/simulated_flight.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -468,31 +467,10 @@ TEST_F(TrackerOnExample, RawFixesWhosePlNeverFitsHal1RerunOnceAndAreNotReplanned
   Tracker tracker;
   tracker.addFlight("F1", example_->flight, example_->approver);
   const ApprovalReport& r = example_->report;
-  const maps::Geodetic origin{r.route.front().lat_rad, r.route.front().lon_rad, r.route.front().h_ell_m};
-  const maps::LocalFrame enu(origin);
-  std::vector<integrity::sim::Waypoint> wps;
-  for (const RoutePoint& p : r.route) {
-    wps.push_back({enu.toEnu({p.lat_rad, p.lon_rad, p.h_ell_m}), example_->approver->mission().cruise_speed_mps});
-  }
-  const integrity::sim::Trajectory traj(origin, wps, 30.0);
-  integrity::sim::SensorSpec spec;
-  spec.model = example_->approver->mission().model;
-  integrity::sim::SensorSimulator sim(traj, example_->approver->orbits(), r.departure, spec, {}, 5);
   std::vector<json> all;
-  std::size_t line = 0;
-  while (sim.running() && line < 40) {
-    (void)sim.stepImu();
-    if (!sim.gnssDue()) continue;
-    const integrity::sim::GnssEpoch ep = sim.gnss();
-    TrackFix f;
-    f.flight = "F1";
-    f.time = ep.time;
-    f.lat_rad = sim.truth().geodetic.lat_rad;
-    f.lon_rad = sim.truth().geodetic.lon_rad;
-    f.h_ell_m = sim.truth().geodetic.h_ell_m;
-    for (const integrity::sim::Pseudorange& pr : ep.ranges) f.ranges.push_back({pr.sat, pr.pseudorange_m, pr.sat_ecef_m});
-    f.line = ++line;
-    for (json& e : tracker.processJson(f)) all.push_back(e);
+  for (const test::SimulatedFix& sf : test::simulateRoute(r, *example_->approver, {}, 5)) {
+    if (sf.fix.line > 40) break;
+    for (json& e : tracker.processJson(sf.fix)) all.push_back(e);
   }
   // THEN one violation by the PL and one rerun event, every fix rerun and outside level 1,
   // and no replan (a corridor of the same width cannot hold the PL)
@@ -524,42 +502,18 @@ TEST(TrackerRaw, SatelliteFaultIsExcludedByTheRerunAndTheFlightRecoversWithoutAR
   tracker.addFlight("F1", a.flight, a.approver);
   // AND the GNSS/INS simulator flying that route, with a 60 m step on one satellite from 60 s to 120 s
   const ApprovalReport& r = a.report;
-  const maps::Geodetic origin{r.route.front().lat_rad, r.route.front().lon_rad, r.route.front().h_ell_m};
-  const maps::LocalFrame enu(origin);
-  std::vector<integrity::sim::Waypoint> wps;
-  for (const RoutePoint& p : r.route) {
-    wps.push_back({enu.toEnu({p.lat_rad, p.lon_rad, p.h_ell_m}), a.approver->mission().cruise_speed_mps});
-  }
-  const integrity::sim::Trajectory traj(origin, wps, 30.0);
-  integrity::sim::SensorSpec spec;
-  spec.model = a.approver->mission().model;
   integrity::sim::FaultSpec fault;
   fault.target = integrity::sim::FaultTarget::kSatellite;
   fault.pick = 0.5;
   fault.t_start_s = 60.0;
   fault.t_end_s = 120.0;
   fault.magnitude = 60.0;
-  integrity::sim::SensorSimulator sim(traj, a.approver->orbits(), r.departure, spec, {fault}, 11);
   int reruns = 0, in_fault = 0, before = 0;
-  std::size_t line = 0;
   std::vector<json> all;
-  while (sim.running()) {
-    (void)sim.stepImu();
-    if (!sim.gnssDue()) continue;
-    const integrity::sim::GnssEpoch ep = sim.gnss();
-    TrackFix f;
-    f.flight = "F1";
-    f.time = ep.time;
-    f.lat_rad = sim.truth().geodetic.lat_rad;  // the reported position only starts the WLS
-    f.lon_rad = sim.truth().geodetic.lon_rad;
-    f.h_ell_m = sim.truth().geodetic.h_ell_m + 5.0;
-    std::optional<integrity::SatId> faulty;
-    for (const integrity::sim::Pseudorange& pr : ep.ranges) {
-      f.ranges.push_back({pr.sat, pr.pseudorange_m, pr.sat_ecef_m});
-      if (pr.injected_m != 0.0) faulty = pr.sat;
-    }
-    f.pl_source = PlSource::kRaw;
-    f.line = ++line;
+  // (the reported height is 5 m off: it only starts skylane's own solution)
+  for (const test::SimulatedFix& sf : test::simulateRoute(r, *a.approver, {fault}, 11, 5.0)) {
+    const TrackFix& f = sf.fix;
+    const std::optional<integrity::SatId>& faulty = sf.faulty;
     const auto ev = tracker.processJson(f);
     ASSERT_FALSE(ev.empty());
     const json& fix = ev.back();
@@ -570,7 +524,7 @@ TEST(TrackerRaw, SatelliteFaultIsExcludedByTheRerunAndTheFlightRecoversWithoutAR
       ++in_fault;
       // THEN the first pass's PL leaves level 1, the rerun excludes the faulty satellite and the
       // PL after it fits again
-      ASSERT_EQ(rr.size(), 1u) << "t = " << ep.t_s << ": " << fix.dump();
+      ASSERT_EQ(rr.size(), 1u) << "t = " << sf.t_s << ": " << fix.dump();
       ASSERT_EQ(rr[0].at("excluded").size(), 1u);
       EXPECT_EQ(rr[0].at("excluded")[0], faulty->str());
       EXPECT_GT(rr[0].at("hpl_before_m").get<double>(), 24.0);
@@ -579,9 +533,9 @@ TEST(TrackerRaw, SatelliteFaultIsExcludedByTheRerunAndTheFlightRecoversWithoutAR
       ++reruns;
     } else {
       ++before;
-      EXPECT_TRUE(rr.empty()) << "t = " << ep.t_s << ": " << rr[0].dump();
+      EXPECT_TRUE(rr.empty()) << "t = " << sf.t_s << ": " << rr[0].dump();
     }
-    EXPECT_EQ(fix.at("verdict"), "inside") << "t = " << ep.t_s << ": " << fix.dump();
+    EXPECT_EQ(fix.at("verdict"), "inside") << "t = " << sf.t_s << ": " << fix.dump();
   }
   EXPECT_GE(in_fault, 59);
   EXPECT_EQ(reruns, in_fault);
