@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -98,6 +99,24 @@ inline std::string nmeaAngle(double deg, bool lat) {
   std::snprintf(buf, sizeof buf, lat ? "%02d%010.7f,%c" : "%03d%010.7f,%c", d, (a - d) * 60.0,
                 lat ? (deg >= 0 ? 'N' : 'S') : (deg >= 0 ? 'E' : 'W'));
   return buf;
+}
+
+/// What a shell command did: its exit status (−1 when it did not exit) and its standard output.
+struct CommandResult {
+  int status = -1;
+  std::string out;
+};
+
+/// Runs `command` with /bin/sh and collects its standard output.
+inline CommandResult runCommand(const std::string& command) {
+  CommandResult r;
+  FILE* p = popen(command.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  while (fgets(buf, sizeof buf, p)) r.out += buf;
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
 }
 
 }  // namespace skylane::test

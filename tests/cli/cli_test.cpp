@@ -15,22 +15,10 @@
 namespace skylane {
 namespace {
 
-struct RunResult {
-  int status = -1;
-  std::string out;  ///< stdout and stderr together
-};
+using RunResult = test::CommandResult;
 
-RunResult run(const std::string& args) {
-  const std::string cmd = std::string(SKYLANE_BINARY) + " " + args + " 2>&1";
-  RunResult r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+/// The skylane command with these arguments, stdout and stderr together.
+RunResult run(const std::string& args) { return test::runCommand(std::string(SKYLANE_BINARY) + " " + args + " 2>&1"); }
 
 std::string writeTemp(const std::string& name, const std::string& text) {
   const std::string path = test::scratchPath(name);

@@ -21,23 +21,14 @@ namespace {
 
 using nlohmann::json;
 
-struct RunResult {
-  int status = -1;
-  std::string out;  ///< stdout (and stderr when asked)
-};
+using RunResult = test::CommandResult;
 
+/// A bash script (written to a scratch file, so it may quote freely); its standard output.
 RunResult sh(const std::string& script) {
   static int n = 0;
   const std::string file = test::scratchPath("script-" + std::to_string(++n) + ".sh");
   std::ofstream(file) << script << "\n";
-  RunResult r;
-  FILE* p = popen(("bash " + file).c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
+  return test::runCommand("bash " + file);
 }
 
 const std::string kBin = SKYLANE_BINARY;
