@@ -51,17 +51,11 @@ struct TrackOptions {
   std::string date;
   std::string db;
   std::string out;
-  std::string level1 = "3/5";
+  std::string level1 = "3/5";  ///< parsed into tracker.level1_m/_n
   std::string level2 = "1/1";
-  int recover_after = 2;
-  double stale_after_s = 3.0;
-  double cooldown_s = 10.0;
-  double max_jump_s = 300.0;
   bool no_replan = false;
-  bool replan_on_pl = false;
+  planner::TrackerOptions tracker;  ///< the defaults live there; the options write into it
   int batch = 200;
-  double horizon_m = 50.0;
-  int jump_confirm = 3;
   std::string map;
 };
 
@@ -287,17 +281,10 @@ void runTrack(const TrackOptions& o) {
   if (o.format != "jsonl" && o.format != "nmea" && o.format != "rinex") {
     throw ParseError("--format", 0, "--format", o.format, "jsonl, nmea or rinex");
   }
-  planner::TrackerOptions topt;
+  planner::TrackerOptions topt = o.tracker;
   std::tie(topt.level1_m, topt.level1_n) = parseMofN(o.level1, "--level1");
   std::tie(topt.level2_m, topt.level2_n) = parseMofN(o.level2, "--level2");
-  topt.recover_after = o.recover_after;
-  topt.stale_after_s = o.stale_after_s;
-  topt.replan_cooldown_s = o.cooldown_s;
-  topt.max_time_jump_s = o.max_jump_s;
   topt.replan = !o.no_replan;
-  topt.replan_on_pl_exceedance = o.replan_on_pl;
-  topt.horizon_m = o.horizon_m;
-  topt.jump_confirm = o.jump_confirm;
   planner::Tracker tracker(topt);
 
   std::unique_ptr<planner::TrackStore> store;
@@ -563,14 +550,17 @@ void addTrackCommands(CLI::App& app) {
   c->add_option("--out", o->out, "append the events to this file (default: stdout)");
   c->add_option("--level1", o->level1, "level-1 persistence M/N before a replan (default 3/5)");
   c->add_option("--level2", o->level2, "level-2, zone and obstacle persistence M/N (default 1/1: at once)");
-  c->add_option("--recover-after", o->recover_after, "fixes in a row inside a level before 'recovered' (default 2)");
-  c->add_option("--stale-after", o->stale_after_s, "seconds without a fix before 'stale' (default 3)");
-  c->add_option("--cooldown", o->cooldown_s, "least seconds between two replans of a flight (default 10)");
-  c->add_option("--max-time-jump", o->max_jump_s, "a fix more than this many seconds after the last is rejected (default 300)");
-  c->add_option("--jump-confirm", o->jump_confirm, "fixes in order on a jumped timeline before it is taken (default 3)");
+  planner::TrackerOptions& t = o->tracker;
+  c->add_option("--recover-after", t.recover_after, "fixes in a row inside a level before 'recovered'")->capture_default_str();
+  c->add_option("--stale-after", t.stale_after_s, "seconds without a fix before 'stale'")->capture_default_str();
+  c->add_option("--cooldown", t.replan_cooldown_s, "least seconds between two replans of a flight")->capture_default_str();
+  c->add_option("--max-time-jump", t.max_time_jump_s, "a fix more than this many seconds from the last is a time jump")
+      ->capture_default_str();
+  c->add_option("--jump-confirm", t.jump_confirm, "fixes in order on a jumped timeline before it is taken")->capture_default_str();
   c->add_flag("--no-replan", o->no_replan, "report violations without replanning");
-  c->add_flag("--replan-on-pl", o->replan_on_pl, "also replan when level 1 is violated by the PLs alone");
-  c->add_option("--horizon", o->horizon_m, "list zones and obstacles within this distance of a volume in its fix event [m] (default 50)");
+  c->add_flag("--replan-on-pl", t.replan_on_pl_exceedance, "also replan when level 1 is violated by the PLs alone");
+  c->add_option("--horizon", t.horizon_m, "list zones and obstacles within this distance of a volume in its fix event [m]")
+      ->capture_default_str();
   c->add_option("--map", o->map, "write an SVG map: zones, buildings, routes and corridors (approved and replanned), the track by verdict, events");
   c->add_option("--batch", o->batch, "fixes per database transaction (default 200)");
   c->callback([o]() { runTrack(*o); });
