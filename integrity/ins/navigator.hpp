@@ -95,6 +95,11 @@ class Navigator {
                        std::optional<double> heading_rad);
 
   [[nodiscard]] const InsEkf& filter() const { return ekf_; }
+  [[nodiscard]] const NavigatorConfig& config() const { return cfg_; }
+  /// \brief How many satellites step 1 may exclude from the next epochs on (a deeper FDE rerun).
+  void setMaxExclusions(int n) { cfg_.max_exclusions = n; }
+  /// \brief Whether the flow is in seed 001's GNSS-alone mode after an IMU fault.
+  [[nodiscard]] bool degraded() const { return degraded_; }
 
  private:
   NavigatorConfig cfg_;

@@ -18,11 +18,7 @@ constexpr double kConvergence_m = 1e-4;
 /// Below this radius a linearisation point is not on or above the Earth (no usable start).
 constexpr double kMinEarthRadius_m = 6.0e6;
 
-struct Located {
-  SatId sat;
-  double pr_m = 0.0;
-  Eigen::Vector3d p_sat = Eigen::Vector3d::Zero();
-};
+using Located = LocatedRange;
 
 /// The linearised problem at a converged point.
 struct Linearised {
@@ -48,10 +44,10 @@ Linearised converge(const std::vector<Located>& located, const std::vector<int>&
     std::vector<int> index;
     for (int k : active) {
       const Located& s = located[static_cast<std::size_t>(k)];
-      const maps::LookAngles look = maps::lookAngles(x, s.p_sat);
+      const maps::LookAngles look = maps::lookAngles(x, s.sat_ecef_m);
       if (look.elevation_rad < cfg.elevation_mask_rad) continue;
       looks.push_back({s.sat, look});
-      ranges.push_back((s.p_sat - x).norm());
+      ranges.push_back((s.sat_ecef_m - x).norm());
       index.push_back(k);
     }
     Geometry g = buildGeometry(looks, cfg.model, tau);
@@ -122,14 +118,10 @@ PlSummary plOf(const Geometry& g, const LiveFixConfig& cfg) {
 
 }  // namespace
 
-LiveFix solveLiveFix(const std::vector<RawRange>& ranges, const maps::Geodetic& initial, const GpsTime& t,
-                     const LiveFixConfig& cfg, bool exclude, const OrbitSource* orbits) {
-  if (!std::isfinite(initial.lat_rad) || !std::isfinite(initial.lon_rad) || !std::isfinite(initial.h_ell_m)) {
-    throw std::invalid_argument("solveLiveFix: the initial position is not finite");
-  }
-  LiveFix out;
-  const Eigen::Vector3d x0 = maps::geodeticToEcef(initial);
-  std::vector<Located> located;
+std::vector<LocatedRange> locateRanges(const std::vector<RawRange>& ranges, const Eigen::Vector3d& x0_ecef,
+                                       const GpsTime& t, const OrbitSource* orbits, std::vector<SatId>& missing) {
+  std::vector<LocatedRange> located;
+  located.reserve(ranges.size());
   std::vector<VisibleSatellite> visible;
   bool looked_up = false;
   for (const RawRange& r : ranges) {
@@ -140,16 +132,27 @@ LiveFix solveLiveFix(const std::vector<RawRange>& ranges, const maps::Geodetic& 
       continue;
     }
     if (orbits && !looked_up) {
-      visible = orbits->visible(x0, t, -M_PI / 2.0);  // every satellite above the horizon plane or not
+      visible = orbits->visible(x0_ecef, t, -M_PI / 2.0);  // every satellite above the horizon plane or not
       looked_up = true;
     }
     const auto it = std::find_if(visible.begin(), visible.end(), [&](const VisibleSatellite& v) { return v.sat == r.sat; });
     if (it == visible.end()) {
-      out.missing_orbit.push_back(r.sat);
+      missing.push_back(r.sat);
       continue;
     }
     located.push_back({r.sat, r.pr_m, it->p_ecef});
   }
+  return located;
+}
+
+LiveFix solveLiveFix(const std::vector<RawRange>& ranges, const maps::Geodetic& initial, const GpsTime& t,
+                     const LiveFixConfig& cfg, bool exclude, const OrbitSource* orbits) {
+  if (!std::isfinite(initial.lat_rad) || !std::isfinite(initial.lon_rad) || !std::isfinite(initial.h_ell_m)) {
+    throw std::invalid_argument("solveLiveFix: the initial position is not finite");
+  }
+  LiveFix out;
+  const Eigen::Vector3d x0 = maps::geodeticToEcef(initial);
+  const std::vector<Located> located = locateRanges(ranges, x0, t, orbits, out.missing_orbit);
   if (!out.missing_orbit.empty()) out.note += std::to_string(out.missing_orbit.size()) + " satellite(s) without an orbit; ";
   if (x0.norm() < kMinEarthRadius_m) {
     out.note += "the reported position is not near the Earth's surface";

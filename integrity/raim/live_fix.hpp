@@ -44,6 +44,19 @@ struct RawRange {
   std::optional<Eigen::Vector3d> sat_ecef_m;
 };
 
+/// \brief A pseudorange with its satellite's position.
+struct LocatedRange {
+  SatId sat;
+  double pr_m = 0.0;
+  Eigen::Vector3d sat_ecef_m = Eigen::Vector3d::Zero();
+};
+
+/// \brief The ranges with their satellites' positions: as given, else from `orbits` (transmit time,
+/// Sagnac: OrbitSource::visible seen from `x0_ecef` at `t`); a range with neither goes to `missing`.
+/// \throws std::invalid_argument for a non-finite pseudorange or satellite position.
+[[nodiscard]] std::vector<LocatedRange> locateRanges(const std::vector<RawRange>& ranges, const Eigen::Vector3d& x0_ecef,
+                                                     const GpsTime& t, const OrbitSource* orbits, std::vector<SatId>& missing);
+
 /// \brief What a live epoch is solved with.
 struct LiveFixConfig {
   IntegrityMethod method = IntegrityMethod::kRaim;

@@ -22,6 +22,7 @@ const char* plSourceName(PlSource s) {
     case PlSource::kRaw: return "raw";
     case PlSource::kNmeaGst: return "nmea_gst";
     case PlSource::kIns: return "ins";
+    case PlSource::kGnssIns: return "gnss_ins";
   }
   return "?";
 }
@@ -37,7 +38,8 @@ std::pair<double, double> insNominalPl(const InsUncertainty& ins) {
 TrackFix parseTrackFixJson(const json& doc, const std::string& source) {
   const maps::JsonNode root{doc, "$", source};
   if (!doc.is_object()) root.fail("one JSON object per line {\"time\", \"lat\", \"lon\", \"h_ell_m\", …}");
-  root.requireKnownFields({"flight", "vehicle", "time", "lat", "lon", "h_ell_m", "hpl_m", "vpl_m", "pseudoranges", "imu"});
+  root.requireKnownFields({"flight", "vehicle", "time", "lat", "lon", "h_ell_m", "hpl_m", "vpl_m", "pseudoranges", "imu",
+                          "velocity_enu_mps", "attitude_deg", "baro_h_m", "mag_heading_deg"});
   TrackFix f;
   f.source = source;
   if (root.has("flight") && root.has("vehicle")) root.at("vehicle").fail("one of \"flight\" and \"vehicle\", not both");
@@ -97,19 +99,80 @@ TrackFix parseTrackFixJson(const json& doc, const std::string& source) {
   }
   if (root.has("imu")) {
     const maps::JsonNode imu = root.at("imu");
-    imu.requireKnownFields({"grade", "sigma_n_m", "sigma_e_m", "sigma_u_m"});
-    InsUncertainty u;
-    const std::string grade = imu.at("grade").str();
-    if (grade == "aviation") u.grade = 0;
-    else if (grade == "tactical") u.grade = 1;
-    else if (grade == "consumer") u.grade = 2;
+    imu.requireKnownFields({"grade", "sigma_n_m", "sigma_e_m", "sigma_u_m", "increments"});
+    int grade = 2;
+    const std::string name = imu.at("grade").str();
+    if (name == "aviation") grade = 0;
+    else if (name == "tactical") grade = 1;
+    else if (name == "consumer") grade = 2;
     else imu.at("grade").fail("aviation, tactical or consumer (seed 000 Table 1)");
-    for (auto [key, dst] : {std::pair{"sigma_n_m", &u.sigma_n_m}, {"sigma_e_m", &u.sigma_e_m}, {"sigma_u_m", &u.sigma_u_m}}) {
-      const maps::JsonNode n = imu.at(key);
-      if (n.number() < 0.0) n.fail("a standard deviation ≥ 0 m");
-      *dst = n.number();
+    if (imu.has("increments")) {
+      for (const char* key : {"sigma_n_m", "sigma_e_m", "sigma_u_m"}) {
+        if (imu.has(key)) imu.at(key).fail("either the INS σ's or the IMU increments, not both");
+      }
+      ImuRecord rec;
+      rec.grade = grade;
+      const maps::JsonNode list = imu.at("increments");
+      const std::size_t n = list.array().size();
+      if (n == 0 || n > 10000) list.fail("1 to 10,000 increments [dt_s, dθx, dθy, dθz, dvx, dvy, dvz]");
+      rec.increments.reserve(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const maps::JsonNode row = list.item(i);
+        if (row.array().size() != 7) row.fail("[dt_s, dθx, dθy, dθz (rad), dvx, dvy, dvz (m/s)]");
+        double v[7];
+        for (std::size_t k = 0; k < 7; ++k) v[k] = row.item(k).number();
+        ImuIncrement inc;
+        inc.dt_s = v[0];
+        if (!(inc.dt_s > 0.0 && inc.dt_s <= 1.0)) row.item(0).fail("an interval in (0, 1] s");
+        inc.dtheta_rad = Eigen::Vector3d(v[1], v[2], v[3]);
+        inc.dv_mps = Eigen::Vector3d(v[4], v[5], v[6]);
+        // Bounds: 2000 °/s and 50 g over the interval, far beyond any airframe's.
+        if (inc.dtheta_rad.norm() > 35.0 * inc.dt_s) row.fail("an angle increment below 35 rad/s × dt_s");
+        if (inc.dv_mps.norm() > 500.0 * inc.dt_s) row.fail("a velocity increment below 500 m/s² × dt_s");
+        rec.increments.push_back(inc);
+      }
+      if (rec.span_s() > 60.0) list.fail("increments spanning at most 60 s");
+      f.imu = std::move(rec);
+    } else {
+      InsUncertainty u;
+      u.grade = grade;
+      for (auto [key, dst] : {std::pair{"sigma_n_m", &u.sigma_n_m}, {"sigma_e_m", &u.sigma_e_m}, {"sigma_u_m", &u.sigma_u_m}}) {
+        const maps::JsonNode n = imu.at(key);
+        if (n.number() < 0.0) n.fail("a standard deviation ≥ 0 m");
+        *dst = n.number();
+      }
+      f.ins = u;
     }
-    f.ins = u;
+  }
+  if (root.has("velocity_enu_mps")) {
+    const maps::JsonNode v = root.at("velocity_enu_mps");
+    if (v.array().size() != 3) v.fail("[ve, vn, vu] in m/s");
+    Eigen::Vector3d vel;
+    for (int k = 0; k < 3; ++k) vel[k] = v.item(static_cast<std::size_t>(k)).number();
+    if (vel.norm() > 400.0) v.fail("a velocity below 400 m/s");
+    f.velocity_enu_mps = vel;
+  }
+  if (root.has("attitude_deg")) {
+    const maps::JsonNode a = root.at("attitude_deg");
+    a.requireKnownFields({"roll", "pitch", "heading"});
+    const double roll = a.at("roll").number(), pitch = a.at("pitch").number(), heading = a.at("heading").number();
+    if (std::abs(roll) > 180.0) a.at("roll").fail("a roll in [-180, 180] degrees");
+    if (std::abs(pitch) > 90.0) a.at("pitch").fail("a pitch in [-90, 90] degrees");
+    if (heading < -360.0 || heading > 360.0) a.at("heading").fail("a heading in [-360, 360] degrees");
+    f.attitude_rad = Eigen::Vector3d(maps::deg2rad(roll), maps::deg2rad(pitch), maps::deg2rad(heading));
+  }
+  if (root.has("baro_h_m")) {
+    const maps::JsonNode b = root.at("baro_h_m");
+    if (std::abs(b.number()) > 1e5) b.fail("a barometric height within ±100 km");
+    f.baro_h_m = b.number();
+  }
+  if (root.has("mag_heading_deg")) {
+    const maps::JsonNode m = root.at("mag_heading_deg");
+    if (m.number() < -360.0 || m.number() > 360.0) m.fail("a heading in [-360, 360] degrees");
+    f.mag_heading_rad = maps::deg2rad(m.number());
+  }
+  if (f.imu && f.ranges.empty() && !f.hpl_m) {
+    root.at("imu").fail("pseudoranges with the IMU increments (GNSS/INS), or hpl_m and vpl_m");
   }
   if (!f.hpl_m && f.ranges.empty() && !f.ins) {
     root.fail("a protection level: hpl_m and vpl_m, pseudoranges, or an imu block");

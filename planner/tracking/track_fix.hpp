@@ -8,6 +8,10 @@
 ///    "hpl_m": 1.1, "vpl_m": 1.3,
 ///    "pseudoranges": [{"sat": "G05", "pr_m": 21456789.123, "ecef_m": [x, y, z]}, …],
 ///    "imu": {"grade": "tactical", "sigma_n_m": 0.4, "sigma_e_m": 0.4, "sigma_u_m": 0.7}}
+/// or, with the IMU's own increments since the previous fix (GNSS/INS, below):
+///    "imu": {"grade": "tactical", "increments": [[dt_s, dθx, dθy, dθz, dvx, dvy, dvz], …]},
+///    "velocity_enu_mps": [ve, vn, vu], "attitude_deg": {"roll": r, "pitch": p, "heading": h},
+///    "baro_h_m": 519.2, "mag_heading_deg": 87.0
 /// - `flight` (or `vehicle`) names the approval; it may be left out when only one is tracked;
 /// - `hpl_m`/`vpl_m`: the onboard protection levels (both or neither);
 /// - `pseudoranges`: corrected pseudoranges (integrity/raim/live_fix.hpp), each with the
@@ -16,6 +20,15 @@
 /// - `imu`: the onboard INS's position σ's (north, east, up) and grade; the PL is then
 ///   max(GNSS PL, seed 000's nominal-INS PL) — HPL_IMU,nominal = Q⁻¹(λ·P_nom,H)·√(σ_N² + σ_E²),
 ///   VPL alike with σ_U (seed 000; λ by grade, P_nom = ⅓ of 0.5e-7 as Seed000Config).
+/// - `imu.increments`: the IMU's body-frame increments (Δθ in rad, Δv in m/s, axes forward-left-
+///   up, each over dt_s ≤ 1 s) from the previous fix to this one. With pseudoranges, skylane runs
+///   seed 001's GNSS/INS flow (integrity/ins/navigator.hpp: LSR FDE, tightly coupled EKF, the IMU
+///   innovation test, seed 001's fault-mode PLs; the filter's noise model is the grade's). The
+///   filter is aligned at a fix that gives `velocity_enu_mps` and `attitude_deg` (heading
+///   clockwise from north, pitch nose up, roll right wing down) — the onboard navigation's —
+///   and skylane's snapshot position; until then, and at that fix, the snapshot PLs are used;
+/// - `baro_h_m` (barometric height, ellipsoidal, bias estimated) and `mag_heading_deg` (heading
+///   from the magnetometer, declination removed) aid the filter when given.
 /// A fix needs a protection level from one of these.
 
 #include "integrity/gnss/nmea.hpp"
@@ -36,10 +49,30 @@ struct InsUncertainty {
   double sigma_n_m = 0.0, sigma_e_m = 0.0, sigma_u_m = 0.0;
 };
 
-/// \brief Where a fix's protection levels came from.
-enum class PlSource { kOnboard, kRaw, kNmeaGst, kIns };
+/// \brief One IMU interval: body-frame (forward-left-up) angle and velocity increments.
+struct ImuIncrement {
+  double dt_s = 0.0;
+  Eigen::Vector3d dtheta_rad = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dv_mps = Eigen::Vector3d::Zero();
+};
 
-/// \brief "onboard", "raw", "nmea_gst", "ins" (the INS block alone).
+/// \brief The IMU's increments from the previous fix to this one, and its grade (0 aviation,
+/// 1 tactical, 2 consumer; integrity/sim/sensors.hpp gives each grade's error figures).
+struct ImuRecord {
+  int grade = 2;
+  std::vector<ImuIncrement> increments;
+  [[nodiscard]] double span_s() const {
+    double s = 0.0;
+    for (const ImuIncrement& i : increments) s += i.dt_s;
+    return s;
+  }
+};
+
+/// \brief Where a fix's protection levels came from.
+enum class PlSource { kOnboard, kRaw, kNmeaGst, kIns, kGnssIns };
+
+/// \brief "onboard", "raw", "nmea_gst", "ins" (the INS σ block alone), "gnss_ins" (seed 001's
+/// flow over the fix's pseudoranges and IMU increments).
 [[nodiscard]] const char* plSourceName(PlSource s);
 
 /// \brief One fix of a stream.
@@ -51,6 +84,10 @@ struct TrackFix {
   PlSource pl_source = PlSource::kOnboard;
   std::vector<integrity::RawRange> ranges;     ///< raw pseudoranges, when given
   std::optional<InsUncertainty> ins;
+  std::optional<ImuRecord> imu;                ///< raw IMU increments, when given
+  std::optional<Eigen::Vector3d> velocity_enu_mps;
+  std::optional<Eigen::Vector3d> attitude_rad;  ///< roll, pitch, heading
+  std::optional<double> baro_h_m, mag_heading_rad;
   std::string source;  ///< "file:line"
   std::size_t line = 0;
 };

@@ -1,5 +1,8 @@
 #include "planner/tracking/tracker.hpp"
 
+#include "integrity/ins/navigator.hpp"
+#include "integrity/sim/sensors.hpp"
+#include "integrity/sim/trajectory.hpp"
 #include "maps/file_digest.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/json_node.hpp"
@@ -24,6 +27,10 @@ double roundDeg(double rad) { return std::round(maps::rad2deg(rad) * 1e8) / 1e8;
 json metres(double v) { return std::isfinite(v) ? json(roundMm(v)) : json(nullptr); }
 
 constexpr int kLevels = 4;
+/// The filter's initial position σ per axis at alignment: a snapshot's error is a few metres.
+constexpr double kAlignPositionSigma_m = 10.0;
+/// How far the IMU increments' span may differ from the time between two fixes (+1 %).
+constexpr double kSpanTolerance_s = 0.02;
 
 /// Pushes v into a window of at most n values and returns how many are true.
 int pushWindow(std::vector<bool>& w, bool v, int n) {
@@ -50,6 +57,101 @@ struct Tracker::Flight {
   std::vector<Eigen::Vector3d> stops;  ///< the mission's points (map frame)
   integrity::LiveFixConfig live;
   FlightState st;
+  // GNSS/INS (seed 001's flow) for fixes with IMU increments. Not persisted: a restarted tracker
+  // aligns the filter again at the next fix with velocity and attitude.
+  std::unique_ptr<integrity::ins::Navigator> nav;
+  int nav_grade = -1;
+  maps::GpsTime nav_t0, nav_time;
+
+  /// Seed 001's flow with the mission's error model and mask and the grade's IMU figures (the
+  /// filter assumes the grade's datasheet values, integrity/sim/sensors.hpp).
+  [[nodiscard]] integrity::ins::NavigatorConfig navigatorConfig(int grade) const {
+    integrity::ins::NavigatorConfig c;
+    const integrity::sim::ImuSpec imu = integrity::sim::imuSpec(static_cast<integrity::sim::ImuGrade>(grade));
+    c.ekf.accel_noise_mps_rts = imu.accel_noise_mps_rts;
+    c.ekf.gyro_noise_rad_rts = imu.gyro_noise_rad_rts;
+    c.ekf.accel_bias_rw_mps2_rts = imu.accel_bias_rw_mps2_rts;
+    c.ekf.gyro_bias_rw_radps_rts = imu.gyro_bias_rw_radps_rts;
+    c.ekf.accel_bias_mps2 = imu.accel_bias_mps2;
+    c.ekf.gyro_bias_radps = imu.gyro_bias_radps;
+    c.ekf.initial_position_m = kAlignPositionSigma_m;
+    c.model = live.model;
+    c.elevation_mask_rad = live.elevation_mask_rad;
+    c.seed000.lambda = integrity::ins::seed000Lambda(grade);
+    c.seed000.phmi_h = c.fault_modes.risk.i_req * (1.0 - c.fault_modes.risk.vertical_share);
+    c.seed000.phmi_v = c.fault_modes.risk.i_req * c.fault_modes.risk.vertical_share;
+    c.compute_araim = false;  // the snapshot ARAIM beside the flow is not used here
+    return c;
+  }
+
+  /// The fix's pseudoranges above the mask seen from r, with their satellites.
+  [[nodiscard]] std::vector<integrity::ins::PseudorangeInput> navRanges(const TrackFix& fix, const Eigen::Vector3d& r) const {
+    std::vector<integrity::SatId> missing;
+    std::vector<integrity::ins::PseudorangeInput> out;
+    for (const integrity::LocatedRange& l : integrity::locateRanges(fix.ranges, r, fix.time, &approver->orbits(), missing)) {
+      if (maps::lookAngles(r, l.sat_ecef_m).elevation_rad < live.elevation_mask_rad) continue;
+      out.push_back({l.sat, l.sat_ecef_m, l.pr_m});
+    }
+    return out;
+  }
+
+  /// One epoch of `n`: the fix's IMU increments, then its pseudoranges and aiding.
+  integrity::ins::NavigatorEpoch runInsEpoch(integrity::ins::Navigator& n, const TrackFix& fix) const {
+    for (const ImuIncrement& i : fix.imu->increments) n.propagate(i.dtheta_rad, i.dv_mps, i.dt_s);
+    return n.epoch(fix.time - nav_t0, navRanges(fix, n.filter().nav().r_ecef_m), fix.baro_h_m, fix.mag_heading_rad);
+  }
+
+  /// The filter's epoch for a fix with IMU increments, when the filter is aligned and the
+  /// increments continue it (they must span the time since its last epoch; else it aligns
+  /// again). `before` keeps the filter as it was, for a monitoring rerun.
+  std::optional<integrity::ins::NavigatorEpoch> insEpoch(const TrackFix& fix, std::string& note,
+                                                         std::optional<integrity::ins::Navigator>& before) {
+    if (!nav) return std::nullopt;
+    const double gap = fix.time - nav_time, span = fix.imu->span_s();
+    char buf[160];
+    if (fix.imu->grade != nav_grade) {
+      std::snprintf(buf, sizeof buf, "GNSS/INS: the IMU grade changed; the filter aligns again");
+    } else if (std::abs(span - gap) > kSpanTolerance_s + 0.01 * gap) {
+      std::snprintf(buf, sizeof buf, "GNSS/INS: the IMU increments span %.3f s but the fixes are %.3f s apart; the filter aligns again",
+                    span, gap);
+    } else {
+      before.emplace(*nav);
+      integrity::ins::NavigatorEpoch ep = runInsEpoch(*nav, fix);
+      nav_time = fix.time;
+      return ep;
+    }
+    nav.reset();
+    note = buf;
+    return std::nullopt;
+  }
+
+  /// Aligns the filter at a snapshot solution with the fix's velocity and attitude.
+  void align(const TrackFix& fix, const integrity::LiveFix& snap, std::string& note) {
+    if (!fix.velocity_enu_mps || !fix.attitude_rad) {
+      if (note.empty()) note = "GNSS/INS not aligned: the fix gives no velocity_enu_mps and attitude_deg";
+      return;
+    }
+    integrity::ins::NavState s;
+    s.r_ecef_m = snap.p_ecef;
+    const Eigen::Matrix3d R_enu_ecef = maps::rotationEcefToEnu(snap.position.lat_rad, snap.position.lon_rad);
+    s.v_ecef_mps = R_enu_ecef.transpose() * *fix.velocity_enu_mps;
+    const Eigen::Vector3d& a = *fix.attitude_rad;
+    s.C_ecef_body = R_enu_ecef.transpose() * integrity::sim::bodyToEnu(a.z(), a.y(), a.x());
+    // The receiver clock: the mean residual of the satellites the snapshot used.
+    std::vector<integrity::SatId> missing;
+    double sum = 0.0;
+    int count = 0;
+    for (const integrity::LocatedRange& l : integrity::locateRanges(fix.ranges, s.r_ecef_m, fix.time, &approver->orbits(), missing)) {
+      if (std::find(snap.used.begin(), snap.used.end(), l.sat) == snap.used.end()) continue;
+      sum += l.pr_m - (l.sat_ecef_m - s.r_ecef_m).norm();
+      ++count;
+    }
+    if (count == 0) return;
+    nav = std::make_unique<integrity::ins::Navigator>(navigatorConfig(fix.imu->grade), s, sum / count, 0.0);
+    nav_grade = fix.imu->grade;
+    nav_t0 = nav_time = fix.time;
+    if (note.empty()) note = "GNSS/INS aligned at the snapshot position with the fix's velocity and attitude";
+  }
 
   void buildBoxes() {
     std::vector<Eigen::Vector3d> path;
@@ -203,6 +305,12 @@ json TrackEvent::toJson() const {
   j["vpl_m"] = metres(f.vpl_m);
   j["pl_source"] = plSourceName(f.pl_source);
   if (f.fault_detected) j["fault_detected"] = *f.fault_detected;
+  if (!f.excluded.empty()) {
+    json ex = json::array();
+    for (const integrity::SatId& s : f.excluded) ex.push_back(s.str());
+    j["excluded"] = ex;
+  }
+  if (f.ins_degraded) j["ins_degraded"] = *f.ins_degraded;
   j["verdict"] = geofence::verdictName(f.verdict.verdict);
   j["violated"] = f.verdict.violated ? json(geofence::levelName(*f.verdict.violated)) : json(nullptr);
   json levels = json::object();
@@ -348,6 +456,15 @@ std::string TrackEvent::jsonLine() const {
   w.open('{');
   w.key("event");
   w.string(type);
+  if (!f.excluded.empty()) {
+    w.key("excluded");
+    w.open('[');
+    for (const integrity::SatId& s : f.excluded) {
+      w.item();
+      w.string(s.str());
+    }
+    w.close(']');
+  }
   if (f.fault_detected) {
     w.key("fault_detected");
     w.boolean(*f.fault_detected);
@@ -360,6 +477,10 @@ std::string TrackEvent::jsonLine() const {
   w.number(roundMm(f.h_ell_m));
   w.key("hpl_m");
   w.metres(f.hpl_m);
+  if (f.ins_degraded) {
+    w.key("ins_degraded");
+    w.boolean(*f.ins_degraded);
+  }
   w.key("lat");
   w.number(roundDeg(f.lat_rad));
   w.key("levels");
@@ -529,13 +650,31 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   if (!fix.hpl_m && fix.ins) source = PlSource::kIns;
   std::optional<integrity::LiveFix> first;
   std::string note;
-  if (!fix.ranges.empty()) {
+  std::optional<integrity::ins::NavigatorEpoch> ins_ep;
+  std::optional<integrity::ins::Navigator> ins_before;
+  if (fix.imu && !fix.ranges.empty()) {
+    ins_ep = f.insEpoch(fix, note, ins_before);
+    if (ins_ep && !ins_ep->seed001_available) {
+      note = ins_ep->outage ? "GNSS/INS: no pseudorange above the mask (dead reckoning, no integrity); the snapshot is used"
+                            : "GNSS/INS gave no protection level (" +
+                                  std::string(ins_ep->gnss_fault_detected ? "a fault detected and not excluded" : "too few satellites") +
+                                  "); the snapshot is used";
+      ins_ep.reset();
+    }
+  }
+  if (ins_ep) {
+    pos = maps::ecefToGeodetic(ins_ep->r_ecef_m);
+    hpl = ins_ep->seed001_hpl_m;
+    vpl = ins_ep->seed001_vpl_m;
+    source = PlSource::kGnssIns;
+  } else if (!fix.ranges.empty()) {
     first = integrity::solveLiveFix(fix.ranges, pos, fix.time, f.live, false, &f.approver->orbits());
     if (first->solved && first->pl.pl_computed) {
       pos = first->position;
       hpl = first->pl.hpl_m;
       vpl = first->pl.vpl_m;
       source = PlSource::kRaw;
+      if (fix.imu && !f.nav && !first->fault_detected) f.align(fix, *first, note);
     } else {
       note = "raw pseudoranges gave no PL (" + first->note + (first->pl.reason.empty() ? "" : "; " + first->pl.reason) + ")";
       first.reset();
@@ -586,28 +725,65 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
 
   // Monitoring rerun: FDE over the raw measurements when level 1 is not held.
   bool rerun = false;
-  // Without a detected fault the FDE would give the first pass back (nothing to exclude), so it
-  // is not computed again; its event is written on a detection and at the start of a level-1
-  // episode (a PL that never fits HAL₁ would otherwise repeat it at every fix).
-  if (first && levelVerdict(verdict, geofence::Level::kCorridor) != geofence::Verdict::kInside) {
-    const integrity::LiveFix again = first->fault_detected
-                                         ? integrity::solveLiveFix(fix.ranges, pos, fix.time, f.live, true, &f.approver->orbits())
-                                         : *first;
+  std::vector<integrity::SatId> excluded;
+  if (ins_ep) excluded = ins_ep->excluded;
+  if ((first || ins_ep) && levelVerdict(verdict, geofence::Level::kCorridor) != geofence::Verdict::kInside) {
+    // The rerun's solution: raw ranges, the method's FDE; GNSS/INS, the epoch again from the
+    // filter as it was with one more exclusion allowed (step 1 of the flow already ran its FDE).
+    struct Again {
+      bool ok = false;
+      maps::Geodetic pos;
+      double hpl_m = 0.0, vpl_m = 0.0;
+      std::vector<integrity::SatId> excluded;
+      std::string note;
+    } again;
+    const bool detected = ins_ep ? ins_ep->gnss_fault_detected : first->fault_detected;
+    if (ins_ep) {
+      again = {true, pos, *hpl, *vpl, ins_ep->excluded, ""};
+      if (detected && ins_before) {
+        integrity::ins::Navigator deeper = *ins_before;
+        const int max_exclusions = deeper.config().max_exclusions;
+        deeper.setMaxExclusions(max_exclusions + 1);
+        const integrity::ins::NavigatorEpoch ep2 = f.runInsEpoch(deeper, fix);
+        if (ep2.seed001_available) {
+          again = {true, maps::ecefToGeodetic(ep2.r_ecef_m), ep2.seed001_hpl_m, ep2.seed001_vpl_m, ep2.excluded, ""};
+          deeper.setMaxExclusions(max_exclusions);
+          *f.nav = std::move(deeper);
+          ins_ep = ep2;
+        } else {
+          again.note = "the epoch with one more exclusion gave no PL; the first pass stands";
+        }
+      }
+    } else {
+      // Without a detected fault the FDE would give the first pass back (nothing to exclude),
+      // so it is not computed again.
+      const integrity::LiveFix lf = detected ? integrity::solveLiveFix(fix.ranges, pos, fix.time, f.live, true, &f.approver->orbits())
+                                             : *first;
+      again.ok = lf.solved && lf.pl.pl_computed;
+      again.pos = lf.position;
+      again.hpl_m = lf.pl.hpl_m;
+      again.vpl_m = lf.pl.vpl_m;
+      again.excluded = lf.excluded;
+      again.note = lf.note + lf.pl.reason;
+    }
     rerun = true;
     ++st.rerun_count;
-    const bool write = first->fault_detected || !st.violated[static_cast<int>(geofence::Level::kCorridor)];
+    // Its event is written on a detection and at the start of a level-1 episode (a PL that never
+    // fits HAL₁ would otherwise repeat it at every fix).
+    const bool write = detected || !st.violated[static_cast<int>(geofence::Level::kCorridor)];
     TrackEvent e = event("monitoring_rerun", id, fix.time);
-    e["fault_detected"] = first->fault_detected;
-    json excluded = json::array();
-    for (const integrity::SatId& s : again.excluded) excluded.push_back(s.str());
-    e["excluded"] = excluded;
+    e["fault_detected"] = detected;
+    json ex = json::array();
+    for (const integrity::SatId& s : again.excluded) ex.push_back(s.str());
+    e["excluded"] = ex;
     e["hpl_before_m"] = metres(*hpl);
     e["vpl_before_m"] = metres(*vpl);
     e["verdict_before"] = geofence::verdictName(levelVerdict(verdict, geofence::Level::kCorridor));
-    if (again.solved && again.pl.pl_computed) {
-      pos = again.position;
-      hpl = again.pl.hpl_m;
-      vpl = again.pl.vpl_m;
+    if (again.ok) {
+      pos = again.pos;
+      hpl = again.hpl_m;
+      vpl = again.vpl_m;
+      excluded = again.excluded;
       const geofence::TimedVolume vol2 = volumeAt(pos, *hpl, *vpl);
       try {
         verdict = geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), vol2, options_.horizon_m);
@@ -618,11 +794,12 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       e["hpl_after_m"] = metres(*hpl);
       e["vpl_after_m"] = metres(*vpl);
       e["verdict_after"] = geofence::verdictName(levelVerdict(verdict, geofence::Level::kCorridor));
+      if (!again.note.empty() && !e.body.contains("note")) e["note"] = again.note;
     } else {
       e["hpl_after_m"] = nullptr;
       e["vpl_after_m"] = nullptr;
       e["verdict_after"] = e.body["verdict_before"];
-      e["note"] = again.note + again.pl.reason;
+      e["note"] = again.note;
     }
     e["line"] = fix.line;
     if (write) out.push_back(std::move(e));
@@ -705,6 +882,11 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   rec.vpl_m = *vpl;
   rec.pl_source = source;
   if (first) rec.fault_detected = first->fault_detected;
+  if (ins_ep) {
+    rec.fault_detected = ins_ep->gnss_fault_detected;
+    rec.ins_degraded = ins_ep->degraded;
+  }
+  rec.excluded = std::move(excluded);
   rec.route_version = st.route_version;
   rec.rerun = rerun;
   rec.note = jump_note.empty() ? note : (note.empty() ? jump_note : jump_note + "; " + note);

@@ -10,12 +10,15 @@
 /// 1. Order: a fix not after the flight's last accepted one (duplicate or out of order), or more
 ///    than `max_time_jump_s` from it, is rejected (`rejected_input`), as is an unknown flight;
 ///    after a jump, `jump_confirm` fixes in order on the new timeline make it the flight's.
-/// 2. Protection levels: raw pseudoranges → skylane's own position and PLs with the mission's
-///    method, first pass detection only (integrity/raim/live_fix.hpp); else the onboard (or NMEA
-///    GST) PLs; an INS block raises them to seed 000's nominal-INS PL when that is larger.
+/// 2. Protection levels: raw pseudoranges with IMU increments, once the filter is aligned →
+///    seed 001's GNSS/INS flow (its FDE, filter and fault-mode PLs; track_fix.hpp); raw
+///    pseudoranges → skylane's own position and PLs with the mission's method, first pass
+///    detection only (integrity/raim/live_fix.hpp); else the onboard (or NMEA GST) PLs; an INS
+///    σ block raises them to seed 000's nominal-INS PL when that is larger.
 /// 3. The fence check of the volume at the fix time (geofence::checkVolume).
 /// 4. Level 1 not inside and raw pseudoranges → **monitoring rerun**: FDE, the PLs of the
-///    remaining geometry, the check again; the fix's verdict is the rerun's.
+///    remaining geometry, the check again; the fix's verdict is the rerun's. GNSS/INS: after a
+///    detection, the epoch again from the filter as it was with one more exclusion allowed.
 /// 5. Persistence: a level counts as violated in a fix when its check is not inside
 ///    (indeterminate counts). Level 1 is persistent when violated in ≥ level1_m of the last
 ///    level1_n fixes by a cause a replan can mend (step 6); level 2, zones and obstacles with
@@ -66,7 +69,9 @@ struct FixRecord {
   double lat_rad = 0.0, lon_rad = 0.0, h_ell_m = 0.0;  ///< the position checked (skylane's own with raw ranges)
   double hpl_m = 0.0, vpl_m = 0.0;
   PlSource pl_source = PlSource::kOnboard;
-  std::optional<bool> fault_detected;  ///< raw ranges: the first pass's detection
+  std::optional<bool> fault_detected;  ///< raw ranges: the first pass's detection (GNSS/INS: step 1's)
+  std::vector<integrity::SatId> excluded;  ///< left out of the position (GNSS/INS FDE, a rerun)
+  std::optional<bool> ins_degraded;    ///< GNSS/INS: seed 001's GNSS-alone mode after an IMU fault
   geofence::FenceVerdict verdict;
   int route_version = 0;
   bool rerun = false;

@@ -541,6 +541,163 @@ TEST(TrackerRaw, SatelliteFaultIsExcludedByTheRerunAndTheFlightRecoversWithoutAR
   EXPECT_TRUE(ofType(all, "violation").empty());
 }
 
+// --- GNSS/INS: IMU increments with the pseudoranges (seed 001's flow) --------------------------
+
+/// A UAV whose corridor (HAL₁ = 48 m) holds seed 001's fault-mode PLs (≈ 15 m, ≈ 25 m with a
+/// satellite excluded) and the simulator's corner cutting (30 m turn radius).
+Approved largeUav() {
+  Approved a = approveMission(exampleMission([](json& doc) {
+    doc["vehicle"]["lateral_m"] = 40.0;
+    doc["vehicle"]["longitudinal_m"] = 50.0;
+    doc["k2"] = 100;
+  }));
+  EXPECT_NEAR(a.report.limits.level1.hal_m, 48.0, 1e-9);
+  return a;
+}
+
+/// Horizontal and vertical distance of a fix event's position from the truth.
+std::pair<double, double> fixError(const json& fix, const maps::Geodetic& truth) {
+  const maps::LocalFrame enu(truth);
+  const Eigen::Vector3d d = enu.toEnu({maps::deg2rad(fix.at("lat").get<double>()), maps::deg2rad(fix.at("lon").get<double>()),
+                                       fix.at("h_ell_m").get<double>()});
+  return {d.head<2>().norm(), std::abs(d.z())};
+}
+
+TEST(TrackerGnssIns, FixesWithImuIncrementsUseSeed001sFlowAndItsPlsBoundTheError) {
+  // GIVEN the large UAV flown by the simulator with a tactical IMU, barometer and magnetometer
+  const Approved a = largeUav();
+  Tracker tracker;
+  tracker.addFlight("F1", a.flight, a.approver);
+  std::vector<json> all;
+  int ins = 0, bounded = 0;
+  const auto flight = test::simulateRoute(a.report, *a.approver, {}, 21, 5.0, "F1", test::ImuFeed{});
+  ASSERT_GT(flight.size(), 100u);
+  for (const test::SimulatedFix& sf : flight) {
+    const auto ev = tracker.processJson(sf.fix);
+    ASSERT_FALSE(ev.empty());
+    const json& fix = ev.back();
+    ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
+    for (const json& e : ev) all.push_back(e);
+    if (sf.fix.line == 1) {
+      // THEN the first fix aligns the filter and is solved as a snapshot
+      EXPECT_EQ(fix.at("pl_source"), "raw");
+      EXPECT_NE(fix.value("note", "").find("GNSS/INS aligned"), std::string::npos) << fix.dump();
+      continue;
+    }
+    // AND every later fix comes from the GNSS/INS flow, and its PLs bound the true error
+    ASSERT_EQ(fix.at("pl_source"), "gnss_ins") << fix.dump();
+    EXPECT_FALSE(fix.at("ins_degraded").get<bool>());
+    ++ins;
+    const auto [eh, ev_] = fixError(fix, sf.truth);
+    if (eh <= fix.at("hpl_m").get<double>() && ev_ <= fix.at("vpl_m").get<double>()) ++bounded;
+    EXPECT_EQ(fix.at("verdict"), "inside") << fix.dump();
+  }
+  EXPECT_EQ(bounded, ins);
+  EXPECT_TRUE(ofType(all, "violation").empty());
+  EXPECT_TRUE(ofType(all, "replan").empty());
+}
+
+TEST(TrackerGnssIns, ASatelliteFaultIsExcludedByTheFlowAndTheErrorStaysBounded) {
+  // GIVEN the same flight with a 60 m step on one satellite from 60 s to 120 s
+  const Approved a = largeUav();
+  Tracker tracker;
+  tracker.addFlight("F1", a.flight, a.approver);
+  integrity::sim::FaultSpec fault;
+  fault.target = integrity::sim::FaultTarget::kSatellite;
+  fault.pick = 0.5;
+  fault.t_start_s = 60.0;
+  fault.t_end_s = 120.0;
+  fault.magnitude = 60.0;
+  int in_fault = 0, excluded_faulty = 0, excluded_other = 0, fixes = 0, bounded = 0;
+  std::vector<json> all;
+  for (const test::SimulatedFix& sf : test::simulateRoute(a.report, *a.approver, {fault}, 23, 5.0, "F1", test::ImuFeed{})) {
+    const auto ev = tracker.processJson(sf.fix);
+    const json& fix = ev.back();
+    ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
+    for (const json& e : ev) all.push_back(e);
+    if (sf.fix.line == 1) continue;
+    ASSERT_EQ(fix.at("pl_source"), "gnss_ins") << fix.dump();
+    ++fixes;
+    const json ex = fix.value("excluded", json::array());
+    if (sf.faulty) {
+      ++in_fault;
+      // THEN step 1's FDE leaves the faulty satellite out
+      if (ex.size() == 1 && ex[0] == sf.faulty->str()) ++excluded_faulty;
+    } else {
+      excluded_other += static_cast<int>(ex.size());
+    }
+    const auto [eh, ev_] = fixError(fix, sf.truth);
+    if (eh <= fix.at("hpl_m").get<double>() && ev_ <= fix.at("vpl_m").get<double>()) ++bounded;
+    EXPECT_EQ(fix.at("verdict"), "inside") << fix.dump();
+  }
+  EXPECT_GE(in_fault, 59);
+  EXPECT_EQ(excluded_faulty, in_fault);
+  EXPECT_LE(excluded_other, 2);  // false exclusions: P_FA per epoch, with some margin
+  // AND the PLs bound the error at every fix, without a violation or a replan
+  EXPECT_EQ(bounded, fixes);
+  EXPECT_TRUE(ofType(all, "violation").empty());
+  EXPECT_TRUE(ofType(all, "replan").empty());
+}
+
+TEST(TrackerGnssIns, AnAccelerometerFaultDegradesToGnssAloneAndTheErrorStaysBounded) {
+  // GIVEN an accelerometer step of 0.5 m/s² on the up axis from 60 s to 200 s
+  const Approved a = largeUav();
+  Tracker tracker;
+  tracker.addFlight("F1", a.flight, a.approver);
+  integrity::sim::FaultSpec fault;
+  fault.target = integrity::sim::FaultTarget::kAccelerometer;
+  fault.axis = 2;
+  fault.t_start_s = 60.0;
+  fault.t_end_s = 200.0;
+  fault.magnitude = 0.5;
+  int degraded = 0, fixes = 0, bounded = 0;
+  for (const test::SimulatedFix& sf : test::simulateRoute(a.report, *a.approver, {fault}, 25, 5.0, "F1", test::ImuFeed{})) {
+    const auto ev = tracker.processJson(sf.fix);
+    const json& fix = ev.back();
+    ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
+    if (sf.fix.line == 1) continue;
+    ++fixes;
+    if (fix.value("ins_degraded", false)) {
+      ++degraded;
+      // THEN the IMU innovation test sends the flow to GNSS alone (seed 001 class 1)
+      EXPECT_GE(sf.t_s, 60.0);
+    }
+    const auto [eh, ev_] = fixError(fix, sf.truth);
+    if (eh <= fix.at("hpl_m").get<double>() && ev_ <= fix.at("vpl_m").get<double>()) ++bounded;
+  }
+  EXPECT_GT(degraded, 60);
+  // AND the PLs bound the error throughout
+  EXPECT_EQ(bounded, fixes);
+}
+
+TEST(TrackerGnssIns, ALostFixOrARestartAlignsTheFilterAgain) {
+  const Approved a = largeUav();
+  const auto flight = test::simulateRoute(a.report, *a.approver, {}, 27, 5.0, "F1", test::ImuFeed{});
+  ASSERT_GT(flight.size(), 60u);
+  Tracker tracker;
+  tracker.addFlight("F1", a.flight, a.approver);
+  std::vector<json> fixes;
+  for (std::size_t i = 0; i < 40; ++i) {
+    if (i == 20) continue;  // GIVEN one line lost: the next fix's increments cover 1 s of 2
+    fixes.push_back(tracker.processJson(flight[i].fix).back());
+  }
+  // THEN the fix after the gap is a snapshot that aligns again, and the next is GNSS/INS
+  EXPECT_EQ(fixes[19].at("pl_source"), "gnss_ins");
+  EXPECT_EQ(fixes[20].at("pl_source"), "raw");
+  EXPECT_NE(fixes[20].value("note", "").find("the filter aligns again"), std::string::npos) << fixes[20].dump();
+  EXPECT_EQ(fixes[21].at("pl_source"), "gnss_ins") << fixes[21].dump();
+  // AND a restarted tracker (state restored, no filter) aligns at its first fix
+  Tracker restarted;
+  restarted.addFlight("F1", a.flight, a.approver);
+  restarted.restore("F1", tracker.state("F1"), tracker.routeJson("F1"));
+  const json r1 = restarted.processJson(flight[40].fix).back();
+  const json r2 = restarted.processJson(flight[41].fix).back();
+  EXPECT_EQ(r1.at("pl_source"), "raw");
+  EXPECT_NE(r1.value("note", "").find("GNSS/INS aligned"), std::string::npos) << r1.dump();
+  EXPECT_EQ(r2.at("pl_source"), "gnss_ins");
+  EXPECT_EQ(restarted.state("F1").fixes, tracker.state("F1").fixes + 2);
+}
+
 // --- parsing ----------------------------------------------------------------------------------
 
 TEST(TrackFixJson, ErrorsNameTheFieldAndWhatWasExpected) {
@@ -562,6 +719,34 @@ TEST(TrackFixJson, ErrorsNameTheFieldAndWhatWasExpected) {
   EXPECT_NE(err("{" + base + R"(,"imu":{"grade":"toy","sigma_n_m":1,"sigma_e_m":1,"sigma_u_m":1}})").find("aviation, tactical or consumer"),
             std::string::npos);
   EXPECT_NE(err("{" + base + "}").find("fixes.jsonl:7"), std::string::npos);
+  // IMU increments: seven numbers each, a positive interval, with pseudoranges or onboard PLs
+  const std::string pr = R"(,"hpl_m":1,"vpl_m":1)";
+  EXPECT_NE(err("{" + base + pr + R"(,"imu":{"grade":"tactical","increments":[[0.01,0,0,0,0,0]]}})").find("$.imu.increments[0]"),
+            std::string::npos);
+  EXPECT_NE(err("{" + base + pr + R"(,"imu":{"grade":"tactical","increments":[[0,0,0,0,0,0,0]]}})").find("(0, 1] s"),
+            std::string::npos);
+  EXPECT_NE(err("{" + base + pr + R"(,"imu":{"grade":"tactical","increments":[[0.01,1,0,0,0,0,0]]}})").find("35 rad/s"),
+            std::string::npos);
+  EXPECT_NE(err("{" + base + pr + R"(,"imu":{"grade":"tactical","increments":[]}})").find("1 to 10,000"), std::string::npos);
+  EXPECT_NE(err("{" + base + pr + R"(,"imu":{"grade":"tactical","sigma_n_m":1,"increments":[[0.01,0,0,0,0,0,0]]}})")
+                .find("not both"),
+            std::string::npos);
+  EXPECT_NE(err("{" + base + R"(,"imu":{"grade":"tactical","increments":[[0.01,0,0,0,0,0,0]]}})").find("pseudoranges with the IMU"),
+            std::string::npos);
+  EXPECT_NE(err("{" + base + pr + R"(,"attitude_deg":{"roll":0,"pitch":95,"heading":0}})").find("$.attitude_deg.pitch"),
+            std::string::npos);
+  EXPECT_NE(err("{" + base + pr + R"(,"velocity_enu_mps":[1,2]})").find("[ve, vn, vu]"), std::string::npos);
+  const TrackFix imu = parseTrackFixJson(
+      json::parse("{" + base + pr +
+                  R"(,"imu":{"grade":"aviation","increments":[[0.01,0.001,0,0,0,0,0.0981],[0.02,0,0,0,0,0,0.1962]]},)"
+                  R"("velocity_enu_mps":[1,2,3],"attitude_deg":{"roll":1,"pitch":2,"heading":90},"mag_heading_deg":91})"),
+      "x");
+  ASSERT_TRUE(imu.imu);
+  EXPECT_EQ(imu.imu->grade, 0);
+  EXPECT_NEAR(imu.imu->span_s(), 0.03, 1e-12);
+  EXPECT_DOUBLE_EQ(imu.imu->increments[1].dv_mps.z(), 0.1962);
+  EXPECT_NEAR(imu.attitude_rad->z(), M_PI / 2.0, 1e-12);
+  EXPECT_NEAR(*imu.mag_heading_rad, maps::deg2rad(91.0), 1e-12);
   const TrackFix ok = parseTrackFixJson(json::parse("{" + base + R"(,"vehicle":42,"hpl_m":1.5,"vpl_m":2})"), "x");
   EXPECT_EQ(ok.flight, "42");
   EXPECT_DOUBLE_EQ(*ok.hpl_m, 1.5);
