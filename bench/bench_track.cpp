@@ -25,6 +25,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -268,52 +269,65 @@ void BM_Replan(benchmark::State& state) {
 }
 BENCHMARK(BM_Replan)->Unit(benchmark::kMillisecond)->Iterations(5);
 
-/// Fixes with raw pseudoranges (skylane's own position and RAIM PLs) on the bundled example,
-/// flown by the simulator with a 60 m fault on one satellite half of the time: the first pass,
-/// and on a detection the FDE rerun and the second check. Vehicle of 20 m span so that the
-/// fault-free PLs fit level 1 and a detection is what triggers the rerun.
-void BM_TrackRawFixes(benchmark::State& state) {
-  planner::Mission m = planner::loadMission(kExample);
-  m.vehicle.lateral_m = 20.0;
-  m.vehicle.longitudinal_m = 25.0;
-  m.levels.k2 = 100.0;
-  auto approver = std::make_shared<planner::Approver>(m);
-  const planner::ApprovalReport r = approver->approve();
-  if (!r.approved) {
-    state.SkipWithError("the example with a 20 m vehicle was not approved");
-    return;
-  }
+/// The bundled example for a vehicle of `span_m` × `length_m` (so that the PLs of raw fixes fit
+/// level 1), its approval as a tracked flight, and the simulator's fixes along it with a 60 m
+/// fault on one satellite over the second half; with `imu`, the IMU increments too.
+struct RawScene {
+  std::shared_ptr<planner::Approver> approver;
   planner::ApprovedFlight flight;
-  flight.approved = true;
-  flight.departure = r.departure;
-  flight.route = r.route;
-  flight.level1 = r.limits.level1;
-  flight.level2 = r.limits.level2;
+  std::vector<planner::TrackFix> fixes;
+};
+
+bool rawScene(benchmark::State& state, double span_m, double length_m, const std::optional<test::ImuFeed>& imu, RawScene& out) {
+  planner::Mission m = planner::loadMission(kExample);
+  m.vehicle.lateral_m = span_m;
+  m.vehicle.longitudinal_m = length_m;
+  m.levels.k2 = 100.0;
+  out.approver = std::make_shared<planner::Approver>(m);
+  const planner::ApprovalReport r = out.approver->approve();
+  if (!r.approved) {
+    state.SkipWithError("the example with a larger vehicle was not approved");
+    return false;
+  }
+  out.flight.approved = true;
+  out.flight.departure = r.departure;
+  out.flight.route = r.route;
+  out.flight.level1 = r.limits.level1;
+  out.flight.level2 = r.limits.level2;
   integrity::sim::FaultSpec fault;
   fault.target = integrity::sim::FaultTarget::kSatellite;
   fault.pick = 0.5;
   fault.t_start_s = r.route.back().eta_s / 2.0;
   fault.t_end_s = r.route.back().eta_s + 60.0;
   fault.magnitude = 60.0;
-  std::vector<planner::TrackFix> fixes;
-  for (test::SimulatedFix& sf : test::simulateRoute(r, *approver, {fault}, 3)) fixes.push_back(std::move(sf.fix));
+  for (test::SimulatedFix& sf : test::simulateRoute(r, *out.approver, {fault}, 3, 0.0, "F1", imu)) out.fixes.push_back(std::move(sf.fix));
+  return true;
+}
+
+/// Replays a scene's fixes (a new tracker each time round) and reports the latencies.
+void replayRaw(benchmark::State& state, const RawScene& scene) {
   planner::TrackerOptions options;
   options.replan = false;
   std::unique_ptr<planner::Tracker> tracker;
-  std::size_t k = fixes.size(), reruns = 0, n = 0, sats = 0;
+  const std::vector<planner::TrackFix>& fixes = scene.fixes;
+  std::size_t k = fixes.size(), reruns = 0, n = 0, sats = 0, excluded = 0;
   std::vector<double> latency_us;
   for (auto _ : state) {
     if (k == fixes.size()) {
       state.PauseTiming();
       tracker = std::make_unique<planner::Tracker>(options);
-      tracker->addFlight("F1", flight, approver);
+      tracker->addFlight("F1", scene.flight, scene.approver);
       k = 0;
       state.ResumeTiming();
     }
     const auto t0 = Clock::now();
     const std::vector<planner::TrackEvent> ev = tracker->process(fixes[k]);
     latency_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
-    for (const planner::TrackEvent& e : ev) reruns += e.fix && e.fix->rerun;
+    for (const planner::TrackEvent& e : ev) {
+      if (!e.fix) continue;
+      reruns += e.fix->rerun;
+      excluded += !e.fix->excluded.empty();
+    }
     sats += fixes[k].ranges.size();
     ++k;
     ++n;
@@ -322,8 +336,26 @@ void BM_TrackRawFixes(benchmark::State& state) {
   state.counters["p50_us"] = percentile(latency_us, 0.50);
   state.counters["p99_us"] = percentile(latency_us, 0.99);
   state.counters["reruns_per_fix"] = static_cast<double>(reruns) / std::max<std::size_t>(n, 1);
+  state.counters["excluding_fixes"] = static_cast<double>(excluded) / std::max<std::size_t>(n, 1);
   state.counters["satellites"] = static_cast<double>(sats) / std::max<std::size_t>(n, 1);
 }
+
+/// Fixes with raw pseudoranges (skylane's own position and RAIM PLs) on the bundled example:
+/// the first pass, and on a detection the FDE rerun and the second check. Vehicle of 20 m span
+/// so that the fault-free PLs fit level 1 and a detection is what triggers the rerun.
+void BM_TrackRawFixes(benchmark::State& state) {
+  RawScene scene;
+  if (rawScene(state, 20.0, 25.0, std::nullopt, scene)) replayRaw(state, scene);
+}
 BENCHMARK(BM_TrackRawFixes)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
+
+/// The same flight with a tactical IMU's increments (100 per fix), barometer and magnetometer:
+/// seed 001's GNSS/INS flow per fix (strapdown, EKF, FDE, IMU test, fault-mode PLs). Vehicle of
+/// 40 m span: the fault-mode PLs fit level 1.
+void BM_TrackGnssInsFixes(benchmark::State& state) {
+  RawScene scene;
+  if (rawScene(state, 40.0, 50.0, test::ImuFeed{}, scene)) replayRaw(state, scene);
+}
+BENCHMARK(BM_TrackGnssInsFixes)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 
 }  // namespace
