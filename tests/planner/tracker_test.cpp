@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <random>
 
 namespace skylane::planner {
 namespace {
@@ -611,7 +612,14 @@ TEST(TrackerGnssIns, ASatelliteFaultIsExcludedByTheFlowAndTheErrorStaysBounded) 
   int in_fault = 0, excluded_faulty = 0, excluded_other = 0, fixes = 0, bounded = 0;
   std::vector<json> all;
   for (const test::SimulatedFix& sf : test::simulateRoute(a.report, *a.approver, {fault}, 23, 5.0, "F1", test::ImuFeed{})) {
-    const auto ev = tracker.processJson(sf.fix);
+    std::vector<json> ev;
+    for (const TrackEvent& e : tracker.process(sf.fix)) {
+      ev.push_back(e.toJson());
+      // (the stream's fast writer gives the same object, excluded satellites and all)
+      if (e.fix) {
+        EXPECT_EQ(json::parse(e.jsonLine()), ev.back());
+      }
+    }
     const json& fix = ev.back();
     ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
     for (const json& e : ev) all.push_back(e);
@@ -668,6 +676,59 @@ TEST(TrackerGnssIns, AnAccelerometerFaultDegradesToGnssAloneAndTheErrorStaysBoun
   EXPECT_GT(degraded, 60);
   // AND the PLs bound the error throughout
   EXPECT_EQ(bounded, fixes);
+}
+
+TEST(TrackerGnssIns, MonteCarloWithRandomFaultsHasNoMisleadingFix) {
+  // GIVEN 100 simulated flights, each with a random fault: none, a satellite step (10–100 m) or
+  // ramp (0.5–3 m/s), an accelerometer step (0.1–1 m/s²) or a gyro step (0.001–0.01 rad/s), at a
+  // random time, on a random satellite or axis
+  const Approved a = largeUav();
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int fixes = 0, misleading = 0, ins = 0;
+  for (int flight = 0; flight < 100; ++flight) {
+    std::vector<integrity::sim::FaultSpec> faults;
+    const int kind = flight % 5;
+    if (kind > 0) {
+      integrity::sim::FaultSpec f;
+      f.t_start_s = 20.0 + 80.0 * u(rng);
+      f.t_end_s = f.t_start_s + 30.0 + 60.0 * u(rng);
+      f.pick = u(rng);
+      f.axis = static_cast<int>(3.0 * u(rng)) % 3;
+      if (kind == 1) {
+        f.magnitude = 10.0 + 90.0 * u(rng);
+      } else if (kind == 2) {
+        f.ramp = true;
+        f.magnitude = 0.5 + 2.5 * u(rng);
+      } else if (kind == 3) {
+        f.target = integrity::sim::FaultTarget::kAccelerometer;
+        f.magnitude = 0.1 + 0.9 * u(rng);
+      } else {
+        f.target = integrity::sim::FaultTarget::kGyro;
+        f.magnitude = 0.001 + 0.009 * u(rng);
+      }
+      faults.push_back(f);
+    }
+    Tracker tracker;
+    tracker.addFlight("F1", a.flight, a.approver);
+    for (const test::SimulatedFix& sf :
+         test::simulateRoute(a.report, *a.approver, faults, 1000 + static_cast<std::uint64_t>(flight), 5.0, "F1", test::ImuFeed{})) {
+      const json fix = tracker.processJson(sf.fix).back();
+      if (fix.at("event") != "fix") continue;
+      ++fixes;
+      ins += fix.at("pl_source") == "gnss_ins";
+      const auto [eh, ev] = fixError(fix, sf.truth);
+      // THEN no fix's position is farther from the truth than its protection levels
+      if (eh > fix.at("hpl_m").get<double>() || ev > fix.at("vpl_m").get<double>()) {
+        ++misleading;
+        ADD_FAILURE() << "flight " << flight << " t = " << sf.t_s << " s: error " << eh << " / " << ev << " m: " << fix.dump();
+      }
+    }
+  }
+  EXPECT_GT(fixes, 15000);
+  EXPECT_GT(ins, fixes * 9 / 10);
+  EXPECT_EQ(misleading, 0);
+  ::testing::Test::RecordProperty("fixes", fixes);
 }
 
 TEST(TrackerGnssIns, ALostFixOrARestartAlignsTheFilterAgain) {
