@@ -349,11 +349,17 @@ void runTrack(const TrackOptions& o) {
   const std::size_t resume_line = resumable ? store->inputLine(o.input) : 0;
   std::size_t open_epoch_line = 0;  // NMEA: the GGA line of the epoch not yet released (0: none)
   std::set<std::string> touched;  // flights whose state changed since the last checkpoint
+  bool output_closed = false;
   auto emit = [&](const std::vector<planner::TrackEvent>& evs) {
     for (const planner::TrackEvent& e : evs) {
       // Quoted input may hold bytes that are not UTF-8: they are replaced, not fatal.
       const std::string line = e.jsonLine();
       out << line << '\n';
+      // A closed output (the reader of a pipe went away): stop as on SIGTERM, the batch saved.
+      if (!out && !output_closed) {
+        output_closed = true;
+        g_stop = true;
+      }
       ++events;
       if (e.is("rejected_input")) ++rejected;
       if (e.is("fix")) ++accepted;
@@ -397,6 +403,11 @@ void runTrack(const TrackOptions& o) {
   sigemptyset(&stop.sa_mask);
   sigaction(SIGTERM, &stop, nullptr);
   sigaction(SIGINT, &stop, nullptr);
+  // A broken pipe is an error on the write (seen above), not the end of the process.
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGPIPE, &ignore, nullptr);
   if (resume_line > 0) std::cerr << "skylane: track: " << o.input << ": resuming after line " << resume_line << "\n";
 
   if (o.format == "rinex") {
@@ -531,7 +542,9 @@ void runTrack(const TrackOptions& o) {
     std::cerr << "skylane: track: wrote " << o.map << "\n";
   }
   std::cerr << "skylane: track: " << accepted << " fix" << (accepted == 1 ? "" : "es") << " accepted, " << rejected
-            << " rejected, " << events << " events" << (g_stop ? " (stopped by a signal; state saved)" : "") << "\n";
+            << " rejected, " << events << " events"
+            << (output_closed ? " (stopped: the output was closed; state saved)" : g_stop ? " (stopped by a signal; state saved)" : "")
+            << "\n";
 }
 
 }  // namespace

@@ -231,6 +231,30 @@ TEST_F(TrackCli, SigtermSavesTheStateAndExitsCleanly) {
   EXPECT_EQ(planner::TrackStore(db).events("fix").size(), 30u);
 }
 
+TEST_F(TrackCli, AClosedOutputPipeStopsCleanlyAndARestartLosesNoFix) {
+  const std::string db = *dir_ + "/pipe.sqlite", all = *dir_ + "/pipe.jsonl", err = *dir_ + "/pipe_err.txt";
+  std::filesystem::remove(db);
+  {
+    std::ofstream f(all);
+    for (int k = 0; k < 3000; ++k) f << goodFix(k % 150).dump() << "\n";  // (times repeat: rejected, also events)
+  }
+  // GIVEN a reader that goes away after one line
+  const std::string cmd = kBin + " track --approval " + approval() + " --input " + all + " --db " + db + " --no-replan";
+  const RunResult r = sh(cmd + " 2> " + err + " | head -n 1 > /dev/null; echo status=${PIPESTATUS[0]}");
+  // THEN the tracker is not killed by SIGPIPE: it saves and exits 0, saying why
+  EXPECT_NE(r.out.find("status=0"), std::string::npos) << r.out;
+  std::ifstream in(err);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("the output was closed; state saved"), std::string::npos) << text;
+  const std::size_t first = planner::TrackStore(db).events("fix").size();
+  EXPECT_GT(first, 0u);
+  // AND a restart on the same database reads on: every accepted fix is in it exactly once
+  const RunResult again = sh(cmd + " > /dev/null 2>&1; echo status=$?");
+  EXPECT_NE(again.out.find("status=0"), std::string::npos) << again.out;
+  EXPECT_EQ(planner::TrackStore(db).events("fix").size(), 150u);
+  EXPECT_EQ(planner::TrackStore(db).events("rejected_input").size(), 2850u);
+}
+
 TEST_F(TrackCli, UdpInputAndAStaleFlightOnAQuietLink) {
   const std::string events = *dir_ + "/udp_events.jsonl";
   std::string send;
