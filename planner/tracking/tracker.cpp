@@ -562,7 +562,7 @@ std::vector<TrackEvent> Tracker::sweepStale(const maps::GpsTime& now) {
   for (auto& [id, f] : flights_) {
     // A flight whose last fix was at its goal has arrived: its silence is expected.
     if (!f->st.last_time || f->st.stale_reported || f->st.arrived) continue;
-    const double gap = now - *f->st.last_time;
+    const double gap = now - f->st.last_time->plus(-f->st.clock_offset_s);
     if (gap <= options_.stale_after_s) continue;
     TrackEvent e = event("stale", id, now);
     e["last_fix"] = maps::formatRfc3339(*f->st.last_time, 3);
@@ -636,6 +636,8 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       return out;
     }
     jump_note = "a new timeline after a " + size + ", confirmed by " + std::to_string(st.jump_count) + " fixes in order";
+    // The flight's clock from here on is the stream's plus an offset: the fix is "now".
+    if (st.last_time && stream_time_) st.clock_offset_s = fix.time - *stream_time_;
   }
   st.jump_candidate.reset();
   st.jump_count = 0;
@@ -707,7 +709,8 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   }
   // Accepted. Stream time moves on with accepted fixes only (a refused one cannot push it
   // ahead); the sweep sees this flight's gap before its time is updated.
-  if (!stream_time_ || fix.time - *stream_time_ > 0) stream_time_ = fix.time;
+  const maps::GpsTime on_stream = fix.time.plus(-st.clock_offset_s);
+  if (!stream_time_ || on_stream - *stream_time_ > 0) stream_time_ = on_stream;
   if (!last_sweep_ || *stream_time_ - *last_sweep_ >= 1.0 || *stream_time_ - *last_sweep_ < 0.0) {
     for (TrackEvent& e : sweepStale(*stream_time_)) out.push_back(std::move(e));
   }
@@ -953,6 +956,7 @@ json flightStateJson(const FlightState& s) {
   j["fixes"] = s.fixes;
   j["reruns"] = s.rerun_count;
   j["replans"] = s.replans;
+  j["clock_offset_s"] = s.clock_offset_s;
   return j;
 }
 
@@ -979,6 +983,7 @@ FlightState parseFlightState(const json& j, const std::string& source) {
     s.fixes = j.at("fixes").get<std::uint64_t>();
     s.rerun_count = j.at("reruns").get<std::uint64_t>();
     s.replans = j.at("replans").get<std::uint64_t>();
+    s.clock_offset_s = j.value("clock_offset_s", 0.0);
   } catch (const nlohmann::json::exception& e) {
     throw maps::ParseError(source, 0, "$", maps::quoteJson(j), std::string("a tracker flight state (") + e.what() + ")");
   }

@@ -31,7 +31,9 @@
 ///    `replan_on_pl_exceedance`: no corridor of the same width can hold a PL wider than itself.
 ///    At most one replan per `replan_cooldown_s`. An approved replan replaces both box levels.
 /// 7. `stale`: a flight without a fix for `stale_after_s` of stream time (once per gap), unless
-///    its last fix was at its goal (it has arrived; nor is an arrived flight replanned).
+///    its last fix was at its goal (it has arrived; nor is an arrived flight replanned). Stream
+///    time is the latest accepted fix time on the stream's clock: a flight whose clock jumped
+///    (step 1) keeps the jump as an offset, so one vehicle's clock cannot make the others stale.
 
 #include "planner/approval.hpp"
 #include "planner/report_formats.hpp"
@@ -108,6 +110,9 @@ struct FlightState {
   std::size_t next_stop = 1;  ///< index into Mission::points of the next point to reach
   int route_version = 0;      ///< 0: the approved route; n: the n-th accepted replan
   std::uint64_t fixes = 0, rerun_count = 0, replans = 0;
+  /// Seconds the flight's clock runs ahead of the stream's since it took a new timeline after a
+  /// jump: its fixes move the stream time, and its silence is measured, on the stream's clock.
+  double clock_offset_s = 0.0;
   std::optional<maps::GpsTime> jump_candidate;  ///< the last fix refused for a time jump (not stored)
   int jump_count = 0;
 };

@@ -383,6 +383,38 @@ TEST_F(TrackerOnExample, AFlightAtItsGoalIsNotStaleAndTheOthersAre) {
   EXPECT_FALSE(tracker.state("F2").arrived);
 }
 
+TEST_F(TrackerOnExample, OneVehiclesClockJumpDoesNotMakeTheOthersStale) {
+  TrackerOptions opt;
+  opt.replan = false;
+  Tracker tracker(opt);
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  tracker.addFlight("F2", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  std::vector<json> all;
+  auto feed = [&](const char* id, double t, int k) {
+    TrackFix f = fixAt(*example_->approver, r.departure.plus(t), along(r, k), 0.5, 0.5, static_cast<std::size_t>(k + 1));
+    f.flight = id;
+    for (json& e : tracker.processJson(f)) all.push_back(e);
+  };
+  // GIVEN two flights reporting every second, F2's receiver clock an hour ahead from 10 s on
+  for (int k = 0; k < 60; ++k) {
+    feed("F1", k, k);
+    feed("F2", k < 10 ? k : k + 3600.0, k);
+  }
+  // THEN F2's new timeline is taken and no flight is stale while both report
+  EXPECT_EQ(tracker.state("F2").fixes, 58u);  // two refused before the jump is confirmed
+  EXPECT_NEAR(tracker.state("F2").clock_offset_s, 3600.0, 1e-9);
+  EXPECT_TRUE(ofType(all, "stale").empty()) << ofType(all, "stale")[0].dump();
+  // AND when F1 goes silent, F2's fixes (on their own clock) still carry the stream time on
+  for (int k = 60; k < 70; ++k) feed("F2", k + 3600.0, k);
+  const auto stale = ofType(all, "stale");
+  ASSERT_EQ(stale.size(), 1u);
+  EXPECT_EQ(stale[0].at("flight"), "F1");
+  EXPECT_NEAR(stale[0].at("gap_s").get<double>(), 4.0, 1e-9);
+  // AND the offset is kept with the flight's state
+  EXPECT_NEAR(parseFlightState(flightStateJson(tracker.state("F2")), "db").clock_offset_s, 3600.0, 1e-9);
+}
+
 // --- NMEA and JSON lines give the same verdicts ---------------------------------------------
 
 TEST_F(TrackerOnExample, NmeaAndJsonLinesGiveTheSameVerdicts) {
