@@ -1,16 +1,19 @@
 #include "cli/track_commands.hpp"
 
 #include "cli/approve_commands.hpp"
+#include "cli/progress.hpp"
 #include "cli/svg_plot.hpp"
 
 #include "integrity/gnss/nmea.hpp"
 #include "integrity/gnss/rinex_nav.hpp"
 #include "integrity/gnss/rinex_obs.hpp"
 #include "integrity/raim/spp.hpp"
+#include "integrity/sim/scenario.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
 #include "planner/report_formats.hpp"
+#include "planner/tracking/flight_sim.hpp"
 #include "planner/tracking/track_store.hpp"
 #include "planner/tracking/tracker.hpp"
 
@@ -547,9 +550,81 @@ void runTrack(const TrackOptions& o) {
             << "\n";
 }
 
+struct FlyOptions {
+  std::string report, out, imu, faults, flight, truth;
+  std::uint64_t seed = 1;
+  bool no_aiding = false;
+  bool progress = false;
+};
+
+/// `skylane fly`: an approved route flown by the simulator, written as tracker input.
+void runFly(const FlyOptions& o) {
+  const planner::ApprovedFlight plan = planner::parseApprovalReport(maps::readJsonFile(o.report), o.report);
+  if (!plan.approved) throw ParseError(o.report, 0, "$.decision", "rejected", "an approved route");
+  const planner::Approver approver(planner::loadMission(planner::approvedMissionPath(plan, o.report)));
+  planner::FlightSimOptions sim;
+  sim.flight = o.flight.empty() ? plan.mission_name : o.flight;
+  sim.seed = o.seed;
+  if (!o.imu.empty()) {
+    const auto grade = integrity::sim::parseImuGrade(o.imu);
+    if (!grade) throw ParseError("--imu", 0, "--imu", o.imu, "aviation, tactical or consumer");
+    planner::ImuFeed feed;
+    feed.grade = *grade;
+    feed.aiding = !o.no_aiding;
+    sim.imu = feed;
+  }
+  if (!o.faults.empty()) {
+    // A list of faults in the scenario format ("skylane simulate"), or {"faults": [...]}.
+    const json doc = maps::readJsonFile(o.faults);
+    const maps::JsonNode root{doc, "$", o.faults};
+    const maps::JsonNode list = doc.is_object() ? root.at("faults") : root;
+    for (std::size_t i = 0; i < list.array().size(); ++i) sim.faults.push_back(integrity::sim::parseFault(list.item(i)));
+  }
+  std::ofstream out(o.out);
+  if (!out) throw ParseError(o.out, 0, "--out", o.out, "a writable file");
+  std::ofstream truth;
+  if (!o.truth.empty()) {
+    truth.open(o.truth);
+    if (!truth) throw ParseError(o.truth, 0, "--truth", o.truth, "a writable file");
+    truth << "line,time,t_s,lat_deg,lon_deg,h_ell_m,faulty_sat\n";
+  }
+  Progress bar("flying", o.progress);
+  const std::vector<planner::SimulatedFix> fixes =
+      planner::simulateFlight(plan, approver, sim, [&bar](double f) { bar(static_cast<std::size_t>(f * 1000.0), 1000); });
+  for (const planner::SimulatedFix& f : fixes) {
+    out << planner::trackFixJson(f.fix).dump() << '\n';
+    if (truth.is_open()) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "%zu,%s,%.3f,%.9f,%.9f,%.4f,%s\n", f.fix.line, maps::formatRfc3339(f.fix.time, 3).c_str(),
+                    f.t_s, maps::rad2deg(f.truth.lat_rad), maps::rad2deg(f.truth.lon_rad), f.truth.h_ell_m,
+                    f.faulty ? f.faulty->str().c_str() : "");
+      truth << buf;
+    }
+  }
+  if (!out) throw ParseError(o.out, 0, "--out", o.out, "a file with room for the fixes");
+  std::cerr << "skylane: fly: " << fixes.size() << " fixes of flight " << sim.flight << " (" << fixes.front().t_s << "–"
+            << fixes.back().t_s << " s" << (sim.imu ? ", with IMU increments" : "") << ", " << sim.faults.size()
+            << " fault(s)) written to " << o.out << "\n";
+}
+
 }  // namespace
 
 void addTrackCommands(CLI::App& app) {
+  {
+    auto o = std::make_shared<FlyOptions>();
+    CLI::App* c = app.add_subcommand(
+        "fly", "fly an approved route with the GNSS/INS simulator (real orbits, the error model, faults) and write the fixes for skylane track");
+    c->add_option("report", o->report, "approval report (skylane approve --out DIR: DIR/report.json)")->required();
+    c->add_option("--out", o->out, "the fixes, as JSON lines for skylane track --format jsonl")->required();
+    c->add_option("--imu", o->imu, "also write the IMU's increments, velocity and attitude: aviation, tactical or consumer");
+    c->add_flag("--no-aiding", o->no_aiding, "with --imu: no barometer or magnetometer in the fixes");
+    c->add_option("--faults", o->faults, "faults to inject, as the scenario's \"faults\" (skylane simulate): a JSON array or {\"faults\": [...]}");
+    c->add_option("--seed", o->seed, "random seed of the sensors and faults")->capture_default_str();
+    c->add_option("--flight", o->flight, "the flight id in every fix (default: the mission's name)");
+    c->add_option("--truth", o->truth, "write the true positions and the faulty satellite per fix to this CSV");
+    c->add_flag("--progress", o->progress, "show a progress bar even when stderr is not a terminal");
+    c->callback([o]() { runFly(*o); });
+  }
   auto o = std::make_shared<TrackOptions>();
   CLI::App* c = app.add_subcommand(
       "track", "live corridor tracking: check each fix against its corridor, airspace and zones; rerun monitoring; replan");

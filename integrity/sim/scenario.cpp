@@ -34,6 +34,8 @@ int axisOf(const JsonNode& n) {
   n.fail("a body axis: \"forward\"/\"x\", \"left\"/\"y\" or \"up\"/\"z\"");
 }
 
+}  // namespace
+
 FaultSpec parseFault(const JsonNode& f) {
   f.requireKnownFields({"type", "sats", "axis", "start_s", "end_s", "ramp", "bias_m", "bias_sigma", "bias_mps2",
                         "bias_g", "bias_radps", "bias_dps"});
@@ -84,8 +86,6 @@ FaultSpec parseFault(const JsonNode& f) {
   }
   return out;
 }
-
-}  // namespace
 
 void matchFilterToSensors(Scenario& s) {
   ins::EkfConfig& e = s.navigator.ekf;

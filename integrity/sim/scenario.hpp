@@ -9,6 +9,10 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+namespace skylane::maps {
+struct JsonNode;
+}
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -39,6 +43,9 @@ void matchFilterToSensors(Scenario& s);
 /// \brief Parses a scenario document; relative file names are resolved against `base_dir`.
 /// \throws maps::ParseError naming the source, the field and what was expected.
 [[nodiscard]] Scenario parseScenario(const nlohmann::json& doc, const std::string& source, const std::string& base_dir);
+/// \brief One fault object of a scenario's "faults" (README, "skylane simulate").
+/// \throws maps::ParseError naming the field and what was expected.
+[[nodiscard]] FaultSpec parseFault(const maps::JsonNode& f);
 /// \brief readJsonFile + parseScenario (base directory = the file's directory).
 [[nodiscard]] Scenario loadScenario(const std::string& path);
 

@@ -162,6 +162,9 @@ double Trajectory::arcLengthAt(double t_s, double& speed, double& accel, const L
   return leg->s0 + (speed - leg->v0) / k;
 }
 
+/// How long rolling into or out of a turn takes.
+constexpr double kRollIn_s = 1.0;
+
 TruthState Trajectory::at(double t_s) const {
   TruthState x;
   x.t_s = t_s;
@@ -207,7 +210,22 @@ TruthState Trajectory::at(double t_s) const {
   const Eigen::Vector3d v_here = R_enu_ecef_here * x.v_ecef_mps;
   x.heading_rad = std::atan2(v_here.x(), v_here.y());
   x.pitch_rad = std::atan2(v_here.z(), v_here.head<2>().norm());
-  x.roll_rad = -std::atan(kappa * v * v / kStandardGravity_mps2);
+  // Coordinated-turn bank, rolled in and out over kRollIn_s: the curvature averaged over the path
+  // flown in ±kRollIn_s/2 (a step in curvature at an arc's ends would otherwise be a step in bank:
+  // an angular rate far beyond any airframe's and any gyro's range).
+  double kappa_bank = 0.0;
+  {
+    constexpr int kSamples = 9;
+    const double half = 0.5 * kRollIn_s * v;
+    Eigen::Vector2d p_k, t_k;
+    for (int i = 0; i < kSamples; ++i) {
+      double k_i = 0.0;
+      const double s_i = std::clamp(s - half + 2.0 * half * i / (kSamples - 1), 0.0, legs_.back().s1);
+      horizontal(s_i, p_k, t_k, k_i);
+      kappa_bank += k_i / kSamples;
+    }
+  }
+  x.roll_rad = -std::atan(kappa_bank * v * v / kStandardGravity_mps2);
   x.C_enu_body = bodyToEnu(x.heading_rad, x.pitch_rad, x.roll_rad);
   x.C_ecef_body = R_enu_ecef_here.transpose() * x.C_enu_body;
   return x;

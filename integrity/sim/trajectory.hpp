@@ -35,7 +35,7 @@ struct TruthState {
   maps::Geodetic geodetic;
   double heading_rad = 0.0;  ///< clockwise from north
   double pitch_rad = 0.0;    ///< nose up positive (flight-path angle)
-  double roll_rad = 0.0;     ///< right wing down positive (coordinated-turn bank)
+  double roll_rad = 0.0;     ///< right wing down positive (coordinated-turn bank, rolled in over 1 s)
   Eigen::Matrix3d C_enu_body = Eigen::Matrix3d::Identity();   ///< body (FLU) → local ENU at the vehicle
   Eigen::Matrix3d C_ecef_body = Eigen::Matrix3d::Identity();  ///< body (FLU) → ECEF
 };

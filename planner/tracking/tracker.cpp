@@ -200,12 +200,7 @@ void Tracker::addFlight(const std::string& id, const ApprovedFlight& approval, s
   flights_.emplace(id, std::move(f));
 }
 
-std::string Tracker::addApprovalFile(const std::string& report_path, const std::string& id) {
-  return addApproval(maps::readJsonFile(report_path), report_path, id);
-}
-
-std::string Tracker::addApproval(const json& report, const std::string& report_path, const std::string& id) {
-  const ApprovedFlight plan = parseApprovalReport(report, report_path);
+std::string approvedMissionPath(const ApprovedFlight& plan, const std::string& report_path) {
   namespace fs = std::filesystem;
   // The mission as written (from here), where it was at approval time, or beside the report.
   fs::path mission = plan.mission_source;
@@ -215,11 +210,22 @@ std::string Tracker::addApproval(const json& report, const std::string& report_p
     throw maps::ParseError(report_path, 0, "$.source", plan.mission_source,
                            "a mission file that exists (as written, at $.source_absolute, or beside the report)");
   }
-  const std::string key = fs::weakly_canonical(mission).string();
   if (!plan.mission_sha256.empty() && maps::fileSha256Hex(mission.string()) != plan.mission_sha256) {
     throw maps::ParseError(report_path, 0, "$.inputs[role=mission].sha256", plan.mission_sha256,
                            "the digest of " + mission.string() + " (the mission changed since it was approved)");
   }
+  return mission.string();
+}
+
+std::string Tracker::addApprovalFile(const std::string& report_path, const std::string& id) {
+  return addApproval(maps::readJsonFile(report_path), report_path, id);
+}
+
+std::string Tracker::addApproval(const json& report, const std::string& report_path, const std::string& id) {
+  const ApprovedFlight plan = parseApprovalReport(report, report_path);
+  namespace fs = std::filesystem;
+  const fs::path mission = approvedMissionPath(plan, report_path);
+  const std::string key = fs::weakly_canonical(mission).string();
   if (!plan.approved) throw maps::ParseError(report_path, 0, "$.decision", "rejected", "an approved route");
   auto it = approvers_.find(key);
   if (it == approvers_.end()) it = approvers_.emplace(key, std::make_shared<Approver>(loadMission(mission.string()))).first;
@@ -768,6 +774,8 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       again.vpl_m = lf.pl.vpl_m;
       again.excluded = lf.excluded;
       again.note = lf.note + lf.pl.reason;
+      // A filter not yet aligned can start from the solution without the faulty satellite.
+      if (fix.imu && !f.nav && again.ok && lf.fault_excluded) f.align(fix, lf, note);
     }
     rerun = true;
     ++st.rerun_count;

@@ -171,6 +171,11 @@ class Tracker {
   std::optional<maps::GpsTime> last_sweep_;
 };
 
+/// \brief The mission of an approval: the report's `source` as written, at `source_absolute`, or
+/// beside the report, with the SHA-256 the report recorded.
+/// \throws maps::ParseError naming the report when it is missing or has changed.
+[[nodiscard]] std::string approvedMissionPath(const ApprovedFlight& plan, const std::string& report_path);
+
 /// \brief FlightState as JSON and back (the tracker database keeps it).
 [[nodiscard]] nlohmann::json flightStateJson(const FlightState& s);
 /// \throws maps::ParseError naming `source` for a malformed state.

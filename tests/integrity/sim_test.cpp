@@ -121,11 +121,24 @@ TEST(SimTrajectory, AttitudeFollowsTheVelocityAndTheCoordinatedTurn) {
       // The body's forward axis points along the velocity.
       ASSERT_GT(x.C_ecef_body.col(0).dot(x.v_ecef_mps.normalized()), 1.0 - 1e-12) << s;
       ASSERT_LT((x.C_ecef_body - R_enu_ecef.transpose() * x.C_enu_body).cwiseAbs().maxCoeff(), 1e-12);
-      // Bank of a coordinated turn, curvature from v and a: κ = (v × a)_z / |v_h|³.
-      const Eigen::Vector2d vh = x.v_enu_mps.head<2>(), ah = x.a_enu_mps2.head<2>();
-      const double speed_h = vh.norm();
-      const double kappa = (vh.x() * ah.y() - vh.y() * ah.x()) / (speed_h * speed_h * speed_h);
-      ASSERT_NEAR(x.roll_rad, -std::atan(kappa * speed_h * speed_h / kG_mps2), 1e-9) << s;
+      // Bank of a coordinated turn, curvature from v and a: κ = (v × a)_z / |v_h|³ — once the
+      // curvature has been the same for the 1 s the bank takes to roll in (±0.6 s here).
+      auto curvature = [&traj = traj](double t) {
+        const TruthState y = traj.at(t);
+        const Eigen::Vector2d vh = y.v_enu_mps.head<2>(), ah = y.a_enu_mps2.head<2>();
+        return (vh.x() * ah.y() - vh.y() * ah.x()) / std::pow(vh.norm(), 3);
+      };
+      const double speed_h = x.v_enu_mps.head<2>().norm();
+      const double kappa = curvature(s);
+      if (s > 0.6 && s + 0.6 < traj.duration_s() && std::abs(curvature(s - 0.6) - kappa) < 1e-9 &&
+          std::abs(curvature(s + 0.6) - kappa) < 1e-9) {
+        ASSERT_NEAR(x.roll_rad, -std::atan(kappa * speed_h * speed_h / kG_mps2), 1e-9) << s;
+      }
+      // The roll rate stays below tan(bank) of the fastest turn per second (the bank's tangent
+      // ramps linearly over 1 s; the paths fly ≤ 15 m/s on 30 m arcs). A step would be ≥ 4 rad/s.
+      if (s + 0.1 < traj.duration_s()) {
+        ASSERT_LT(std::abs(traj.at(s + 0.1).roll_rad - x.roll_rad) / 0.1, 1.05 * 15.5 * 15.5 / (30.0 * kG_mps2)) << s;
+      }
       if (std::abs(std::abs(kappa) - 1.0 / 30.0) < 1e-9) {
         ++on_arc;
         // Right turn (κ < 0): right wing down, roll > 0.

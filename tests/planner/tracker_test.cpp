@@ -763,6 +763,42 @@ TEST(TrackerGnssIns, MonteCarloWithRandomFaultsHasNoMisleadingFix) {
   ::testing::Test::RecordProperty("fixes", fixes);
 }
 
+TEST(TrackerGnssIns, SimulatedFixesWrittenAsJsonLinesReadBackTheSame) {
+  // GIVEN a simulated GNSS/INS flight (turns, climbs, a satellite fault)
+  const Approved a = largeUav();
+  integrity::sim::FaultSpec fault;
+  fault.pick = 0.3;
+  fault.t_start_s = 30.0;
+  fault.t_end_s = 60.0;
+  fault.magnitude = 40.0;
+  const auto flight = test::simulateRoute(a.report, *a.approver, {fault}, 31, 0.0, "F1", test::ImuFeed{});
+  for (const test::SimulatedFix& sf : flight) {
+    // WHEN each fix is written as a JSON line (skylane fly) and read back (skylane track)
+    const TrackFix& f = sf.fix;
+    const TrackFix g = parseTrackFixJson(json::parse(trackFixJson(f).dump()), "fly.jsonl:" + std::to_string(f.line));
+    // THEN it is the same fix, to the writer's rounding
+    ASSERT_EQ(g.flight, f.flight);
+    ASSERT_NEAR(g.time - f.time, 0.0, 5e-4);
+    ASSERT_NEAR(g.lat_rad, f.lat_rad, 1e-10);
+    ASSERT_NEAR(g.h_ell_m, f.h_ell_m, 1e-4);
+    ASSERT_EQ(g.ranges.size(), f.ranges.size());
+    for (std::size_t i = 0; i < f.ranges.size(); ++i) {
+      ASSERT_EQ(g.ranges[i].sat, f.ranges[i].sat);
+      ASSERT_NEAR(g.ranges[i].pr_m, f.ranges[i].pr_m, 1e-4);
+      ASSERT_LT((*g.ranges[i].sat_ecef_m - *f.ranges[i].sat_ecef_m).norm(), 1e-4);
+    }
+    ASSERT_TRUE(g.imu);
+    ASSERT_EQ(g.imu->increments.size(), f.imu->increments.size());
+    for (std::size_t i = 0; i < f.imu->increments.size(); ++i) {
+      ASSERT_EQ(g.imu->increments[i].dtheta_rad, f.imu->increments[i].dtheta_rad);
+      ASSERT_EQ(g.imu->increments[i].dv_mps, f.imu->increments[i].dv_mps);
+    }
+    ASSERT_LT((*g.attitude_rad - *f.attitude_rad).norm(), 1e-7);
+    ASSERT_LT((*g.velocity_enu_mps - *f.velocity_enu_mps).norm(), 1e-4);
+    ASSERT_NEAR(*g.baro_h_m, *f.baro_h_m, 1e-4);
+  }
+}
+
 TEST(TrackerGnssIns, ALostFixOrARestartAlignsTheFilterAgain) {
   const Approved a = largeUav();
   const auto flight = test::simulateRoute(a.report, *a.approver, {}, 27, 5.0, "F1", test::ImuFeed{});

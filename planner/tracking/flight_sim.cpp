@@ -1,0 +1,132 @@
+#include "planner/tracking/flight_sim.hpp"
+
+#include "integrity/sim/trajectory.hpp"
+#include "maps/geodesy.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <random>
+
+namespace skylane::planner {
+
+using nlohmann::json;
+
+std::vector<SimulatedFix> simulateFlight(const ApprovedFlight& flight, const Approver& approver, const FlightSimOptions& o,
+                                         const std::function<void(double)>& progress) {
+  if (flight.route.size() < 2) throw std::invalid_argument("simulateFlight: a route of at least 2 points is needed");
+  const maps::Geodetic origin{flight.route.front().lat_rad, flight.route.front().lon_rad, flight.route.front().h_ell_m};
+  const maps::LocalFrame enu(origin);
+  std::vector<integrity::sim::Waypoint> wps;
+  for (const RoutePoint& p : flight.route) {
+    wps.push_back({enu.toEnu({p.lat_rad, p.lon_rad, p.h_ell_m}), approver.mission().cruise_speed_mps});
+  }
+  const integrity::sim::Trajectory traj(origin, wps, o.turn_radius_m);
+  integrity::sim::SensorSpec spec;
+  spec.model = approver.mission().model;
+  spec.elevation_mask_rad = maps::deg2rad(approver.mission().mask_deg);
+  if (o.imu) spec.imu = integrity::sim::imuSpec(o.imu->grade);
+  integrity::sim::SensorSimulator sim(traj, approver.orbits(), flight.departure, spec, o.faults, o.seed);
+  std::mt19937_64 onboard_rng(o.seed ^ 0x5eedULL);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  auto noise3 = [&] { return Eigen::Vector3d(n01(onboard_rng), n01(onboard_rng), n01(onboard_rng)); };
+  std::vector<SimulatedFix> out;
+  std::vector<ImuIncrement> increments;
+  double reported = 0.0;
+  while (sim.running()) {
+    const integrity::sim::ImuSample is = sim.stepImu();
+    increments.push_back({is.dt_s, is.dtheta_rad, is.dv_mps});
+    if (!sim.gnssDue()) continue;
+    const integrity::sim::GnssEpoch ep = sim.gnss();
+    const integrity::sim::TruthState& x = sim.truth();
+    SimulatedFix s;
+    s.t_s = ep.t_s;
+    s.truth = x.geodetic;
+    s.fix.flight = o.flight;
+    s.fix.time = ep.time;
+    s.fix.lat_rad = x.geodetic.lat_rad;
+    s.fix.lon_rad = x.geodetic.lon_rad;
+    s.fix.h_ell_m = x.geodetic.h_ell_m + o.reported_dh_m;
+    for (const integrity::sim::Pseudorange& pr : ep.ranges) {
+      s.fix.ranges.push_back({pr.sat, pr.pseudorange_m, pr.sat_ecef_m});
+      if (pr.injected_m != 0.0) s.faulty = pr.sat;
+    }
+    s.fix.pl_source = PlSource::kRaw;
+    if (o.imu) {
+      ImuRecord rec;
+      rec.grade = static_cast<int>(o.imu->grade);
+      rec.increments = std::move(increments);
+      s.fix.imu = std::move(rec);
+      s.fix.velocity_enu_mps = x.v_enu_mps + o.imu->velocity_sigma_mps * noise3();
+      s.fix.attitude_rad = Eigen::Vector3d(x.roll_rad, x.pitch_rad, x.heading_rad) + o.imu->attitude_sigma_rad * noise3();
+      if (o.imu->aiding) {
+        const integrity::sim::AidingSample aid = sim.aiding();
+        s.fix.baro_h_m = aid.baro_h_m;
+        s.fix.mag_heading_rad = aid.heading_rad;
+      }
+    }
+    increments.clear();
+    s.fix.line = out.size() + 1;
+    s.fix.source = "simulated:" + std::to_string(s.fix.line);
+    out.push_back(std::move(s));
+    if (progress && ep.t_s - reported >= 10.0) {
+      reported = ep.t_s;
+      progress(ep.t_s / traj.duration_s());
+    }
+  }
+  if (progress) progress(1.0);
+  return out;
+}
+
+namespace {
+
+double round_to(double v, double step) { return std::round(v / step) * step; }
+
+json vec(const Eigen::Vector3d& v, double step) {
+  return json::array({round_to(v.x(), step), round_to(v.y(), step), round_to(v.z(), step)});
+}
+
+}  // namespace
+
+json trackFixJson(const TrackFix& f) {
+  json j;
+  if (!f.flight.empty()) j["flight"] = f.flight;
+  j["time"] = maps::formatRfc3339(f.time, 3);
+  j["lat"] = round_to(maps::rad2deg(f.lat_rad), 1e-9);
+  j["lon"] = round_to(maps::rad2deg(f.lon_rad), 1e-9);
+  j["h_ell_m"] = round_to(f.h_ell_m, 1e-4);
+  if (f.hpl_m && f.vpl_m) {
+    j["hpl_m"] = round_to(*f.hpl_m, 1e-4);
+    j["vpl_m"] = round_to(*f.vpl_m, 1e-4);
+  }
+  if (!f.ranges.empty()) {
+    json list = json::array();
+    for (const integrity::RawRange& r : f.ranges) {
+      json one = {{"sat", r.sat.str()}, {"pr_m", round_to(r.pr_m, 1e-4)}};
+      if (r.sat_ecef_m) one["ecef_m"] = vec(*r.sat_ecef_m, 1e-4);
+      list.push_back(std::move(one));
+    }
+    j["pseudoranges"] = std::move(list);
+  }
+  static const char* const kGrades[] = {"aviation", "tactical", "consumer"};
+  if (f.imu) {
+    json inc = json::array();
+    for (const ImuIncrement& i : f.imu->increments) {
+      inc.push_back({i.dt_s, i.dtheta_rad.x(), i.dtheta_rad.y(), i.dtheta_rad.z(), i.dv_mps.x(), i.dv_mps.y(), i.dv_mps.z()});
+    }
+    j["imu"] = {{"grade", kGrades[f.imu->grade]}, {"increments", std::move(inc)}};
+  } else if (f.ins) {
+    j["imu"] = {{"grade", kGrades[f.ins->grade]}, {"sigma_n_m", f.ins->sigma_n_m}, {"sigma_e_m", f.ins->sigma_e_m}, {"sigma_u_m", f.ins->sigma_u_m}};
+  }
+  if (f.velocity_enu_mps) j["velocity_enu_mps"] = vec(*f.velocity_enu_mps, 1e-4);
+  if (f.attitude_rad) {
+    j["attitude_deg"] = {{"roll", round_to(maps::rad2deg(f.attitude_rad->x()), 1e-6)},
+                         {"pitch", round_to(maps::rad2deg(f.attitude_rad->y()), 1e-6)},
+                         {"heading", round_to(maps::rad2deg(f.attitude_rad->z()), 1e-6)}};
+  }
+  if (f.baro_h_m) j["baro_h_m"] = round_to(*f.baro_h_m, 1e-4);
+  if (f.mag_heading_rad) j["mag_heading_deg"] = round_to(maps::rad2deg(*f.mag_heading_rad), 1e-6);
+  return j;
+}
+
+}  // namespace skylane::planner
