@@ -69,3 +69,27 @@ for l in open("examples/out/track/events.jsonl"):
 ./build/skylane track --approval zrh=examples/out/approve/report.json --format nmea --input examples/out/track/fixes.nmea \
   > examples/out/track/events_nmea.jsonl 2> /dev/null
 echo "  NMEA (GGA + GST + RMC) replay: $(grep -c '"verdict":"inside"' examples/out/track/events_nmea.jsonl) of $(wc -l < examples/out/track/events_nmea.jsonl) fixes inside"
+echo "--- GNSS/INS tracking rehearsal: a 40 m survey drone flown by the simulator (skylane fly: tactical IMU, a 60 m step on G20 at 60-120 s,"
+echo "    an accelerometer step at 140 s), tracked from its raw pseudoranges and IMU increments (examples/out/track_gnss_ins/):"
+mkdir -p examples/out/track_gnss_ins
+./build/skylane approve examples/track/gnss_ins/mission.json --out examples/out/track_gnss_ins/approve > /dev/null
+./build/skylane fly examples/out/track_gnss_ins/approve/report.json --out examples/out/track_gnss_ins/fixes.jsonl --imu tactical \
+  --faults examples/track/gnss_ins/faults.json --seed 3 --flight uav --truth examples/out/track_gnss_ins/truth.csv
+./build/skylane track --approval uav=examples/out/track_gnss_ins/approve/report.json --input examples/out/track_gnss_ins/fixes.jsonl \
+  --map examples/out/track_gnss_ins/track.svg > examples/out/track_gnss_ins/events.jsonl 2> /dev/null
+python3 - <<'PY'
+import csv, json, math
+d = "examples/out/track_gnss_ins/"
+truth = {int(r["line"]): r for r in csv.DictReader(open(d + "truth.csv"))}
+fixes = [e for e in map(json.loads, open(d + "events.jsonl")) if e["event"] == "fix"]
+def ratio(e):
+    t = truth[e["line"]]
+    n = math.radians(e["lat"] - float(t["lat_deg"])) * 6371000.0
+    east = math.radians(e["lon"] - float(t["lon_deg"])) * 6371000.0 * math.cos(math.radians(e["lat"]))
+    return max(math.hypot(n, east) / e["hpl_m"], abs(e["h_ell_m"] - float(t["h_ell_m"])) / e["vpl_m"])
+src = {}
+for e in fixes: src[e["pl_source"]] = src.get(e["pl_source"], 0) + 1
+print("  %d fixes %s; inside: %d; G20 excluded at %d; GNSS alone after the IMU fault at %d; worst error/PL %.2f"
+      % (len(fixes), src, sum(e["verdict"] == "inside" for e in fixes), sum("G20" in e.get("excluded", []) for e in fixes),
+         sum(e.get("ins_degraded", False) for e in fixes), max(map(ratio, fixes))))
+PY

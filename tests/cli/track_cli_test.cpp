@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdio>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -288,6 +289,42 @@ TEST_F(TrackCli, BadApprovalsExitTwoNamingTheField) {
   const RunResult fmt = sh(kBin + " track --approval " + approval() + " --input /dev/null --level1 5/3 2>&1");
   EXPECT_EQ(fmt.status, 2) << fmt.out;
   EXPECT_NE(fmt.out.find("--level1"), std::string::npos) << fmt.out;
+}
+
+TEST_F(TrackCli, FlyWritesFixesThatTrackReadsAndBadOptionsExitTwo) {
+  const std::string report = *dir_ + "/approve/report.json", fixes = *dir_ + "/fly.jsonl", faults = *dir_ + "/fly_faults.json";
+  // GIVEN the approved example flown by the simulator with a tactical IMU and a 60 m step on one satellite
+  std::ofstream(faults) << R"({"faults": [{"type": "satellite", "sats": ["G20"], "start_s": 20, "end_s": 40, "bias_m": 60}]})";
+  const RunResult fly = sh(kBin + " fly " + report + " --out " + fixes + " --imu tactical --faults " + faults +
+                           " --flight zrh --truth " + *dir_ + "/fly_truth.csv 2>&1; echo status=$?");
+  ASSERT_NE(fly.out.find("status=0"), std::string::npos) << fly.out;
+  // WHEN skylane track reads them
+  const RunResult track = sh(kBin + " track --approval " + approval() + " --input " + fixes + " --no-replan > " + *dir_ +
+                             "/fly_events.jsonl 2>/dev/null; echo status=$?");
+  ASSERT_NE(track.out.find("status=0"), std::string::npos) << track.out;
+  // THEN every fix is accepted, from the first aligned on seed 001's GNSS/INS flow
+  const auto ev = readEvents(*dir_ + "/fly_events.jsonl");
+  const auto fx = ofType(ev, "fix");
+  EXPECT_TRUE(ofType(ev, "rejected_input").empty());
+  std::ifstream truth(*dir_ + "/fly_truth.csv");
+  const auto rows = std::count(std::istreambuf_iterator<char>(truth), std::istreambuf_iterator<char>(), '\n');
+  EXPECT_EQ(static_cast<long>(fx.size()), rows - 1);
+  ASSERT_GT(fx.size(), 100u);
+  int ins = 0, excluded = 0;
+  for (const json& f : fx) {
+    ins += f.at("pl_source") == "gnss_ins";
+    if (f.contains("excluded") && f.at("excluded").size() == 1 && f.at("excluded")[0] == "G20") ++excluded;
+  }
+  EXPECT_EQ(ins, static_cast<int>(fx.size()) - 1);
+  EXPECT_EQ(excluded, 20);
+  // AND bad options name what was expected and exit 2
+  RunResult bad = sh(kBin + " fly " + report + " --out " + fixes + " --imu toy 2>&1; echo status=$?");
+  EXPECT_NE(bad.out.find("aviation, tactical or consumer"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("status=2"), std::string::npos) << bad.out;
+  std::ofstream(faults) << R"([{"type": "satellite", "sats": ["G20"], "start_s": 20, "end_s": 10, "bias_m": 60}])";
+  bad = sh(kBin + " fly " + report + " --out " + fixes + " --faults " + faults + " 2>&1; echo status=$?");
+  EXPECT_NE(bad.out.find("[0].end_s"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("status=2"), std::string::npos) << bad.out;
 }
 
 TEST(TrackCliRinex, ObservationReplayGivesSkylanesOwnPls) {
