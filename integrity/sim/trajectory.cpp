@@ -165,6 +165,22 @@ double Trajectory::arcLengthAt(double t_s, double& speed, double& accel, const L
 /// How long rolling into or out of a turn takes.
 constexpr double kRollIn_s = 1.0;
 
+double Trajectory::meanCurvature(double a, double b, double at_s) const {
+  const double total = pieces_.back().s0 + pieces_.back().length;
+  a = std::max(a, 0.0);
+  b = std::min(b, total);
+  if (!(b - a > 1e-9)) return at_s;
+  // Σ κ_piece · (overlap of the piece with [a, b]) / (b − a): lines have κ = 0.
+  double sum = 0.0;
+  auto it = std::upper_bound(pieces_.begin(), pieces_.end(), a, [](double v, const Piece& pc) { return v < pc.s0; });
+  for (auto p = it == pieces_.begin() ? it : it - 1; p != pieces_.end() && p->s0 < b; ++p) {
+    if (!p->arc) continue;
+    const double overlap = std::min(b, p->s0 + p->length) - std::max(a, p->s0);
+    if (overlap > 0.0) sum += (p->turn > 0.0 ? 1.0 : -1.0) / p->radius * overlap;
+  }
+  return sum / (b - a);
+}
+
 TruthState Trajectory::at(double t_s) const {
   TruthState x;
   x.t_s = t_s;
@@ -213,18 +229,7 @@ TruthState Trajectory::at(double t_s) const {
   // Coordinated-turn bank, rolled in and out over kRollIn_s: the curvature averaged over the path
   // flown in ±kRollIn_s/2 (a step in curvature at an arc's ends would otherwise be a step in bank:
   // an angular rate far beyond any airframe's and any gyro's range).
-  double kappa_bank = 0.0;
-  {
-    constexpr int kSamples = 9;
-    const double half = 0.5 * kRollIn_s * v;
-    Eigen::Vector2d p_k, t_k;
-    for (int i = 0; i < kSamples; ++i) {
-      double k_i = 0.0;
-      const double s_i = std::clamp(s - half + 2.0 * half * i / (kSamples - 1), 0.0, legs_.back().s1);
-      horizontal(s_i, p_k, t_k, k_i);
-      kappa_bank += k_i / kSamples;
-    }
-  }
+  const double kappa_bank = meanCurvature(s - 0.5 * kRollIn_s * v, s + 0.5 * kRollIn_s * v, kappa);
   x.roll_rad = -std::atan(kappa_bank * v * v / kStandardGravity_mps2);
   x.C_enu_body = bodyToEnu(x.heading_rad, x.pitch_rad, x.roll_rad);
   x.C_ecef_body = R_enu_ecef_here.transpose() * x.C_enu_body;

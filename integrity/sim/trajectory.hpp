@@ -77,6 +77,9 @@ class Trajectory {
   };
 
   void horizontal(double s, Eigen::Vector2d& p, Eigen::Vector2d& tangent, double& curvature) const;
+  /// The mean signed curvature over horizontal arc lengths [a, b] (clipped to the path; `at_s`
+  /// when that leaves nothing).
+  [[nodiscard]] double meanCurvature(double a, double b, double at_s) const;
   [[nodiscard]] double arcLengthAt(double t_s, double& speed, double& accel, const Leg*& leg) const;
 
   maps::LocalFrame frame_;
