@@ -519,6 +519,17 @@ TEST_F(TrackerOnExample, RawFixesWhosePlNeverFitsHal1RerunOnceAndAreNotReplanned
   }
 }
 
+/// A step of `bias_m` on the satellite in the middle of those in view (in id order) over [t0, t1).
+integrity::sim::FaultSpec satelliteStep(double bias_m, double t0, double t1) {
+  integrity::sim::FaultSpec f;
+  f.target = integrity::sim::FaultTarget::kSatellite;
+  f.pick = 0.5;
+  f.t_start_s = t0;
+  f.t_end_s = t1;
+  f.magnitude = bias_m;
+  return f;
+}
+
 TEST(TrackerRaw, SatelliteFaultIsExcludedByTheRerunAndTheFlightRecoversWithoutAReplan) {
   // GIVEN a large UAV (20 m span, 25 m long: HAL₁ = 24 m, VAL₁ = 30 m) on the example route, so
   // that fault-free RAIM PLs (≈ 12–13 m here) fit level 1
@@ -532,12 +543,7 @@ TEST(TrackerRaw, SatelliteFaultIsExcludedByTheRerunAndTheFlightRecoversWithoutAR
   tracker.addFlight("F1", a.flight, a.approver);
   // AND the GNSS/INS simulator flying that route, with a 60 m step on one satellite from 60 s to 120 s
   const ApprovalReport& r = a.report;
-  integrity::sim::FaultSpec fault;
-  fault.target = integrity::sim::FaultTarget::kSatellite;
-  fault.pick = 0.5;
-  fault.t_start_s = 60.0;
-  fault.t_end_s = 120.0;
-  fault.magnitude = 60.0;
+  const integrity::sim::FaultSpec fault = satelliteStep(60.0, 60.0, 120.0);
   int reruns = 0, in_fault = 0, before = 0;
   std::vector<json> all;
   // (the reported height is 5 m off: it only starts skylane's own solution)
@@ -596,6 +602,12 @@ std::pair<double, double> fixError(const json& fix, const maps::Geodetic& truth)
   return {d.head<2>().norm(), std::abs(d.z())};
 }
 
+/// Whether a fix event's PLs bound its position's error (HPE ≤ HPL and VPE ≤ VPL).
+bool plsBound(const json& fix, const maps::Geodetic& truth) {
+  const auto [eh, ev] = fixError(fix, truth);
+  return eh <= fix.at("hpl_m").get<double>() && ev <= fix.at("vpl_m").get<double>();
+}
+
 TEST(TrackerGnssIns, FixesWithImuIncrementsUseSeed001sFlowAndItsPlsBoundTheError) {
   // GIVEN the large UAV flown by the simulator with a tactical IMU, barometer and magnetometer
   const Approved a = largeUav();
@@ -621,8 +633,7 @@ TEST(TrackerGnssIns, FixesWithImuIncrementsUseSeed001sFlowAndItsPlsBoundTheError
     ASSERT_EQ(fix.at("pl_source"), "gnss_ins") << fix.dump();
     EXPECT_FALSE(fix.at("ins_degraded").get<bool>());
     ++ins;
-    const auto [eh, ev_] = fixError(fix, sf.truth);
-    if (eh <= fix.at("hpl_m").get<double>() && ev_ <= fix.at("vpl_m").get<double>()) ++bounded;
+    bounded += plsBound(fix, sf.truth);
     EXPECT_EQ(fix.at("verdict"), "inside") << fix.dump();
   }
   EXPECT_EQ(bounded, ins);
@@ -635,12 +646,7 @@ TEST(TrackerGnssIns, ASatelliteFaultIsExcludedByTheFlowAndTheErrorStaysBounded) 
   const Approved a = largeUav();
   Tracker tracker;
   tracker.addFlight("F1", a.flight, a.approver);
-  integrity::sim::FaultSpec fault;
-  fault.target = integrity::sim::FaultTarget::kSatellite;
-  fault.pick = 0.5;
-  fault.t_start_s = 60.0;
-  fault.t_end_s = 120.0;
-  fault.magnitude = 60.0;
+  const integrity::sim::FaultSpec fault = satelliteStep(60.0, 60.0, 120.0);
   int in_fault = 0, excluded_faulty = 0, excluded_other = 0, fixes = 0, bounded = 0;
   std::vector<json> all;
   for (const test::SimulatedFix& sf : test::simulateRoute(a.report, *a.approver, {fault}, 23, 5.0, "F1", test::ImuFeed{})) {
@@ -666,8 +672,7 @@ TEST(TrackerGnssIns, ASatelliteFaultIsExcludedByTheFlowAndTheErrorStaysBounded) 
     } else {
       excluded_other += static_cast<int>(ex.size());
     }
-    const auto [eh, ev_] = fixError(fix, sf.truth);
-    if (eh <= fix.at("hpl_m").get<double>() && ev_ <= fix.at("vpl_m").get<double>()) ++bounded;
+    bounded += plsBound(fix, sf.truth);
     EXPECT_EQ(fix.at("verdict"), "inside") << fix.dump();
   }
   EXPECT_GE(in_fault, 59);
@@ -702,8 +707,7 @@ TEST(TrackerGnssIns, AnAccelerometerFaultDegradesToGnssAloneAndTheErrorStaysBoun
       // THEN the IMU innovation test sends the flow to GNSS alone (seed 001 class 1)
       EXPECT_GE(sf.t_s, 60.0);
     }
-    const auto [eh, ev_] = fixError(fix, sf.truth);
-    if (eh <= fix.at("hpl_m").get<double>() && ev_ <= fix.at("vpl_m").get<double>()) ++bounded;
+    bounded += plsBound(fix, sf.truth);
   }
   EXPECT_GT(degraded, 60);
   // AND the PLs bound the error throughout
