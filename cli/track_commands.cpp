@@ -70,6 +70,16 @@ class TrackMap {
   void add(const planner::TrackEvent& e) {
     if (e.fix) {
       tracks_[e.flight].push_back({e.fix->lat_rad, e.fix->lon_rad, static_cast<int>(e.fix->verdict.verdict)});
+      // The start of each exclusion and of each GNSS-alone stretch (IMU fault) is marked.
+      Episodes& ep = episodes_[e.flight];
+      std::string excluded;
+      for (const integrity::SatId& s : e.fix->excluded) excluded += (excluded.empty() ? "" : ", ") + s.str();
+      const Eigen::Vector2d here(e.fix->lat_rad, e.fix->lon_rad);
+      if (!excluded.empty() && excluded != ep.excluded) marks_.push_back({here, "excluded " + excluded, "#17becf"});
+      ep.excluded = excluded;
+      const bool degraded = e.fix->ins_degraded.value_or(false);
+      if (degraded && !ep.degraded) marks_.push_back({here, "GNSS alone (IMU fault)", "#8c564b"});
+      ep.degraded = degraded;
       return;
     }
     if (!e.time || e.flight.empty()) return;
@@ -85,9 +95,6 @@ class TrackMap {
       const auto& last = tracks_[e.flight].back();
       const std::string cause = e.body.value("cause", e.body.value("subject", ""));
       marks_.push_back({{last.lat, last.lon}, e.body.value("level", "") + " (" + cause + ")", "#d62728"});
-    } else if (e.is("monitoring_rerun") && !e.body.at("excluded").empty() && reruns_++ == 0 && !tracks_[e.flight].empty()) {
-      const auto& last = tracks_[e.flight].back();
-      marks_.push_back({{last.lat, last.lon}, "rerun: excluded " + e.body.at("excluded")[0].get<std::string>(), "#17becf"});
     }
   }
   std::string svg(const planner::Tracker& tracker) const {
@@ -153,7 +160,8 @@ class TrackMap {
     return renderPlanMapSvg("skylane track: " + std::to_string(tracks_.size()) + " flight(s), " + std::to_string(fixes) + " fixes",
                             shapes, lines, markers, 150.0,
                             {"track coloured by the fix verdict (corridor, airspace, zones, obstacles)",
-                             "purple: replans from where the vehicle was; red: violations"});
+                             "purple: replans from where the vehicle was; red: violations; cyan: satellites excluded;",
+                             "brown: GNSS alone after an IMU fault (GNSS/INS)"});
   }
 
  private:
@@ -167,8 +175,12 @@ class TrackMap {
   };
   std::map<std::string, std::vector<std::vector<Eigen::Vector2d>>> routes_;
   std::map<std::string, std::vector<Point>> tracks_;
+  struct Episodes {
+    std::string excluded;  ///< the satellites the last fix left out
+    bool degraded = false;
+  };
   std::vector<Mark> marks_;
-  int reruns_ = 0;
+  std::map<std::string, Episodes> episodes_;
 };
 
 std::pair<int, int> parseMofN(const std::string& text, const char* option) {

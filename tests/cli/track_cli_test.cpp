@@ -299,9 +299,12 @@ TEST_F(TrackCli, FlyWritesFixesThatTrackReadsAndBadOptionsExitTwo) {
                            " --flight zrh --truth " + *dir_ + "/fly_truth.csv 2>&1; echo status=$?");
   ASSERT_NE(fly.out.find("status=0"), std::string::npos) << fly.out;
   // WHEN skylane track reads them
-  const RunResult track = sh(kBin + " track --approval " + approval() + " --input " + fixes + " --no-replan > " + *dir_ +
-                             "/fly_events.jsonl 2>/dev/null; echo status=$?");
+  const RunResult track = sh(kBin + " track --approval " + approval() + " --input " + fixes + " --no-replan --map " + *dir_ +
+                             "/fly.svg > " + *dir_ + "/fly_events.jsonl 2>/dev/null; echo status=$?");
   ASSERT_NE(track.out.find("status=0"), std::string::npos) << track.out;
+  std::ifstream svg(*dir_ + "/fly.svg");
+  const std::string map((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
+  EXPECT_NE(map.find("excluded G20"), std::string::npos);  // the map marks the exclusion
   // THEN every fix is accepted, from the first aligned on seed 001's GNSS/INS flow
   const auto ev = readEvents(*dir_ + "/fly_events.jsonl");
   const auto fx = ofType(ev, "fix");
