@@ -125,6 +125,19 @@ struct Tracker::Flight {
     return std::nullopt;
   }
 
+  /// The fix's epoch again from the filter as it was (`before`), with one more exclusion allowed
+  /// (the monitoring rerun of the GNSS/INS flow); when it gives a PL the filter takes it.
+  std::optional<integrity::ins::NavigatorEpoch> deeperEpoch(const integrity::ins::Navigator& before, const TrackFix& fix) {
+    integrity::ins::Navigator deeper = before;
+    const int max_exclusions = deeper.config().max_exclusions;
+    deeper.setMaxExclusions(max_exclusions + 1);
+    integrity::ins::NavigatorEpoch ep = runInsEpoch(deeper, fix);
+    if (!ep.seed001_available) return std::nullopt;
+    deeper.setMaxExclusions(max_exclusions);
+    *nav = std::move(deeper);
+    return ep;
+  }
+
   /// Aligns the filter at a snapshot solution with the fix's velocity and attitude.
   void align(const TrackFix& fix, const integrity::LiveFix& snap, std::string& note) {
     if (!fix.velocity_enu_mps || !fix.attitude_rad) {
@@ -660,8 +673,29 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   std::string note;
   std::optional<integrity::ins::NavigatorEpoch> ins_ep;
   std::optional<integrity::ins::Navigator> ins_before;
+  std::vector<TrackEvent> pre_events;  // written once the fix is accepted
+  bool early_rerun = false;
   if (fix.imu && !fix.ranges.empty()) {
     ins_ep = f.insEpoch(fix, note, ins_before);
+    if (ins_ep && !ins_ep->seed001_available && ins_ep->gnss_fault_detected && ins_before) {
+      // A fault detected and not excluded: the monitoring rerun at once, one more exclusion allowed.
+      if (auto again = f.deeperEpoch(*ins_before, fix)) {
+        TrackEvent e = event("monitoring_rerun", id, fix.time);
+        e["fault_detected"] = true;
+        json ex = json::array();
+        for (const integrity::SatId& s : again->excluded) ex.push_back(s.str());
+        e["excluded"] = ex;
+        e["hpl_before_m"] = nullptr;
+        e["vpl_before_m"] = nullptr;
+        e["hpl_after_m"] = metres(again->seed001_hpl_m);
+        e["vpl_after_m"] = metres(again->seed001_vpl_m);
+        e["note"] = "GNSS/INS: a fault detected and not excluded; the epoch again with one more exclusion";
+        e["line"] = fix.line;
+        pre_events.push_back(std::move(e));
+        ins_ep = again;
+        early_rerun = true;
+      }
+    }
     if (ins_ep && !ins_ep->seed001_available) {
       note = ins_ep->outage ? "GNSS/INS: no pseudorange above the mask (dead reckoning, no integrity); the snapshot is used"
                             : "GNSS/INS gave no protection level (" +
@@ -720,6 +754,8 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   if (!last_sweep_ || *stream_time_ - *last_sweep_ >= 1.0 || *stream_time_ - *last_sweep_ < 0.0) {
     for (TrackEvent& e : sweepStale(*stream_time_)) out.push_back(std::move(e));
   }
+  for (TrackEvent& e : pre_events) out.push_back(std::move(e));
+  if (early_rerun) ++st.rerun_count;
   st.last_time = fix.time;
   st.stale_reported = false;
   ++st.fixes;
@@ -733,10 +769,10 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   };
 
   // Monitoring rerun: FDE over the raw measurements when level 1 is not held.
-  bool rerun = false;
+  bool rerun = early_rerun;  // (GNSS/INS: already rerun for a fault it could not exclude)
   std::vector<integrity::SatId> excluded;
   if (ins_ep) excluded = ins_ep->excluded;
-  if ((first || ins_ep) && levelVerdict(verdict, geofence::Level::kCorridor) != geofence::Verdict::kInside) {
+  if ((first || ins_ep) && !early_rerun && levelVerdict(verdict, geofence::Level::kCorridor) != geofence::Verdict::kInside) {
     // The rerun's solution: raw ranges, the method's FDE; GNSS/INS, the epoch again from the
     // filter as it was with one more exclusion allowed (step 1 of the flow already ran its FDE).
     struct Again {
@@ -750,14 +786,8 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
     if (ins_ep) {
       again = {true, pos, *hpl, *vpl, ins_ep->excluded, ""};
       if (detected && ins_before) {
-        integrity::ins::Navigator deeper = *ins_before;
-        const int max_exclusions = deeper.config().max_exclusions;
-        deeper.setMaxExclusions(max_exclusions + 1);
-        const integrity::ins::NavigatorEpoch ep2 = f.runInsEpoch(deeper, fix);
-        if (ep2.seed001_available) {
-          again = {true, maps::ecefToGeodetic(ep2.r_ecef_m), ep2.seed001_hpl_m, ep2.seed001_vpl_m, ep2.excluded, ""};
-          deeper.setMaxExclusions(max_exclusions);
-          *f.nav = std::move(deeper);
+        if (auto ep2 = f.deeperEpoch(*ins_before, fix)) {
+          again = {true, maps::ecefToGeodetic(ep2->r_ecef_m), ep2->seed001_hpl_m, ep2->seed001_vpl_m, ep2->excluded, ""};
           ins_ep = ep2;
         } else {
           again.note = "the epoch with one more exclusion gave no PL; the first pass stands";

@@ -684,6 +684,47 @@ TEST(TrackerGnssIns, ASatelliteFaultIsExcludedByTheFlowAndTheErrorStaysBounded) 
   EXPECT_TRUE(ofType(all, "replan").empty());
 }
 
+TEST(TrackerGnssIns, TwoSatelliteFaultsAreExcludedByTheRerunWithOneMoreExclusion) {
+  // GIVEN 60 m steps on two satellites at once from 40 s to 150 s (step 1 of the flow may
+  // exclude one: it detects a fault it cannot exclude)
+  const Approved a = largeUav();
+  Tracker tracker;
+  tracker.addFlight("F1", a.flight, a.approver);
+  integrity::sim::FaultSpec second = satelliteStep(60.0, 40.0, 150.0);
+  second.pick = 0.1;
+  int in_fault = 0, both_excluded = 0, snapshot = 0, fixes = 0, bounded = 0, reruns = 0;
+  for (const test::SimulatedFix& sf :
+       test::simulateRoute(a.report, *a.approver, {satelliteStep(60.0, 40.0, 150.0), second}, 33, 5.0, "F1", test::ImuFeed{})) {
+    const auto ev = tracker.processJson(sf.fix);
+    const json& fix = ev.back();
+    ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
+    reruns += static_cast<int>(ofType(ev, "monitoring_rerun").size());
+    if (sf.fix.line == 1) continue;
+    // THEN the fixes stay on the GNSS/INS flow, the rerun leaving both satellites out (or, where
+    // the remaining geometry cannot tell, the snapshot's grown PL_det stands)
+    ++fixes;
+    if (sf.t_s >= 40.0 && sf.t_s < 150.0) {
+      ++in_fault;
+      both_excluded += fix.at("pl_source") == "gnss_ins" && fix.value("excluded", json::array()).size() == 2;
+      if (fix.at("pl_source") != "gnss_ins") {
+        ++snapshot;
+        EXPECT_TRUE(fix.at("fault_detected").get<bool>()) << fix.dump();
+      }
+    } else {
+      ASSERT_EQ(fix.at("pl_source"), "gnss_ins") << fix.dump();
+      EXPECT_EQ(fix.at("verdict"), "inside") << fix.dump();
+    }
+    bounded += plsBound(fix, sf.truth);
+  }
+  EXPECT_GE(in_fault, 109);
+  EXPECT_GE(both_excluded, in_fault * 9 / 10) << snapshot << " snapshot fixes";
+  ::testing::Test::RecordProperty("snapshot_fixes", snapshot);
+  ::testing::Test::RecordProperty("both_excluded", both_excluded);
+  EXPECT_GE(reruns, in_fault / 2);
+  // AND the PLs bound the error at every fix
+  EXPECT_EQ(bounded, fixes);
+}
+
 TEST(TrackerGnssIns, AnAccelerometerFaultDegradesToGnssAloneAndTheErrorStaysBounded) {
   // GIVEN an accelerometer step of 0.5 m/s² on the up axis from 60 s to 200 s
   const Approved a = largeUav();
