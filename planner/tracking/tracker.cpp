@@ -105,7 +105,7 @@ struct Tracker::Flight {
   /// increments continue it (they must span the time since its last epoch; else it aligns
   /// again). `before` keeps the filter as it was, for a monitoring rerun.
   std::optional<integrity::ins::NavigatorEpoch> insEpoch(const TrackFix& fix, std::string& note,
-                                                         std::optional<integrity::ins::Navigator>& before) {
+                                                         std::unique_ptr<integrity::ins::Navigator>& before) {
     if (!nav) return std::nullopt;
     const double gap = fix.time - nav_time, span = fix.imu->span_s();
     char buf[160];
@@ -115,7 +115,7 @@ struct Tracker::Flight {
       std::snprintf(buf, sizeof buf, "GNSS/INS: the IMU increments span %.3f s but the fixes are %.3f s apart; the filter aligns again",
                     span, gap);
     } else {
-      before.emplace(*nav);
+      before = std::make_unique<integrity::ins::Navigator>(*nav);
       integrity::ins::NavigatorEpoch ep = runInsEpoch(*nav, fix);
       nav_time = fix.time;
       return ep;
@@ -128,13 +128,13 @@ struct Tracker::Flight {
   /// The fix's epoch again from the filter as it was (`before`), with one more exclusion allowed
   /// (the monitoring rerun of the GNSS/INS flow); when it gives a PL the filter takes it.
   std::optional<integrity::ins::NavigatorEpoch> deeperEpoch(const integrity::ins::Navigator& before, const TrackFix& fix) {
-    integrity::ins::Navigator deeper = before;
-    const int max_exclusions = deeper.config().max_exclusions;
-    deeper.setMaxExclusions(max_exclusions + 1);
-    integrity::ins::NavigatorEpoch ep = runInsEpoch(deeper, fix);
+    auto deeper = std::make_unique<integrity::ins::Navigator>(before);  // (kept off the fix path's stack)
+    const int max_exclusions = deeper->config().max_exclusions;
+    deeper->setMaxExclusions(max_exclusions + 1);
+    integrity::ins::NavigatorEpoch ep = runInsEpoch(*deeper, fix);
     if (!ep.seed001_available) return std::nullopt;
-    deeper.setMaxExclusions(max_exclusions);
-    *nav = std::move(deeper);
+    deeper->setMaxExclusions(max_exclusions);
+    nav = std::move(deeper);
     return ep;
   }
 
@@ -672,7 +672,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   std::optional<integrity::LiveFix> first;
   std::string note;
   std::optional<integrity::ins::NavigatorEpoch> ins_ep;
-  std::optional<integrity::ins::Navigator> ins_before;
+  std::unique_ptr<integrity::ins::Navigator> ins_before;  // the filter before this epoch (GNSS/INS)
   std::vector<TrackEvent> pre_events;  // written once the fix is accepted
   bool early_rerun = false;
   if (fix.imu && !fix.ranges.empty()) {

@@ -87,7 +87,7 @@ struct TrackEvent {
   std::string flight;             ///< empty: none (an unreadable record)
   std::optional<maps::GpsTime> time;
   std::optional<FixRecord> fix;
-  nlohmann::json body = nlohmann::json::object();
+  nlohmann::json body;  ///< null until a field is set (a `fix` event needs none: no allocation per fix)
   /// \brief A field of the body.
   nlohmann::json& operator[](const char* key) { return body[key]; }
   [[nodiscard]] bool is(const char* t) const { return std::string_view(type) == t; }
