@@ -603,6 +603,7 @@ void runFly(const FlyOptions& o) {
   Progress bar("flying", o.progress);
   const std::vector<planner::SimulatedFix> fixes =
       planner::simulateFlight(plan, approver, sim, [&bar](double f) { bar(static_cast<std::size_t>(f * 1000.0), 1000); });
+  if (fixes.empty()) throw ParseError(o.report, 0, "$.route", "", "a route long enough for one GNSS epoch (1 s of flight)");
   for (const planner::SimulatedFix& f : fixes) {
     out << planner::trackFixJson(f.fix).dump() << '\n';
     if (truth.is_open()) {

@@ -101,11 +101,12 @@ void InsEkf::applyCorrection(const StateVector& dx) {
   baro_bias_m_ += dx(kBaro);
 }
 
-void InsEkf::updateScalar(const Eigen::Matrix<double, 1, kNumStates>& h, double nu, double r) {
+bool InsEkf::updateScalar(const Eigen::Matrix<double, 1, kNumStates>& h, double nu, double r, double gate_chi2) {
   propagateCovariance();  // fold any pending propagation in first so that P belongs to now
   const StateVector PHt = P_ * h.transpose();
   const double s = h.dot(PHt) + r;
   if (!(s > 0.0)) throw std::runtime_error("ins ekf: innovation variance not positive");
+  if (!(nu * nu / s <= gate_chi2)) return false;
   const StateVector K = PHt / s;
   // Joseph form expanded for a scalar measurement: (I − K h) P (I − K h)ᵀ + K r Kᵀ
   // = P − K PHtᵀ − PHt Kᵀ + s K Kᵀ (O(n²) instead of two n³ products).
@@ -113,15 +114,16 @@ void InsEkf::updateScalar(const Eigen::Matrix<double, 1, kNumStates>& h, double 
   P_ = 0.5 * (P_ + P_.transpose()).eval();
   for (auto& [sat, m] : sensitivity_) m -= K * h.dot(m);  // M ← (I − K h) M
   applyCorrection(K * nu);
+  return true;
 }
 
-void InsEkf::updateBaro(double h_m) {
+bool InsEkf::updateBaro(double h_m) {
   const maps::Geodetic g = maps::ecefToGeodetic(nav_.r_ecef_m);
   const Eigen::Matrix3d R_enu_ecef = maps::rotationEcefToEnu(g.lat_rad, g.lon_rad);
   Eigen::Matrix<double, 1, kNumStates> h = Eigen::Matrix<double, 1, kNumStates>::Zero();
   h.segment<3>(kPos) = R_enu_ecef.row(2);
   h(kBaro) = 1.0;
-  updateScalar(h, h_m - (g.h_ell_m + baro_bias_m_), cfg_.baro_noise_m * cfg_.baro_noise_m);
+  return updateScalar(h, h_m - (g.h_ell_m + baro_bias_m_), cfg_.baro_noise_m * cfg_.baro_noise_m, cfg_.aiding_gate_chi2);
 }
 
 double InsEkf::heading_rad() const {
@@ -130,19 +132,19 @@ double InsEkf::heading_rad() const {
   return std::atan2(f.x(), f.y());
 }
 
-void InsEkf::updateHeading(double heading_rad) {
+bool InsEkf::updateHeading(double heading_rad) {
   const maps::Geodetic g = maps::ecefToGeodetic(nav_.r_ecef_m);
   const Eigen::Matrix3d R_enu_ecef = maps::rotationEcefToEnu(g.lat_rad, g.lon_rad);
   const Eigen::Vector3d f_ecef = nav_.C_ecef_body.col(0);
   const Eigen::Vector3d f = R_enu_ecef * f_ecef;
   const double h2 = f.x() * f.x() + f.y() * f.y();
-  if (h2 < 1e-6) return;  // nose vertical: heading undefined
+  if (h2 < 1e-6) return false;  // nose vertical: heading undefined
   // ψ = atan2(f_E, f_N); δf = φ × f = −[f×]φ (ECEF), so ∂ψ/∂φ = (f_N, −f_E, 0)/(f_E² + f_N²) · R · (−[f×]).
   const Eigen::RowVector3d dpsi_df = Eigen::RowVector3d(f.y(), -f.x(), 0.0) / h2;
   Eigen::Matrix<double, 1, kNumStates> h = Eigen::Matrix<double, 1, kNumStates>::Zero();
   h.segment<3>(kAtt) = dpsi_df * R_enu_ecef * (-skew(f_ecef));
-  updateScalar(h, std::remainder(heading_rad - std::atan2(f.x(), f.y()), 2.0 * M_PI),
-               cfg_.heading_noise_rad * cfg_.heading_noise_rad);
+  return updateScalar(h, std::remainder(heading_rad - std::atan2(f.x(), f.y()), 2.0 * M_PI),
+               cfg_.heading_noise_rad * cfg_.heading_noise_rad, cfg_.aiding_gate_chi2);
 }
 
 double InsEkf::predictedRange_m(const Eigen::Vector3d& sat_ecef_m) const {

@@ -55,6 +55,9 @@ struct EkfConfig {
   double initial_clock_m = 30.0;
   double initial_drift_mps = 1.0;
   double covariance_rate_hz = 10.0;      ///< how often P (and M) are propagated
+  /// Baro and heading readings with ν²/(h P hᵀ + r) above this are refused: χ²(1) at 1e-7
+  /// (|ν| > 5.33 σ), so a wrong reading cannot pull the filter outside what its PLs cover.
+  double aiding_gate_chi2 = 28.37;
 };
 
 /// \brief One pseudorange as the filter sees it.
@@ -95,9 +98,11 @@ class InsEkf {
   /// \brief Mechanises one IMU interval (bias-corrected) and propagates P at the covariance rate.
   void propagate(const Eigen::Vector3d& dtheta_rad, const Eigen::Vector3d& dv_mps, double dt_s);
   /// \brief Barometric height update (ellipsoidal height + baro bias).
-  void updateBaro(double h_m);
+  /// \returns false when the innovation test (EkfConfig::aiding_gate_chi2) refused the reading.
+  bool updateBaro(double h_m);
   /// \brief Magnetometer heading update (clockwise from north, declination removed).
-  void updateHeading(double heading_rad);
+  /// \returns false when the innovation test refused the reading.
+  bool updateHeading(double heading_rad);
   /// \brief Tightly coupled pseudorange update; returns the record for integrity monitoring.
   GnssUpdateRecord updateGnss(const std::vector<RangeInput>& ranges);
 
@@ -116,7 +121,8 @@ class InsEkf {
  private:
   void propagateCovariance();
   /// Scalar update (Joseph form, expanded); applies the correction and resets δx.
-  void updateScalar(const Eigen::Matrix<double, 1, kNumStates>& h, double nu, double r);
+  /// \returns false (and leaves the state alone) when ν²/s exceeds `gate_chi2`.
+  bool updateScalar(const Eigen::Matrix<double, 1, kNumStates>& h, double nu, double r, double gate_chi2);
   void applyCorrection(const StateVector& dx);
 
   EkfConfig cfg_;

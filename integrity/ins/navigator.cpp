@@ -19,8 +19,8 @@ NavigatorEpoch Navigator::epoch(double t_s, const std::vector<PseudorangeInput>&
                                 std::optional<double> heading_rad) {
   NavigatorEpoch out;
   out.t_s = t_s;
-  if (cfg_.use_baro && baro_h_m) ekf_.updateBaro(*baro_h_m);
-  if (cfg_.use_heading && heading_rad) ekf_.updateHeading(*heading_rad);
+  if (cfg_.use_baro && baro_h_m) out.baro_refused = !ekf_.updateBaro(*baro_h_m);
+  if (cfg_.use_heading && heading_rad) out.heading_refused = !ekf_.updateHeading(*heading_rad);
   out.visible = static_cast<int>(ranges.size());
   if (ranges.empty()) {
     out.outage = true;

@@ -62,6 +62,7 @@ struct SnapshotSolution {
 struct NavigatorEpoch {
   double t_s = 0.0;
   bool outage = false;
+  bool baro_refused = false, heading_refused = false;  ///< aiding refused by the innovation gate
   int visible = 0;
   int used = 0;
   std::vector<SatId> excluded;

@@ -29,7 +29,7 @@ json metres(double v) { return std::isfinite(v) ? json(roundMm(v)) : json(nullpt
 constexpr int kLevels = 4;
 /// The filter's initial position σ per axis at alignment: a snapshot's error is a few metres.
 constexpr double kAlignPositionSigma_m = 10.0;
-/// How far the IMU increments' span may differ from the time between two fixes (+1 %).
+/// How far the IMU increments' span may differ from the time between two fixes (+0.1 %).
 constexpr double kSpanTolerance_s = 0.02;
 
 /// Pushes v into a window of at most n values and returns how many are true.
@@ -111,7 +111,7 @@ struct Tracker::Flight {
     char buf[160];
     if (fix.imu->grade != nav_grade) {
       std::snprintf(buf, sizeof buf, "GNSS/INS: the IMU grade changed; the filter aligns again");
-    } else if (std::abs(span - gap) > kSpanTolerance_s + 0.01 * gap) {
+    } else if (std::abs(span - gap) > kSpanTolerance_s + 0.001 * gap) {
       std::snprintf(buf, sizeof buf, "GNSS/INS: the IMU increments span %.3f s but the fixes are %.3f s apart; the filter aligns again",
                     span, gap);
     } else {
@@ -127,7 +127,7 @@ struct Tracker::Flight {
 
   /// The fix's epoch again from the filter as it was (`before`), with one more exclusion allowed
   /// (the monitoring rerun of the GNSS/INS flow); when it gives a PL the filter takes it.
-  std::optional<integrity::ins::NavigatorEpoch> deeperEpoch(const integrity::ins::Navigator& before, const TrackFix& fix) {
+  std::optional<integrity::ins::NavigatorEpoch> deeperEpoch(const integrity::ins::Navigator& before, const TrackFix& fix) try {
     auto deeper = std::make_unique<integrity::ins::Navigator>(before);  // (kept off the fix path's stack)
     const int max_exclusions = deeper->config().max_exclusions;
     deeper->setMaxExclusions(max_exclusions + 1);
@@ -136,6 +136,8 @@ struct Tracker::Flight {
     deeper->setMaxExclusions(max_exclusions);
     nav = std::move(deeper);
     return ep;
+  } catch (const std::exception&) {  // the rerun failed: the first pass stands
+    return std::nullopt;
   }
 
   /// Aligns the filter at a snapshot solution with the fix's velocity and attitude.
@@ -610,6 +612,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   // Order: against the last accepted fix, or (the first fix) the approved departure and flight.
   std::string jump_note;
   std::optional<double> jump_s;
+  std::optional<double> new_offset;
   std::string jump_from;
   if (st.last_time) {
     const double dt = fix.time - *st.last_time;
@@ -655,8 +658,9 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       return out;
     }
     jump_note = "a new timeline after a " + size + ", confirmed by " + std::to_string(st.jump_count) + " fixes in order";
-    // The flight's clock from here on is the stream's plus an offset: the fix is "now".
-    if (st.last_time && stream_time_) st.clock_offset_s = fix.time - *stream_time_;
+    // The flight's clock from here on is the stream's plus an offset: the fix is "now" (taken
+    // once the fix is accepted, after the sweep has seen the flight's gap on its old clock).
+    if (st.last_time && stream_time_) new_offset = fix.time - *stream_time_;
   }
   st.jump_candidate.reset();
   st.jump_count = 0;
@@ -676,7 +680,14 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   std::vector<TrackEvent> pre_events;  // written once the fix is accepted
   bool early_rerun = false;
   if (fix.imu && !fix.ranges.empty()) {
-    ins_ep = f.insEpoch(fix, note, ins_before);
+    try {
+      ins_ep = f.insEpoch(fix, note, ins_before);
+    } catch (const std::exception& err) {  // e.g. a covariance gone non-positive: align again
+      f.nav.reset();
+      ins_ep.reset();
+      ins_before.reset();
+      note = std::string("GNSS/INS filter failed (") + err.what() + "); the filter aligns again";
+    }
     if (ins_ep && !ins_ep->seed001_available && ins_ep->gnss_fault_detected && ins_before) {
       // A fault detected and not excluded: the monitoring rerun at once, one more exclusion allowed.
       if (auto again = f.deeperEpoch(*ins_before, fix)) {
@@ -697,14 +708,20 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
       }
     }
     if (ins_ep && !ins_ep->seed001_available) {
+      const bool unresolved = ins_ep->gnss_fault_detected && ins_ep->excluded.empty();
       note = ins_ep->outage ? "GNSS/INS: no pseudorange above the mask (dead reckoning, no integrity); the snapshot is used"
                             : "GNSS/INS gave no protection level (" +
-                                  std::string(ins_ep->gnss_fault_detected ? "a fault detected and not excluded" : "too few satellites") +
+                                  std::string(unresolved ? "a fault detected and not excluded" : "too few satellites or no fault-mode PL") +
                                   "); the snapshot is used";
       ins_ep.reset();
     }
   }
   if (ins_ep) {
+    if (ins_ep->baro_refused || ins_ep->heading_refused) {
+      note = std::string("GNSS/INS refused the ") +
+             (ins_ep->baro_refused ? (ins_ep->heading_refused ? "barometer and magnetometer" : "barometer") : "magnetometer") +
+             " reading (its innovation failed the gate)";
+    }
     pos = maps::ecefToGeodetic(ins_ep->r_ecef_m);
     hpl = ins_ep->seed001_hpl_m;
     vpl = ins_ep->seed001_vpl_m;
@@ -749,13 +766,14 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   }
   // Accepted. Stream time moves on with accepted fixes only (a refused one cannot push it
   // ahead); the sweep sees this flight's gap before its time is updated.
-  const maps::GpsTime on_stream = fix.time.plus(-st.clock_offset_s);
+  const maps::GpsTime on_stream = fix.time.plus(-new_offset.value_or(st.clock_offset_s));
   if (!stream_time_ || on_stream - *stream_time_ > 0) stream_time_ = on_stream;
   if (!last_sweep_ || *stream_time_ - *last_sweep_ >= 1.0 || *stream_time_ - *last_sweep_ < 0.0) {
     for (TrackEvent& e : sweepStale(*stream_time_)) out.push_back(std::move(e));
   }
   for (TrackEvent& e : pre_events) out.push_back(std::move(e));
   if (early_rerun) ++st.rerun_count;
+  if (new_offset) st.clock_offset_s = *new_offset;
   st.last_time = fix.time;
   st.stale_reported = false;
   ++st.fixes;

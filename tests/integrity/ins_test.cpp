@@ -441,6 +441,22 @@ TEST(InsEkf, HeadingUpdateMovesByTheKalmanFraction) {
   }
 }
 
+TEST(InsEkf, AidingFarFromThePredictionIsRefusedAndLeavesTheStateAlone) {
+  const EkfConfig cfg = testConfig();
+  InsEkf ekf(cfg, stateAt(45.0, 0.0, 0.0), 0.0, 0.0);
+  const NavState before = ekf.nav();
+  const maps::Geodetic g0 = maps::ecefToGeodetic(before.r_ecef_m);
+  const StateMatrix P = ekf.covariance();
+  // A barometer 1 km off (σ_S ≈ 6 m here) and a heading 90° off (σ ≈ 3°) fail the χ²(1) gate
+  EXPECT_FALSE(ekf.updateBaro(g0.h_ell_m + 1000.0));
+  EXPECT_FALSE(ekf.updateHeading(std::remainder(ekf.heading_rad() + M_PI / 2.0, 2 * M_PI)));
+  EXPECT_EQ(ekf.nav().r_ecef_m, before.r_ecef_m);
+  EXPECT_EQ(ekf.nav().C_ecef_body, before.C_ecef_body);
+  EXPECT_EQ(ekf.covariance(), P);
+  // while one 2 m off is taken
+  EXPECT_TRUE(ekf.updateBaro(g0.h_ell_m + 2.0));
+}
+
 TEST(InsEkf, BaroUpdateSplitsTheInnovationBetweenHeightAndBaroBias) {
   const EkfConfig cfg = testConfig();
   const NavState x0 = stateAt(45.0, 0.0, 0.0);

@@ -415,6 +415,29 @@ TEST_F(TrackerOnExample, OneVehiclesClockJumpDoesNotMakeTheOthersStale) {
   EXPECT_NEAR(parseFlightState(flightStateJson(tracker.state("F2")), "db").clock_offset_s, 3600.0, 1e-9);
 }
 
+TEST_F(TrackerOnExample, TakingAJumpedTimelineWithASweepDueIsNotStale) {
+  TrackerOptions opt;
+  opt.replan = false;
+  Tracker tracker(opt);
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  auto feed = [&](double t, std::size_t line) {
+    return tracker.processJson(fixAt(*example_->approver, r.departure.plus(t), along(r, 5), 0.5, 0.5, line));
+  };
+  feed(0, 1);
+  feed(1, 2);
+  feed(3602, 3);
+  feed(3603, 4);
+  // GIVEN a quiet-input sweep (as the CLI makes on a live input) that leaves a sweep due
+  EXPECT_TRUE(tracker.sweepStale(r.departure.plus(1.5)).empty());
+  // WHEN the third fix takes the new timeline
+  const auto ev = tracker.processJson(fixAt(*example_->approver, r.departure.plus(3604), along(r, 5), 0.5, 0.5, 5));
+  // THEN the flight is not reported stale by its own jump
+  EXPECT_TRUE(ofType(ev, "stale").empty()) << ofType(ev, "stale")[0].dump();
+  EXPECT_EQ(ev.back().at("event"), "fix");
+  EXPECT_NEAR(tracker.state("F1").clock_offset_s, 3603.0, 1e-9);
+}
+
 // --- NMEA and JSON lines give the same verdicts ---------------------------------------------
 
 TEST_F(TrackerOnExample, NmeaAndJsonLinesGiveTheSameVerdicts) {
@@ -842,6 +865,30 @@ TEST(TrackerGnssIns, SimulatedFixesWrittenAsJsonLinesReadBackTheSame) {
     ASSERT_LT((*g.velocity_enu_mps - *f.velocity_enu_mps).norm(), 1e-4);
     ASSERT_NEAR(*g.baro_h_m, *f.baro_h_m, 1e-4);
   }
+}
+
+TEST(TrackerGnssIns, AWrongBarometerIsRefusedAndTheErrorStaysBounded) {
+  // GIVEN a flight whose barometer reads 500 m high from 50 s on
+  const Approved a = largeUav();
+  Tracker tracker;
+  tracker.addFlight("F1", a.flight, a.approver);
+  int refused = 0, wrong = 0, fixes = 0, bounded = 0;
+  for (test::SimulatedFix sf : test::simulateRoute(a.report, *a.approver, {}, 35, 5.0, "F1", test::ImuFeed{})) {
+    if (sf.t_s >= 50.0) *sf.fix.baro_h_m += 500.0;
+    const json fix = tracker.processJson(sf.fix).back();
+    ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
+    if (sf.fix.line == 1) continue;
+    ++fixes;
+    wrong += sf.t_s >= 50.0;
+    // THEN the filter's innovation gate refuses every such reading and says so
+    if (fix.value("note", "").find("refused the barometer") != std::string::npos) ++refused;
+    bounded += plsBound(fix, sf.truth);
+    EXPECT_EQ(fix.at("pl_source"), "gnss_ins");
+  }
+  EXPECT_GT(fixes, 150);
+  EXPECT_EQ(refused, wrong);
+  // AND the PLs bound the error at every fix
+  EXPECT_EQ(bounded, fixes);
 }
 
 TEST(TrackerGnssIns, ALostFixOrARestartAlignsTheFilterAgain) {
