@@ -87,26 +87,30 @@ FaultSpec parseFault(const JsonNode& f) {
   return out;
 }
 
-void matchFilterToSensors(Scenario& s) {
-  ins::EkfConfig& e = s.navigator.ekf;
-  const ImuSpec& imu = s.sensors.imu;
+void matchFilterToSensors(ins::NavigatorConfig& nav, const SensorSpec& sensors, ImuGrade grade) {
+  ins::EkfConfig& e = nav.ekf;
+  const ImuSpec& imu = sensors.imu;
   e.accel_noise_mps_rts = imu.accel_noise_mps_rts;
   e.gyro_noise_rad_rts = imu.gyro_noise_rad_rts;
   e.accel_bias_rw_mps2_rts = imu.accel_bias_rw_mps2_rts;
   e.gyro_bias_rw_radps_rts = imu.gyro_bias_rw_radps_rts;
   e.accel_bias_mps2 = imu.accel_bias_mps2;
   e.gyro_bias_radps = imu.gyro_bias_radps;
-  e.clock_h0 = s.sensors.clock_h0;
-  e.clock_hm2 = s.sensors.clock_hm2;
-  e.baro_noise_m = s.sensors.baro_noise_m;
-  e.baro_bias_m = s.sensors.baro_bias_m;
-  e.baro_bias_rw_m_rts = s.sensors.baro_bias_rw_m_rts;
-  e.heading_noise_rad = s.sensors.heading_noise_rad;
-  s.navigator.model = s.sensors.model;
-  s.navigator.elevation_mask_rad = s.sensors.elevation_mask_rad;
-  s.navigator.seed000.lambda = ins::seed000Lambda(static_cast<int>(s.grade));
-  s.navigator.seed000.phmi_h = s.navigator.fault_modes.risk.i_req * (1.0 - s.navigator.fault_modes.risk.vertical_share);
-  s.navigator.seed000.phmi_v = s.navigator.fault_modes.risk.i_req * s.navigator.fault_modes.risk.vertical_share;
+  e.clock_h0 = sensors.clock_h0;
+  e.clock_hm2 = sensors.clock_hm2;
+  e.baro_noise_m = sensors.baro_noise_m;
+  e.baro_bias_m = sensors.baro_bias_m;
+  e.baro_bias_rw_m_rts = sensors.baro_bias_rw_m_rts;
+  e.heading_noise_rad = sensors.heading_noise_rad;
+  nav.model = sensors.model;
+  nav.elevation_mask_rad = sensors.elevation_mask_rad;
+  nav.seed000.lambda = ins::seed000Lambda(static_cast<int>(grade));
+  nav.seed000.phmi_h = nav.fault_modes.risk.i_req * (1.0 - nav.fault_modes.risk.vertical_share);
+  nav.seed000.phmi_v = nav.fault_modes.risk.i_req * nav.fault_modes.risk.vertical_share;
+}
+
+void matchFilterToSensors(Scenario& s) {
+  matchFilterToSensors(s.navigator, s.sensors, s.grade);
   s.navigator.araim.requirements.hal_m = s.hal_m;
   s.navigator.araim.requirements.val_m = s.val_m;
 }

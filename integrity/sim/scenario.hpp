@@ -39,6 +39,9 @@ struct Scenario {
 /// \brief The navigator's filter and seed-000 settings that match an IMU grade and the sensors
 /// (the filter assumes the simulator's noise figures; seed 000's λ from the grade).
 void matchFilterToSensors(Scenario& s);
+/// \brief The same for any navigator: its filter noise from `sensors` (IMU, clock, baro,
+/// magnetometer), its error model and mask, seed 000's λ from `grade`.
+void matchFilterToSensors(ins::NavigatorConfig& nav, const SensorSpec& sensors, ImuGrade grade);
 
 /// \brief Parses a scenario document; relative file names are resolved against `base_dir`.
 /// \throws maps::ParseError naming the source, the field and what was expected.

@@ -108,15 +108,15 @@ json trackFixJson(const TrackFix& f) {
     }
     j["pseudoranges"] = std::move(list);
   }
-  static const char* const kGrades[] = {"aviation", "tactical", "consumer"};
+  auto grade = [](int g) { return std::string(integrity::sim::imuGradeName(static_cast<integrity::sim::ImuGrade>(g))); };
   if (f.imu) {
     json inc = json::array();
     for (const ImuIncrement& i : f.imu->increments) {
       inc.push_back({i.dt_s, i.dtheta_rad.x(), i.dtheta_rad.y(), i.dtheta_rad.z(), i.dv_mps.x(), i.dv_mps.y(), i.dv_mps.z()});
     }
-    j["imu"] = {{"grade", kGrades[f.imu->grade]}, {"increments", std::move(inc)}};
+    j["imu"] = {{"grade", grade(f.imu->grade)}, {"increments", std::move(inc)}};
   } else if (f.ins) {
-    j["imu"] = {{"grade", kGrades[f.ins->grade]}, {"sigma_n_m", f.ins->sigma_n_m}, {"sigma_e_m", f.ins->sigma_e_m}, {"sigma_u_m", f.ins->sigma_u_m}};
+    j["imu"] = {{"grade", grade(f.ins->grade)}, {"sigma_n_m", f.ins->sigma_n_m}, {"sigma_e_m", f.ins->sigma_e_m}, {"sigma_u_m", f.ins->sigma_u_m}};
   }
   if (f.velocity_enu_mps) j["velocity_enu_mps"] = vec(*f.velocity_enu_mps, 1e-4);
   if (f.attitude_rad) {

@@ -1,6 +1,7 @@
 #include "planner/tracking/track_fix.hpp"
 
 #include "integrity/ins/protection_levels.hpp"
+#include "integrity/sim/sensors.hpp"
 #include "integrity/stats.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/json_node.hpp"
@@ -100,12 +101,9 @@ TrackFix parseTrackFixJson(const json& doc, const std::string& source) {
   if (root.has("imu")) {
     const maps::JsonNode imu = root.at("imu");
     imu.requireKnownFields({"grade", "sigma_n_m", "sigma_e_m", "sigma_u_m", "increments"});
-    int grade = 2;
-    const std::string name = imu.at("grade").str();
-    if (name == "aviation") grade = 0;
-    else if (name == "tactical") grade = 1;
-    else if (name == "consumer") grade = 2;
-    else imu.at("grade").fail("aviation, tactical or consumer (seed 000 Table 1)");
+    const auto parsed = integrity::sim::parseImuGrade(imu.at("grade").str());
+    if (!parsed) imu.at("grade").fail("aviation, tactical or consumer (seed 000 Table 1)");
+    const int grade = static_cast<int>(*parsed);
     if (imu.has("increments")) {
       for (const char* key : {"sigma_n_m", "sigma_e_m", "sigma_u_m"}) {
         if (imu.has(key)) imu.at(key).fail("either the INS σ's or the IMU increments, not both");

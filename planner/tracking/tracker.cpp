@@ -1,7 +1,7 @@
 #include "planner/tracking/tracker.hpp"
 
 #include "integrity/ins/navigator.hpp"
-#include "integrity/sim/sensors.hpp"
+#include "integrity/sim/scenario.hpp"
 #include "integrity/sim/trajectory.hpp"
 #include "maps/file_digest.hpp"
 #include "maps/geodesy.hpp"
@@ -64,22 +64,17 @@ struct Tracker::Flight {
   maps::GpsTime nav_t0, nav_time;
 
   /// Seed 001's flow with the mission's error model and mask and the grade's IMU figures (the
-  /// filter assumes the grade's datasheet values, integrity/sim/sensors.hpp).
+  /// filter assumes the grade's datasheet values, integrity/sim/sensors.hpp; baro, magnetometer
+  /// and clock the simulator's defaults).
   [[nodiscard]] integrity::ins::NavigatorConfig navigatorConfig(int grade) const {
+    const auto g = static_cast<integrity::sim::ImuGrade>(grade);
+    integrity::sim::SensorSpec sensors;
+    sensors.imu = integrity::sim::imuSpec(g);
+    sensors.model = live.model;
+    sensors.elevation_mask_rad = live.elevation_mask_rad;
     integrity::ins::NavigatorConfig c;
-    const integrity::sim::ImuSpec imu = integrity::sim::imuSpec(static_cast<integrity::sim::ImuGrade>(grade));
-    c.ekf.accel_noise_mps_rts = imu.accel_noise_mps_rts;
-    c.ekf.gyro_noise_rad_rts = imu.gyro_noise_rad_rts;
-    c.ekf.accel_bias_rw_mps2_rts = imu.accel_bias_rw_mps2_rts;
-    c.ekf.gyro_bias_rw_radps_rts = imu.gyro_bias_rw_radps_rts;
-    c.ekf.accel_bias_mps2 = imu.accel_bias_mps2;
-    c.ekf.gyro_bias_radps = imu.gyro_bias_radps;
+    integrity::sim::matchFilterToSensors(c, sensors, g);
     c.ekf.initial_position_m = kAlignPositionSigma_m;
-    c.model = live.model;
-    c.elevation_mask_rad = live.elevation_mask_rad;
-    c.seed000.lambda = integrity::ins::seed000Lambda(grade);
-    c.seed000.phmi_h = c.fault_modes.risk.i_req * (1.0 - c.fault_modes.risk.vertical_share);
-    c.seed000.phmi_v = c.fault_modes.risk.i_req * c.fault_modes.risk.vertical_share;
     c.compute_araim = false;  // the snapshot ARAIM beside the flow is not used here
     return c;
   }

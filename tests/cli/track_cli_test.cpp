@@ -3,6 +3,7 @@
 // exits; NMEA, UDP and RINEX replay inputs; bad approvals exit 2.
 #include "maps/time.hpp"
 #include "planner/tracking/track_store.hpp"
+#include "tests/planner/track_events.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -45,13 +46,7 @@ std::vector<json> readEvents(const std::string& path) {
   return out;
 }
 
-std::vector<json> ofType(const std::vector<json>& all, const std::string& type) {
-  std::vector<json> out;
-  for (const json& e : all) {
-    if (e.at("event") == type) out.push_back(e);
-  }
-  return out;
-}
+using test::ofType;
 
 /// The bundled example approved once for the suite, and good fixes along its route (1 per s).
 class TrackCli : public ::testing::Test {

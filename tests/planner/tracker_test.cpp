@@ -7,6 +7,7 @@
 #include "maps/json_node.hpp"
 #include "maps/text_file.hpp"
 #include "tests/planner/simulated_flight.hpp"
+#include "tests/planner/track_events.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <random>
 
@@ -67,13 +69,7 @@ TrackFix fixAt(const Approver& a, const maps::GpsTime& t, const Eigen::Vector3d&
   return f;
 }
 
-std::vector<json> ofType(const std::vector<json>& events, const std::string& type) {
-  std::vector<json> out;
-  for (const json& e : events) {
-    if (e.at("event") == type) out.push_back(e);
-  }
-  return out;
-}
+using test::ofType;
 
 /// The unit vector across the route's first segment (left of the direction of flight).
 Eigen::Vector3d acrossFirstSegment(const ApprovalReport& r) {
@@ -631,22 +627,57 @@ bool plsBound(const json& fix, const maps::Geodetic& truth) {
   return eh <= fix.at("hpl_m").get<double>() && ev <= fix.at("vpl_m").get<double>();
 }
 
+/// One simulated fix through the tracker, with its events (the `fix` event last).
+struct TrackedFix {
+  test::SimulatedFix sim;
+  std::vector<json> events;
+  [[nodiscard]] const json& fix() const { return events.back(); }
+};
+
+/// `a`'s route flown by the simulator with a tactical IMU, barometer and magnetometer (`faults`,
+/// `seed`; `edit` may change each fix first) and tracked by a new tracker. Every fix must give a
+/// `fix` event, and the stream's fast writer must give the same object as toJson.
+std::vector<TrackedFix> trackGnssIns(const Approved& a, const std::vector<integrity::sim::FaultSpec>& faults, std::uint64_t seed,
+                                     const std::function<void(test::SimulatedFix&)>& edit = {}) {
+  Tracker tracker;
+  tracker.addFlight("F1", a.flight, a.approver);
+  std::vector<TrackedFix> out;
+  for (test::SimulatedFix& sf : test::simulateRoute(a.report, *a.approver, faults, seed, 5.0, "F1", test::ImuFeed{})) {
+    if (edit) edit(sf);
+    TrackedFix t;
+    for (const TrackEvent& e : tracker.process(sf.fix)) {
+      t.events.push_back(e.toJson());
+      if (e.fix) {
+        EXPECT_EQ(json::parse(e.jsonLine()), t.events.back());
+      }
+    }
+    EXPECT_FALSE(t.events.empty());
+    if (t.events.empty() || t.fix().at("event") != "fix") {
+      ADD_FAILURE() << "line " << sf.fix.line << " gave no fix event";
+      continue;
+    }
+    t.sim = std::move(sf);
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+/// The events of a replay, in order.
+std::vector<json> allEvents(const std::vector<TrackedFix>& replay) {
+  std::vector<json> out;
+  for (const TrackedFix& t : replay) out.insert(out.end(), t.events.begin(), t.events.end());
+  return out;
+}
+
 TEST(TrackerGnssIns, FixesWithImuIncrementsUseSeed001sFlowAndItsPlsBoundTheError) {
   // GIVEN the large UAV flown by the simulator with a tactical IMU, barometer and magnetometer
   const Approved a = largeUav();
-  Tracker tracker;
-  tracker.addFlight("F1", a.flight, a.approver);
-  std::vector<json> all;
+  const std::vector<TrackedFix> replay = trackGnssIns(a, {}, 21);
+  ASSERT_GT(replay.size(), 100u);
   int ins = 0, bounded = 0;
-  const auto flight = test::simulateRoute(a.report, *a.approver, {}, 21, 5.0, "F1", test::ImuFeed{});
-  ASSERT_GT(flight.size(), 100u);
-  for (const test::SimulatedFix& sf : flight) {
-    const auto ev = tracker.processJson(sf.fix);
-    ASSERT_FALSE(ev.empty());
-    const json& fix = ev.back();
-    ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
-    for (const json& e : ev) all.push_back(e);
-    if (sf.fix.line == 1) {
+  for (const TrackedFix& t : replay) {
+    const json& fix = t.fix();
+    if (t.sim.fix.line == 1) {
       // THEN the first fix aligns the filter and is solved as a snapshot
       EXPECT_EQ(fix.at("pl_source"), "raw");
       EXPECT_NE(fix.value("note", "").find("GNSS/INS aligned"), std::string::npos) << fix.dump();
@@ -656,10 +687,11 @@ TEST(TrackerGnssIns, FixesWithImuIncrementsUseSeed001sFlowAndItsPlsBoundTheError
     ASSERT_EQ(fix.at("pl_source"), "gnss_ins") << fix.dump();
     EXPECT_FALSE(fix.at("ins_degraded").get<bool>());
     ++ins;
-    bounded += plsBound(fix, sf.truth);
+    bounded += plsBound(fix, t.sim.truth);
     EXPECT_EQ(fix.at("verdict"), "inside") << fix.dump();
   }
   EXPECT_EQ(bounded, ins);
+  const std::vector<json> all = allEvents(replay);
   EXPECT_TRUE(ofType(all, "violation").empty());
   EXPECT_TRUE(ofType(all, "replan").empty());
 }
@@ -667,35 +699,22 @@ TEST(TrackerGnssIns, FixesWithImuIncrementsUseSeed001sFlowAndItsPlsBoundTheError
 TEST(TrackerGnssIns, ASatelliteFaultIsExcludedByTheFlowAndTheErrorStaysBounded) {
   // GIVEN the same flight with a 60 m step on one satellite from 60 s to 120 s
   const Approved a = largeUav();
-  Tracker tracker;
-  tracker.addFlight("F1", a.flight, a.approver);
-  const integrity::sim::FaultSpec fault = satelliteStep(60.0, 60.0, 120.0);
+  const std::vector<TrackedFix> replay = trackGnssIns(a, {satelliteStep(60.0, 60.0, 120.0)}, 23);
   int in_fault = 0, excluded_faulty = 0, excluded_other = 0, fixes = 0, bounded = 0;
-  std::vector<json> all;
-  for (const test::SimulatedFix& sf : test::simulateRoute(a.report, *a.approver, {fault}, 23, 5.0, "F1", test::ImuFeed{})) {
-    std::vector<json> ev;
-    for (const TrackEvent& e : tracker.process(sf.fix)) {
-      ev.push_back(e.toJson());
-      // (the stream's fast writer gives the same object, excluded satellites and all)
-      if (e.fix) {
-        EXPECT_EQ(json::parse(e.jsonLine()), ev.back());
-      }
-    }
-    const json& fix = ev.back();
-    ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
-    for (const json& e : ev) all.push_back(e);
-    if (sf.fix.line == 1) continue;
+  for (const TrackedFix& t : replay) {
+    const json& fix = t.fix();
+    if (t.sim.fix.line == 1) continue;
     ASSERT_EQ(fix.at("pl_source"), "gnss_ins") << fix.dump();
     ++fixes;
     const json ex = fix.value("excluded", json::array());
-    if (sf.faulty) {
+    if (t.sim.faulty) {
       ++in_fault;
       // THEN step 1's FDE leaves the faulty satellite out
-      if (ex.size() == 1 && ex[0] == sf.faulty->str()) ++excluded_faulty;
+      if (ex.size() == 1 && ex[0] == t.sim.faulty->str()) ++excluded_faulty;
     } else {
       excluded_other += static_cast<int>(ex.size());
     }
-    bounded += plsBound(fix, sf.truth);
+    bounded += plsBound(fix, t.sim.truth);
     EXPECT_EQ(fix.at("verdict"), "inside") << fix.dump();
   }
   EXPECT_GE(in_fault, 59);
@@ -703,6 +722,7 @@ TEST(TrackerGnssIns, ASatelliteFaultIsExcludedByTheFlowAndTheErrorStaysBounded) 
   EXPECT_LE(excluded_other, 2);  // false exclusions: P_FA per epoch, with some margin
   // AND the PLs bound the error at every fix, without a violation or a replan
   EXPECT_EQ(bounded, fixes);
+  const std::vector<json> all = allEvents(replay);
   EXPECT_TRUE(ofType(all, "violation").empty());
   EXPECT_TRUE(ofType(all, "replan").empty());
 }
@@ -711,17 +731,13 @@ TEST(TrackerGnssIns, TwoSatelliteFaultsAreExcludedByTheRerunWithOneMoreExclusion
   // GIVEN 60 m steps on two satellites at once from 40 s to 150 s (step 1 of the flow may
   // exclude one: it detects a fault it cannot exclude)
   const Approved a = largeUav();
-  Tracker tracker;
-  tracker.addFlight("F1", a.flight, a.approver);
   integrity::sim::FaultSpec second = satelliteStep(60.0, 40.0, 150.0);
   second.pick = 0.1;
   int in_fault = 0, both_excluded = 0, snapshot = 0, fixes = 0, bounded = 0, reruns = 0;
-  for (const test::SimulatedFix& sf :
-       test::simulateRoute(a.report, *a.approver, {satelliteStep(60.0, 40.0, 150.0), second}, 33, 5.0, "F1", test::ImuFeed{})) {
-    const auto ev = tracker.processJson(sf.fix);
-    const json& fix = ev.back();
-    ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
-    reruns += static_cast<int>(ofType(ev, "monitoring_rerun").size());
+  for (const TrackedFix& t : trackGnssIns(a, {satelliteStep(60.0, 40.0, 150.0), second}, 33)) {
+    const json& fix = t.fix();
+    const test::SimulatedFix& sf = t.sim;
+    reruns += static_cast<int>(ofType(t.events, "monitoring_rerun").size());
     if (sf.fix.line == 1) continue;
     // THEN the fixes stay on the GNSS/INS flow, the rerun leaving both satellites out (or, where
     // the remaining geometry cannot tell, the snapshot's grown PL_det stands)
@@ -751,8 +767,6 @@ TEST(TrackerGnssIns, TwoSatelliteFaultsAreExcludedByTheRerunWithOneMoreExclusion
 TEST(TrackerGnssIns, AnAccelerometerFaultDegradesToGnssAloneAndTheErrorStaysBounded) {
   // GIVEN an accelerometer step of 0.5 m/s² on the up axis from 60 s to 200 s
   const Approved a = largeUav();
-  Tracker tracker;
-  tracker.addFlight("F1", a.flight, a.approver);
   integrity::sim::FaultSpec fault;
   fault.target = integrity::sim::FaultTarget::kAccelerometer;
   fault.axis = 2;
@@ -760,10 +774,9 @@ TEST(TrackerGnssIns, AnAccelerometerFaultDegradesToGnssAloneAndTheErrorStaysBoun
   fault.t_end_s = 200.0;
   fault.magnitude = 0.5;
   int degraded = 0, fixes = 0, bounded = 0;
-  for (const test::SimulatedFix& sf : test::simulateRoute(a.report, *a.approver, {fault}, 25, 5.0, "F1", test::ImuFeed{})) {
-    const auto ev = tracker.processJson(sf.fix);
-    const json& fix = ev.back();
-    ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
+  for (const TrackedFix& t : trackGnssIns(a, {fault}, 25)) {
+    const json& fix = t.fix();
+    const test::SimulatedFix& sf = t.sim;
     if (sf.fix.line == 1) continue;
     ++fixes;
     if (fix.value("ins_degraded", false)) {
@@ -809,12 +822,9 @@ TEST(TrackerGnssIns, MonteCarloWithRandomFaultsHasNoMisleadingFix) {
       }
       faults.push_back(f);
     }
-    Tracker tracker;
-    tracker.addFlight("F1", a.flight, a.approver);
-    for (const test::SimulatedFix& sf :
-         test::simulateRoute(a.report, *a.approver, faults, 1000 + static_cast<std::uint64_t>(flight), 5.0, "F1", test::ImuFeed{})) {
-      const json fix = tracker.processJson(sf.fix).back();
-      if (fix.at("event") != "fix") continue;
+    for (const TrackedFix& t : trackGnssIns(a, faults, 1000 + static_cast<std::uint64_t>(flight))) {
+      const json& fix = t.fix();
+      const test::SimulatedFix& sf = t.sim;
       ++fixes;
       ins += fix.at("pl_source") == "gnss_ins";
       const auto [eh, ev] = fixError(fix, sf.truth);
@@ -870,13 +880,13 @@ TEST(TrackerGnssIns, SimulatedFixesWrittenAsJsonLinesReadBackTheSame) {
 TEST(TrackerGnssIns, AWrongBarometerIsRefusedAndTheErrorStaysBounded) {
   // GIVEN a flight whose barometer reads 500 m high from 50 s on
   const Approved a = largeUav();
-  Tracker tracker;
-  tracker.addFlight("F1", a.flight, a.approver);
   int refused = 0, wrong = 0, fixes = 0, bounded = 0;
-  for (test::SimulatedFix sf : test::simulateRoute(a.report, *a.approver, {}, 35, 5.0, "F1", test::ImuFeed{})) {
+  const auto high = [](test::SimulatedFix& sf) {
     if (sf.t_s >= 50.0) *sf.fix.baro_h_m += 500.0;
-    const json fix = tracker.processJson(sf.fix).back();
-    ASSERT_EQ(fix.at("event"), "fix") << fix.dump();
+  };
+  for (const TrackedFix& t : trackGnssIns(a, {}, 35, high)) {
+    const json& fix = t.fix();
+    const test::SimulatedFix& sf = t.sim;
     if (sf.fix.line == 1) continue;
     ++fixes;
     wrong += sf.t_s >= 50.0;
