@@ -10,10 +10,10 @@
 #include "maps/geodesy.hpp"
 #include "maps/plane_frame.hpp"
 #include "planner/approval.hpp"
+#include "planner/rehearsal/flight_sim.hpp"
 #include "planner/report_formats.hpp"
 #include "planner/tracking/track_fix.hpp"
 #include "planner/tracking/tracker.hpp"
-#include "tests/planner/simulated_flight.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -278,7 +278,7 @@ struct RawScene {
   std::vector<planner::TrackFix> fixes;
 };
 
-bool rawScene(benchmark::State& state, double span_m, double length_m, const std::optional<test::ImuFeed>& imu, RawScene& out) {
+bool rawScene(benchmark::State& state, double span_m, double length_m, const std::optional<planner::ImuFeed>& imu, RawScene& out) {
   planner::Mission m = planner::loadMission(kExample);
   m.vehicle.lateral_m = span_m;
   m.vehicle.longitudinal_m = length_m;
@@ -300,7 +300,11 @@ bool rawScene(benchmark::State& state, double span_m, double length_m, const std
   fault.t_start_s = r.route.back().eta_s / 2.0;
   fault.t_end_s = r.route.back().eta_s + 60.0;
   fault.magnitude = 60.0;
-  for (test::SimulatedFix& sf : test::simulateRoute(r, *out.approver, {fault}, 3, 0.0, "F1", imu)) out.fixes.push_back(std::move(sf.fix));
+  planner::FlightSimOptions sim;
+  sim.seed = 3;
+  sim.faults = {fault};
+  sim.imu = imu;
+  for (planner::SimulatedFix& sf : planner::simulateFlight(r, *out.approver, sim)) out.fixes.push_back(std::move(sf.fix));
   return true;
 }
 
@@ -354,7 +358,7 @@ BENCHMARK(BM_TrackRawFixes)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 /// 40 m span: the fault-mode PLs fit level 1.
 void BM_TrackGnssInsFixes(benchmark::State& state) {
   RawScene scene;
-  if (rawScene(state, 40.0, 50.0, test::ImuFeed{}, scene)) replayRaw(state, scene);
+  if (rawScene(state, 40.0, 50.0, planner::ImuFeed{}, scene)) replayRaw(state, scene);
 }
 BENCHMARK(BM_TrackGnssInsFixes)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 

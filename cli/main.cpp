@@ -18,6 +18,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"skylane: airspace geofence and path-planning integrity planner for unmanned aircraft"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("skylane ") + SKYLANE_VERSION);
   skylane::cli::addIntegrityCommands(app);
   skylane::cli::addZonesCommands(app);
   skylane::cli::addSkyMaskCommands(app);

@@ -5,37 +5,25 @@
 #include "cli/svg_plot.hpp"
 
 #include "integrity/gnss/nmea.hpp"
-#include "integrity/gnss/rinex_nav.hpp"
-#include "integrity/gnss/rinex_obs.hpp"
 #include "integrity/raim/spp.hpp"
 #include "integrity/sim/scenario.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
 #include "planner/report_formats.hpp"
-#include "planner/tracking/flight_sim.hpp"
-#include "planner/tracking/track_store.hpp"
+#include "planner/rehearsal/flight_sim.hpp"
 #include "planner/tracking/tracker.hpp"
+#include "planner/tracking/tracking_session.hpp"
 
-#include <arpa/inet.h>
-#include <fcntl.h>
-#include <netinet/in.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <atomic>
-#include <cerrno>
-#include <chrono>
 #include <csignal>
 #include <algorithm>
-#include <filesystem>
-#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <memory>
-#include <set>
+#include <optional>
+#include <sstream>
 
 namespace skylane::cli {
 namespace {
@@ -43,8 +31,11 @@ namespace {
 using maps::ParseError;
 using nlohmann::json;
 
-std::atomic<bool> g_stop{false};
-extern "C" void onStopSignal(int) { g_stop = true; }
+/// The running session's stop flag, for the signal handler.
+std::atomic<std::atomic<bool>*> g_stop{nullptr};
+extern "C" void onStopSignal(int) {
+  if (std::atomic<bool>* stop = g_stop.load()) stop->store(true);
+}
 
 struct TrackOptions {
   std::vector<std::string> approvals;
@@ -64,8 +55,9 @@ struct TrackOptions {
 
 /// What the map of a run shows: each flight's routes (the approved one and every accepted
 /// replan), its track coloured by verdict, and the events that matter.
-class TrackMap {
+class TrackMap final : public planner::EventSink {
  public:
+  void write(const planner::TrackEvent& e, const std::string& /*json_line*/) override { add(e); }
   void route(const std::string& flight, const std::vector<Eigen::Vector2d>& lat_lon_rad) { routes_[flight].push_back(lat_lon_rad); }
   void add(const planner::TrackEvent& e) {
     if (e.fix) {
@@ -193,373 +185,110 @@ std::pair<int, int> parseMofN(const std::string& text, const char* option) {
   return {m, n};
 }
 
-/// The longest input line taken [bytes]: a fix is a few hundred bytes, with pseudoranges a few kB.
-constexpr std::size_t kMaxLineBytes = 1 << 20;
-
-/// Lines from a file, stdin or UDP datagrams (one or more lines each), with a timeout so that a
-/// stop signal and stale flights are noticed while the input is quiet.
-class LineSource {
- public:
-  explicit LineSource(const std::string& input) : name_(input) {
-    if (input == "-") {
-      fd_ = STDIN_FILENO;
-      live_ = true;
-    } else if (input.rfind("udp://", 0) == 0) {
-      const std::string hostport = input.substr(6);
-      const auto colon = hostport.rfind(':');
-      sockaddr_in addr{};
-      addr.sin_family = AF_INET;
-      const std::string host = colon == std::string::npos ? "" : hostport.substr(0, colon);
-      const std::string port = colon == std::string::npos ? "" : hostport.substr(colon + 1);
-      char* end = nullptr;
-      const long p = std::strtol(port.c_str(), &end, 10);
-      if (host.empty() || port.empty() || *end != '\0' || p < 1 || p > 65535 || inet_pton(AF_INET, host.c_str(), &addr.sin_addr) != 1) {
-        throw ParseError("--input", 0, "--input", input, "udp://IPv4:PORT, e.g. udp://127.0.0.1:5005");
-      }
-      addr.sin_port = htons(static_cast<std::uint16_t>(p));
-      fd_ = socket(AF_INET, SOCK_DGRAM, 0);
-      if (fd_ < 0 || bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-        throw ParseError("--input", 0, "--input", input, std::string("a UDP port to listen on (") + std::strerror(errno) + ")");
-      }
-      udp_ = live_ = true;
-    } else {
-      fd_ = open(input.c_str(), O_RDONLY);
-      if (fd_ < 0) throw ParseError(input, 0, "--input", input, std::string("a readable file (") + std::strerror(errno) + ")");
-      struct stat info {};
-      live_ = fstat(fd_, &info) == 0 && (S_ISFIFO(info.st_mode) || S_ISCHR(info.st_mode) || S_ISSOCK(info.st_mode));
-    }
-  }
-  ~LineSource() {
-    if (fd_ > STDIN_FILENO) close(fd_);
-  }
-  LineSource(const LineSource&) = delete;
-  LineSource& operator=(const LineSource&) = delete;
-
-  enum class Status { kLine, kTimeout, kEnd, kTooLong };
-  /// Next line (without the line end); kTimeout after `timeout_ms` without one on a live input;
-  /// kTooLong once for a line longer than kMaxLineBytes (the rest of it is dropped).
-  Status next(std::string& line, int timeout_ms) {
-    for (;;) {
-      const auto nl = buffer_.find('\n');
-      if (skipping_) {
-        if (nl == std::string::npos) {
-          buffer_.clear();
-        } else {
-          buffer_.erase(0, nl + 1);
-          skipping_ = false;
-          continue;
-        }
-      } else if (nl == std::string::npos && buffer_.size() > kMaxLineBytes) {
-        buffer_.clear();
-        skipping_ = true;
-        return Status::kTooLong;
-      }
-      if (nl != std::string::npos && !skipping_) {
-        line = buffer_.substr(0, nl);
-        buffer_.erase(0, nl + 1);
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        return Status::kLine;
-      }
-      if (eof_) {
-        if (buffer_.empty()) return Status::kEnd;
-        line.swap(buffer_);
-        buffer_.clear();
-        return Status::kLine;
-      }
-      if (live_) {
-        pollfd p{fd_, POLLIN, 0};
-        const int r = poll(&p, 1, timeout_ms);
-        if (r == 0 || (r < 0 && errno == EINTR)) return Status::kTimeout;
-      }
-      char chunk[65536];
-      const ssize_t n = udp_ ? recv(fd_, chunk, sizeof chunk, 0) : read(fd_, chunk, sizeof chunk);
-      if (n < 0 && errno == EINTR) return Status::kTimeout;
-      if (n <= 0) {
-        if (!udp_) eof_ = true;
-        continue;
-      }
-      buffer_.append(chunk, static_cast<std::size_t>(n));
-      if (udp_ && buffer_.back() != '\n') buffer_.push_back('\n');  // a datagram ends its last line
-    }
-  }
-  [[nodiscard]] bool live() const { return live_; }
-  [[nodiscard]] const std::string& name() const { return name_; }
-
- private:
-  std::string name_;
-  int fd_ = -1;
-  bool live_ = false, udp_ = false, eof_ = false, skipping_ = false;
-  std::string buffer_;
-};
-
-void runTrack(const TrackOptions& o) {
-  if (o.format != "jsonl" && o.format != "nmea" && o.format != "rinex") {
-    throw ParseError("--format", 0, "--format", o.format, "jsonl, nmea or rinex");
-  }
+/// The tracker's options from the command line (the M/N rules, --no-replan).
+planner::TrackerOptions trackerOptions(const TrackOptions& o) {
   planner::TrackerOptions topt = o.tracker;
   std::tie(topt.level1_m, topt.level1_n) = parseMofN(o.level1, "--level1");
   std::tie(topt.level2_m, topt.level2_n) = parseMofN(o.level2, "--level2");
   topt.replan = !o.no_replan;
-  planner::Tracker tracker(topt);
+  return topt;
+}
 
-  std::unique_ptr<planner::TrackStore> store;
-  std::map<std::string, std::string> report_of;
-  if (!o.db.empty()) {
-    store = std::make_unique<planner::TrackStore>(o.db);
-    for (const planner::StoredFlight& f : store->flights()) {
-      // The approval comes from the database (the report file may have gone); the mission must
-      // still be there, unchanged.
-      const std::string id = tracker.addApproval(f.approval, f.report, f.id);
-      tracker.restore(id, planner::parseFlightState(f.state, o.db + ": flight " + id), f.route);
-      report_of[id] = f.report;
-      std::cerr << "skylane: track: resumed flight " << id << " (" << tracker.state(id).fixes << " fixes so far, route version "
-                << tracker.state(id).route_version << ")\n";
-    }
-  }
+/// Every --approval ([ID=]FILE), unless the database gave it back already.
+void addApprovals(planner::TrackingSession& session, const TrackOptions& o) {
   for (const std::string& a : o.approvals) {
     const auto eq = a.find('=');
     const std::string id = eq == std::string::npos ? "" : a.substr(0, eq);
     const std::string path = eq == std::string::npos ? a : a.substr(eq + 1);
-    // Resumed from the database already: the same id, or (no id given) the same report.
-    const bool resumed = id.empty() ? std::any_of(report_of.begin(), report_of.end(), [&](const auto& kv) {
-      std::error_code ec;
-      return kv.second == path || std::filesystem::equivalent(kv.second, path, ec);
-    })
-                                    : report_of.count(id) > 0;
-    if (resumed) continue;
-    const json report = maps::readJsonFile(path);
-    const std::string got = tracker.addApproval(report, path, id);
-    report_of[got] = path;
-    if (store) {  // kept once; the checkpoints update the state and the route
-      store->begin();
-      store->putFlight({got, path, report, planner::flightStateJson(tracker.state(got)), tracker.routeJson(got)});
-      store->commit();
-    }
+    (void)session.addApprovalFile(path, id);
   }
-  TrackMap track_map;
+  const planner::Tracker& tracker = session.tracker();
+  if (tracker.flights().empty()) throw ParseError("--approval", 0, "--approval", "", "at least one approval report");
+  if ((o.format == "nmea" || o.format == "rinex") && tracker.flights().size() != 1) {
+    throw ParseError("--format", 0, "--format", o.format, "one approval (an NMEA or RINEX stream is one vehicle)");
+  }
+}
+
+/// The fix source of --input and --format.
+std::unique_ptr<planner::FixSource> openFixSource(const TrackOptions& o, const planner::Tracker& tracker) {
+  if (o.format == "rinex") {
+    // Replay: skylane's own position and PLs at every epoch, with the mission's integrity
+    // method, mask and error model, as for its approval.
+    const planner::Mission& m = tracker.approver(tracker.onlyFlight()).mission();
+    integrity::SppConfig cfg;
+    cfg.method = m.method;
+    cfg.model = m.model;
+    cfg.elevation_mask_rad = maps::deg2rad(m.mask_deg);
+    return std::make_unique<planner::RinexReplayFixSource>(o.input, o.navs, cfg);
+  }
+  std::unique_ptr<planner::LineInput> in = planner::openLineInput(o.input);
+  if (o.format == "jsonl") return std::make_unique<planner::JsonLinesFixSource>(std::move(in));
+  std::optional<integrity::NmeaDate> date;
+  if (!o.date.empty()) {
+    const auto t = maps::parseRfc3339(o.date + "T00:00:00Z");
+    if (!t) throw ParseError("--date", 0, "--date", o.date, "a date YYYY-MM-DD (for NMEA streams without RMC/ZDA)");
+    const maps::CalendarTime c = maps::utcFromGps(*t);
+    date = integrity::NmeaDate{{0.0}, c.year, c.month, c.day};
+  }
+  return std::make_unique<planner::NmeaFixSource>(std::move(in), date);
+}
+
+/// SIGTERM and SIGINT request a stop (without SA_RESTART: a blocking read returns at once and the
+/// session sees the flag); a broken pipe is an error on the write, not the end of the process.
+void installStopSignals(std::atomic<bool>& stop) {
+  g_stop = &stop;
+  struct sigaction on_stop {};
+  on_stop.sa_handler = onStopSignal;
+  sigemptyset(&on_stop.sa_mask);
+  sigaction(SIGTERM, &on_stop, nullptr);
+  sigaction(SIGINT, &on_stop, nullptr);
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGPIPE, &ignore, nullptr);
+}
+
+/// Each flight's approved (or current) route on the map.
+void drawRoutes(TrackMap& map, const planner::Tracker& tracker) {
   for (const std::string& id : tracker.flights()) {
     std::vector<Eigen::Vector2d> pts;
     const json route = tracker.routeJson(id);  // named: a range over a temporary's member dangles
     for (const json& p : route.at("route")) {
       pts.emplace_back(maps::deg2rad(p.at("lat").get<double>()), maps::deg2rad(p.at("lon").get<double>()));
     }
-    track_map.route(id, pts);
+    map.route(id, pts);
   }
-  if (tracker.flights().empty()) throw ParseError("--approval", 0, "--approval", "", "at least one approval report");
-  if ((o.format == "nmea" || o.format == "rinex") && tracker.flights().size() != 1) {
-    throw ParseError("--format", 0, "--format", o.format, "one approval (an NMEA or RINEX stream is one vehicle)");
-  }
+}
 
+void runTrack(const TrackOptions& o) {
+  if (o.format != "jsonl" && o.format != "nmea" && o.format != "rinex") {
+    throw ParseError("--format", 0, "--format", o.format, "jsonl, nmea or rinex");
+  }
+  auto log = [](const std::string& m) { std::cerr << "skylane: track: " << m << "\n"; };
+  planner::TrackingSession session(trackerOptions(o), o.db.empty() ? nullptr : std::make_unique<planner::TrackStore>(o.db),
+                                   o.batch, log);
+  session.resumeFlights();
+  addApprovals(session, o);
+  TrackMap track_map;
+  drawRoutes(track_map, session.tracker());
   std::ofstream out_file;
   if (!o.out.empty()) {
     out_file.open(o.out, std::ios::app);
     if (!out_file) throw ParseError(o.out, 0, "--out", o.out, "a writable file");
   }
-  std::ostream& out = o.out.empty() ? std::cout : out_file;
-  std::size_t accepted = 0, rejected = 0, events = 0, line_no = 0;
-  // A file input (not stdin, a FIFO or UDP: those cannot be read again) resumes where the last
-  // committed batch left it.
-  std::error_code fs_error;
-  const bool resumable = store && (o.format == "rinex" || std::filesystem::is_regular_file(o.input, fs_error));
-  const std::size_t resume_line = resumable ? store->inputLine(o.input) : 0;
-  std::size_t open_epoch_line = 0;  // NMEA: the GGA line of the epoch not yet released (0: none)
-  std::set<std::string> touched;  // flights whose state changed since the last checkpoint
-  bool output_closed = false;
-  auto emit = [&](const std::vector<planner::TrackEvent>& evs) {
-    for (const planner::TrackEvent& e : evs) {
-      // Quoted input may hold bytes that are not UTF-8: they are replaced, not fatal.
-      const std::string line = e.jsonLine();
-      out << line << '\n';
-      // A closed output (the reader of a pipe went away): stop as on SIGTERM, the batch saved.
-      if (!out && !output_closed) {
-        output_closed = true;
-        g_stop = true;
-      }
-      ++events;
-      if (e.is("rejected_input")) ++rejected;
-      if (e.is("fix")) ++accepted;
-      if (store) store->appendEvent(e.type, e.flight, e.time ? maps::formatRfc3339(*e.time, 3) : std::string(), line);
-      if (!e.flight.empty() && !e.is("rejected_input")) touched.insert(e.flight);
-      if (!o.map.empty()) track_map.add(e);
-    }
-  };
-  int pending = 0;
-  auto checkpoint = [&](bool force) {
-    if (!store || (!force && pending < o.batch)) return;
-    for (const std::string& id : touched) store->putState(id, planner::flightStateJson(tracker.state(id)), tracker.routeJson(id));
-    touched.clear();
-    // An NMEA epoch still open is read again after a restart: the position stays before it.
-    if (resumable) store->setInputLine(o.input, open_epoch_line > 0 ? std::min(line_no, open_epoch_line) : line_no);
-    store->commit();
-    out.flush();
-    pending = 0;
-  };
-  auto process = [&](const planner::TrackFix& fix) {
-    if (store) store->begin();
-    try {
-      emit(tracker.process(fix));
-    } catch (const std::exception& e) {  // a fix the tracker cannot take never ends the stream
-      emit({tracker.rejectedInput(fix.source, fix.line, e.what())});
-      std::cerr << "skylane: track: skipped " << fix.source << ": " << e.what() << "\n";
-    }
-    ++pending;
-    checkpoint(false);
-  };
-  auto reject = [&](const std::string& source, std::size_t line, const std::string& why) {
-    if (store) store->begin();
-    emit({tracker.rejectedInput(source, line, why)});
-    std::cerr << "skylane: track: skipped " << source << ": " << why << "\n";
-    ++pending;
-  };
-
-  // Without SA_RESTART: a blocking read returns at once and the loop sees the stop flag.
-  struct sigaction stop {};
-  stop.sa_handler = onStopSignal;
-  sigemptyset(&stop.sa_mask);
-  sigaction(SIGTERM, &stop, nullptr);
-  sigaction(SIGINT, &stop, nullptr);
-  // A broken pipe is an error on the write (seen above), not the end of the process.
-  struct sigaction ignore {};
-  ignore.sa_handler = SIG_IGN;
-  sigemptyset(&ignore.sa_mask);
-  sigaction(SIGPIPE, &ignore, nullptr);
-  if (resume_line > 0) std::cerr << "skylane: track: " << o.input << ": resuming after line " << resume_line << "\n";
-
-  if (o.format == "rinex") {
-    // Replay: skylane's own position and PLs at every epoch (SPP with the mission's method).
-    if (o.navs.empty()) throw ParseError("--nav", 0, "--nav", "", "a RINEX navigation file for the observation replay");
-    const integrity::ObservationData obs = integrity::loadRinexObs(o.input);
-    integrity::NavigationData nav;
-    for (const std::string& n : o.navs) nav.merge(integrity::loadRinexNav(n));
-    // The mission's integrity method, mask and error model, as for its approval.
-    const planner::Mission& m = tracker.approver(tracker.onlyFlight()).mission();
-    integrity::SppConfig cfg;
-    cfg.method = m.method;
-    cfg.model = m.model;
-    cfg.elevation_mask_rad = maps::deg2rad(m.mask_deg);
-    std::optional<Eigen::Vector3d> prior = obs.approx_position_ecef;
-    for (const integrity::ObservationEpoch& ep : obs.epochs) {
-      if (g_stop) break;
-      line_no = static_cast<std::size_t>(ep.source_line);
-      if (line_no <= resume_line) continue;
-      const std::string source = o.input + ":" + std::to_string(ep.source_line);
-      const integrity::SppEpoch s = integrity::solveSppEpoch(ep, obs, nav, cfg, prior);
-      if (!s.solved || !s.pl.pl_computed) {
-        reject(source, line_no, "no position or protection level at this epoch: " + s.note);
-        continue;
-      }
-      prior = s.p_ecef;
-      planner::TrackFix f;
-      f.time = s.t;
-      f.lat_rad = s.position.lat_rad;
-      f.lon_rad = s.position.lon_rad;
-      f.h_ell_m = s.position.h_ell_m;
-      f.hpl_m = s.pl.hpl_m;
-      f.vpl_m = s.pl.vpl_m;
-      f.pl_source = planner::PlSource::kRaw;
-      f.source = source;
-      f.line = line_no;
-      process(f);
-    }
-  } else {
-    LineSource in(o.input);
-    std::optional<integrity::NmeaDate> date;
-    if (!o.date.empty()) {
-      const auto t = maps::parseRfc3339(o.date + "T00:00:00Z");
-      if (!t) throw ParseError("--date", 0, "--date", o.date, "a date YYYY-MM-DD (for NMEA streams without RMC/ZDA)");
-      const maps::CalendarTime c = maps::utcFromGps(*t);
-      date = integrity::NmeaDate{{0.0}, c.year, c.month, c.day};
-    }
-    integrity::NmeaEpochAssembler nmea(date);
-    std::size_t epoch_line = 0;  // the line of the GGA that opened the NMEA epoch
-    // On a resume, an NMEA file is read again from its start so that the epoch assembler has
-    // its date and open epoch back; the epochs opened before the resume line were processed then.
-    auto nmeaFix = [&](const std::optional<integrity::NmeaFix>& nf, std::size_t first_line) {
-      if (!nf || first_line < resume_line) return;
-      const std::string source = o.input + ":" + std::to_string(first_line);
-      try {
-        planner::TrackFix f = planner::trackFixFromNmea(*nf, source);
-        f.line = first_line;
-        process(f);
-      } catch (const maps::ParseError& e) {
-        reject(source, first_line, e.what());
-      }
-    };
-    auto last_wall = std::chrono::steady_clock::now();
-    std::string text;
-    for (;;) {
-      if (g_stop) break;
-      const LineSource::Status st = in.next(text, 250);
-      if (st == LineSource::Status::kEnd) break;
-      if (st == LineSource::Status::kTooLong) {
-        ++line_no;
-        if (line_no > resume_line) {
-          reject(o.input + ":" + std::to_string(line_no), line_no, "a line longer than " + std::to_string(kMaxLineBytes) + " bytes");
-        }
-        continue;
-      }
-      if (st == LineSource::Status::kTimeout) {
-        // A quiet live input: stream time runs on with the wall clock for the stale check.
-        if (in.live() && tracker.streamTime()) {
-          const double quiet = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_wall).count();
-          if (store) store->begin();
-          emit(tracker.sweepStale(tracker.streamTime()->plus(quiet)));
-          checkpoint(true);
-        }
-        continue;
-      }
-      last_wall = std::chrono::steady_clock::now();
-      ++line_no;
-      const bool replaying = line_no <= resume_line;
-      if (replaying && o.format != "nmea") continue;
-      if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-      const std::string source = o.input + ":" + std::to_string(line_no);
-      if (o.format == "jsonl") {
-        planner::TrackFix f;
-        try {
-          f = planner::parseTrackFixJson(maps::parseJsonLine(text, source), source);
-          f.line = line_no;
-        } catch (const std::exception& e) {
-          reject(source, line_no, e.what());
-          continue;
-        }
-        process(f);
-      } else {
-        try {
-          const integrity::NmeaSentence s = integrity::parseNmeaSentence(text, source);
-          if (std::holds_alternative<integrity::NmeaGga>(s)) {
-            const std::size_t closed_line = epoch_line;
-            std::optional<integrity::NmeaFix> closed = nmea.add(s);
-            epoch_line = open_epoch_line = line_no;  // before the checkpoint the closed fix may make
-            nmeaFix(closed, closed_line);
-          } else {
-            std::optional<integrity::NmeaFix> closed = nmea.add(s);
-            if (closed) open_epoch_line = 0;
-            nmeaFix(closed, epoch_line);
-          }
-        } catch (const std::exception& e) {
-          if (!replaying) reject(source, line_no, e.what());
-        }
-      }
-    }
-    if (o.format == "nmea" && !g_stop) {
-      std::optional<integrity::NmeaFix> last = nmea.flush();
-      open_epoch_line = 0;
-      nmeaFix(last, epoch_line);
-    }
-  }
-  if (store) store->begin();
-  if (tracker.streamTime()) emit(tracker.sweepStale(*tracker.streamTime()));
-  checkpoint(true);
-  out.flush();
+  planner::JsonLinesSink out(o.out.empty() ? std::cout : out_file);
+  session.addSink(out);
+  if (!o.map.empty()) session.addSink(track_map);
+  installStopSignals(session.stopFlag());
+  const std::unique_ptr<planner::FixSource> source = openFixSource(o, session.tracker());
+  const planner::SessionSummary sum = session.run(*source);
   if (!o.map.empty()) {
-    std::ofstream(o.map) << track_map.svg(tracker);
-    std::cerr << "skylane: track: wrote " << o.map << "\n";
+    std::ofstream(o.map) << track_map.svg(session.tracker());
+    log("wrote " + o.map);
   }
-  std::cerr << "skylane: track: " << accepted << " fix" << (accepted == 1 ? "" : "es") << " accepted, " << rejected
-            << " rejected, " << events << " events"
-            << (output_closed ? " (stopped: the output was closed; state saved)" : g_stop ? " (stopped by a signal; state saved)" : "")
-            << "\n";
+  log(std::to_string(sum.accepted) + " fix" + (sum.accepted == 1 ? "" : "es") + " accepted, " + std::to_string(sum.rejected) +
+      " rejected, " + std::to_string(sum.events) + " events" +
+      (sum.output_closed ? " (stopped: the output was closed; state saved)" : sum.stopped ? " (stopped by a signal; state saved)" : ""));
 }
 
 struct FlyOptions {
@@ -578,7 +307,7 @@ void runFly(const FlyOptions& o) {
   sim.flight = o.flight.empty() ? plan.mission_name : o.flight;
   sim.seed = o.seed;
   if (!o.imu.empty()) {
-    const auto grade = integrity::sim::parseImuGrade(o.imu);
+    const auto grade = integrity::ins::parseImuGrade(o.imu);
     if (!grade) throw ParseError("--imu", 0, "--imu", o.imu, "aviation, tactical or consumer");
     planner::ImuFeed feed;
     feed.grade = *grade;

@@ -70,4 +70,11 @@ void bodyIncrements(const NavState& from, const NavState& to, double dt, Eigen::
   dv = C_mid.transpose() * (to.v_ecef_mps - from.v_ecef_mps - (g - coriolis) * dt);
 }
 
+Eigen::Matrix3d bodyToEnu(double heading_rad, double pitch_rad, double roll_rad) {
+  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(M_PI / 2.0 - heading_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d Ry = Eigen::AngleAxisd(-pitch_rad, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const Eigen::Matrix3d Rx = Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  return Rz * Ry * Rx;
+}
+
 }  // namespace skylane::integrity::ins

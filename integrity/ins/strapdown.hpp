@@ -46,4 +46,8 @@ struct NavState {
 void bodyIncrements(const NavState& from, const NavState& to, double dt_s, Eigen::Vector3d& dtheta_rad,
                     Eigen::Vector3d& dv_mps);
 
+/// \brief Body (FLU) → ENU for heading ψ (clockwise from north), pitch θ (nose up), roll φ
+/// (right wing down): Rz(π/2 − ψ)·Ry(−θ)·Rx(φ).
+[[nodiscard]] Eigen::Matrix3d bodyToEnu(double heading_rad, double pitch_rad, double roll_rad);
+
 }  // namespace skylane::integrity::ins

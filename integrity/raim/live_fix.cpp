@@ -145,6 +145,31 @@ std::vector<LocatedRange> locateRanges(const std::vector<RawRange>& ranges, cons
   return located;
 }
 
+std::vector<LocatedRange> rangesAboveMask(const std::vector<RawRange>& ranges, const Eigen::Vector3d& r_ecef, const GpsTime& t,
+                                          const OrbitSource* orbits, double elevation_mask_rad) {
+  std::vector<SatId> missing;
+  std::vector<LocatedRange> out;
+  for (LocatedRange& l : locateRanges(ranges, r_ecef, t, orbits, missing)) {
+    if (maps::lookAngles(r_ecef, l.sat_ecef_m).elevation_rad < elevation_mask_rad) continue;
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
+std::optional<double> meanClockResidual_m(const std::vector<RawRange>& ranges, const Eigen::Vector3d& r_ecef, const GpsTime& t,
+                                          const OrbitSource* orbits, const std::vector<SatId>& used) {
+  std::vector<SatId> missing;
+  double sum = 0.0;
+  int count = 0;
+  for (const LocatedRange& l : locateRanges(ranges, r_ecef, t, orbits, missing)) {
+    if (std::find(used.begin(), used.end(), l.sat) == used.end()) continue;
+    sum += l.pr_m - (l.sat_ecef_m - r_ecef).norm();
+    ++count;
+  }
+  if (count == 0) return std::nullopt;
+  return sum / count;
+}
+
 LiveFix solveLiveFix(const std::vector<RawRange>& ranges, const maps::Geodetic& initial, const GpsTime& t,
                      const LiveFixConfig& cfg, bool exclude, const OrbitSource* orbits) {
   if (!std::isfinite(initial.lat_rad) || !std::isfinite(initial.lon_rad) || !std::isfinite(initial.h_ell_m)) {

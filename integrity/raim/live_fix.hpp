@@ -57,6 +57,17 @@ struct LocatedRange {
 [[nodiscard]] std::vector<LocatedRange> locateRanges(const std::vector<RawRange>& ranges, const Eigen::Vector3d& x0_ecef,
                                                      const GpsTime& t, const OrbitSource* orbits, std::vector<SatId>& missing);
 
+/// \brief locateRanges() seen from `r_ecef` at `t`, keeping the satellites at or above
+/// `elevation_mask_rad` (those without a position or orbit are left out).
+[[nodiscard]] std::vector<LocatedRange> rangesAboveMask(const std::vector<RawRange>& ranges, const Eigen::Vector3d& r_ecef,
+                                                        const GpsTime& t, const OrbitSource* orbits, double elevation_mask_rad);
+
+/// \brief The receiver clock bias [m] at `r_ecef`: the mean residual ρ − |r_s − r| of the
+/// satellites in `used`; std::nullopt when none of them has a range.
+[[nodiscard]] std::optional<double> meanClockResidual_m(const std::vector<RawRange>& ranges, const Eigen::Vector3d& r_ecef,
+                                                        const GpsTime& t, const OrbitSource* orbits,
+                                                        const std::vector<SatId>& used);
+
 /// \brief What a live epoch is solved with.
 struct LiveFixConfig {
   IntegrityMethod method = IntegrityMethod::kRaim;

@@ -88,25 +88,9 @@ FaultSpec parseFault(const JsonNode& f) {
 }
 
 void matchFilterToSensors(ins::NavigatorConfig& nav, const SensorSpec& sensors, ImuGrade grade) {
-  ins::EkfConfig& e = nav.ekf;
-  const ImuSpec& imu = sensors.imu;
-  e.accel_noise_mps_rts = imu.accel_noise_mps_rts;
-  e.gyro_noise_rad_rts = imu.gyro_noise_rad_rts;
-  e.accel_bias_rw_mps2_rts = imu.accel_bias_rw_mps2_rts;
-  e.gyro_bias_rw_radps_rts = imu.gyro_bias_rw_radps_rts;
-  e.accel_bias_mps2 = imu.accel_bias_mps2;
-  e.gyro_bias_radps = imu.gyro_bias_radps;
-  e.clock_h0 = sensors.clock_h0;
-  e.clock_hm2 = sensors.clock_hm2;
-  e.baro_noise_m = sensors.baro_noise_m;
-  e.baro_bias_m = sensors.baro_bias_m;
-  e.baro_bias_rw_m_rts = sensors.baro_bias_rw_m_rts;
-  e.heading_noise_rad = sensors.heading_noise_rad;
+  ins::tuneFilterToSensors(nav, sensors, grade);
   nav.model = sensors.model;
   nav.elevation_mask_rad = sensors.elevation_mask_rad;
-  nav.seed000.lambda = ins::seed000Lambda(static_cast<int>(grade));
-  nav.seed000.phmi_h = nav.fault_modes.risk.i_req * (1.0 - nav.fault_modes.risk.vertical_share);
-  nav.seed000.phmi_v = nav.fault_modes.risk.i_req * nav.fault_modes.risk.vertical_share;
 }
 
 void matchFilterToSensors(Scenario& s) {

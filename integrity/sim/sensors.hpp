@@ -4,14 +4,7 @@
 /// from real orbits with the error model of DESIGN.md, barometric height, magnetometer heading,
 /// and fault injection. Every random draw comes from one seeded generator.
 ///
-/// IMU grades (seed 000 Table 1 gives the turn-on biases; the noise figures are not in the seed
-/// and are skylane's documented choices, typical datasheet values):
-/// | grade    | accel bias σ | gyro bias σ      | VRW (m/s/√s) | ARW (rad/√s) | accel / gyro bias RW        |
-/// | aviation | 3e-4 m/s²    | 5e-8 rad/s       | 2e-4         | 5.8e-7       | 1e-6 m/s²/√s / 1e-9 rad/s/√s |
-/// | tactical | 1e-2 m/s²    | 5e-6 rad/s       | 8.3e-4       | 2.9e-5       | 1e-4 / 1e-7                  |
-/// | consumer | 3e-2 m/s²    | 5e-4 rad/s (¹)   | 2.0e-3       | 1.75e-4      | 3e-4 / 1e-5                  |
-/// (¹) The seed's consumer gyro exponent is unreadable ("> 5 × 10^?"); 5e-4 rad/s (≈ 100 °/h) is
-/// the tactical upper bound and typical of MEMS gyros.
+/// IMU grades and their figures: integrity/ins/imu_grade.hpp.
 ///
 /// Pseudorange (per satellite i, epoch k): ρ = |r_s − r| (light time and Sagnac, as
 /// OrbitSource::visible) + c·δt_r + b_i + ε_i,k + f_i,k, with
@@ -26,6 +19,8 @@
 #include "integrity/gnss/gnss_time.hpp"
 #include "integrity/gnss/orbit_source.hpp"
 #include "integrity/gnss/satellite_id.hpp"
+#include "integrity/ins/filter_tuning.hpp"
+#include "integrity/ins/imu_grade.hpp"
 #include "integrity/ins/strapdown.hpp"
 #include "integrity/sim/trajectory.hpp"
 
@@ -41,27 +36,11 @@
 
 namespace skylane::integrity::sim {
 
-/// \brief IMU grades of seed 000 Table 1.
-enum class ImuGrade { kAviation, kTactical, kConsumer };
-
-/// \brief "aviation", "tactical", "consumer".
-[[nodiscard]] std::string_view imuGradeName(ImuGrade g);
-/// \brief Parses a grade name; std::nullopt when unknown.
-[[nodiscard]] std::optional<ImuGrade> parseImuGrade(std::string_view name);
-
-/// \brief IMU error figures (1σ; noise as random-walk coefficients).
-struct ImuSpec {
-  double accel_bias_mps2 = 0.0;       ///< turn-on bias σ per axis
-  double gyro_bias_radps = 0.0;
-  double accel_noise_mps_rts = 0.0;   ///< velocity random walk [m/s/√s]
-  double gyro_noise_rad_rts = 0.0;    ///< angle random walk [rad/√s]
-  double accel_bias_rw_mps2_rts = 0.0;  ///< bias random walk [m/s²/√s]
-  double gyro_bias_rw_radps_rts = 0.0;  ///< [rad/s/√s]
-  double rate_hz = 100.0;
-};
-
-/// \brief The figures of the file comment's table.
-[[nodiscard]] ImuSpec imuSpec(ImuGrade g);
+using ins::ImuGrade;
+using ins::imuGradeName;
+using ins::ImuSpec;
+using ins::imuSpec;
+using ins::parseImuGrade;
 
 /// \brief What a fault acts on.
 enum class FaultTarget { kSatellite, kAccelerometer, kGyro, kGnssOutage };
@@ -83,18 +62,12 @@ struct FaultSpec {
   [[nodiscard]] double valueAt(double t_s) const;
 };
 
-/// \brief Sensor settings.
-struct SensorSpec {
-  ImuSpec imu = imuSpec(ImuGrade::kConsumer);
+/// \brief Sensor settings: the IMU, clock, barometer and magnetometer figures the filter is
+/// tuned to (ins::SensorErrorSpec), and the GNSS side.
+struct SensorSpec : ins::SensorErrorSpec {
   double gnss_rate_hz = 1.0;
   double elevation_mask_rad = 5.0 * M_PI / 180.0;
   ErrorModel model;
-  double clock_h0 = 2e-19;    ///< receiver oscillator Allan coefficients
-  double clock_hm2 = 2e-20;
-  double baro_noise_m = 0.3;       ///< white noise σ of each barometric height
-  double baro_bias_m = 3.0;        ///< turn-on bias σ
-  double baro_bias_rw_m_rts = 0.01;
-  double heading_noise_rad = 2.0 * M_PI / 180.0;  ///< magnetometer heading σ (declination known)
 };
 
 /// \brief One IMU interval's increments (what the IMU outputs).

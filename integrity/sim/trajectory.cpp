@@ -19,13 +19,6 @@ double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x()
 
 }  // namespace
 
-Eigen::Matrix3d bodyToEnu(double heading_rad, double pitch_rad, double roll_rad) {
-  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(M_PI / 2.0 - heading_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Matrix3d Ry = Eigen::AngleAxisd(-pitch_rad, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  const Eigen::Matrix3d Rx = Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  return Rz * Ry * Rx;
-}
-
 Trajectory::Trajectory(const maps::Geodetic& origin, std::vector<Waypoint> waypoints, double turn_radius_m)
     : frame_(origin) {
   const std::size_t n = waypoints.size();

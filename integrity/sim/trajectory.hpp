@@ -10,6 +10,7 @@
 /// the ENU ones). The body frame is forward-left-up (FLU); attitude is given against the local
 /// ENU frame *at the vehicle* (so a magnetometer or a level sensor sees what it would).
 
+#include "integrity/ins/strapdown.hpp"
 #include "maps/geodesy.hpp"
 
 #include <Eigen/Core>
@@ -40,8 +41,7 @@ struct TruthState {
   Eigen::Matrix3d C_ecef_body = Eigen::Matrix3d::Identity();  ///< body (FLU) → ECEF
 };
 
-/// \brief Body (FLU) → ENU for heading ψ, pitch θ, roll φ: Rz(π/2 − ψ)·Ry(−θ)·Rx(φ).
-[[nodiscard]] Eigen::Matrix3d bodyToEnu(double heading_rad, double pitch_rad, double roll_rad);
+using ins::bodyToEnu;
 
 /// \brief A flyable path through waypoints.
 class Trajectory {

@@ -1,7 +1,7 @@
 #include "planner/tracking/track_fix.hpp"
 
 #include "integrity/ins/protection_levels.hpp"
-#include "integrity/sim/sensors.hpp"
+#include "integrity/ins/imu_grade.hpp"
 #include "integrity/stats.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/json_node.hpp"
@@ -101,7 +101,7 @@ TrackFix parseTrackFixJson(const json& doc, const std::string& source) {
   if (root.has("imu")) {
     const maps::JsonNode imu = root.at("imu");
     imu.requireKnownFields({"grade", "sigma_n_m", "sigma_e_m", "sigma_u_m", "increments"});
-    const auto parsed = integrity::sim::parseImuGrade(imu.at("grade").str());
+    const auto parsed = integrity::ins::parseImuGrade(imu.at("grade").str());
     if (!parsed) imu.at("grade").fail("aviation, tactical or consumer (seed 000 Table 1)");
     const int grade = static_cast<int>(*parsed);
     if (imu.has("increments")) {
@@ -203,6 +203,57 @@ TrackFix trackFixFromNmea(const integrity::NmeaFix& fix, const std::string& sour
   f.vpl_m = integrity::normalTailInverse(risk.p_v / 2.0) * sigma_v;
   f.pl_source = PlSource::kNmeaGst;
   return f;
+}
+
+namespace {
+
+double round_to(double v, double step) { return std::round(v / step) * step; }
+
+json vec(const Eigen::Vector3d& v, double step) {
+  return json::array({round_to(v.x(), step), round_to(v.y(), step), round_to(v.z(), step)});
+}
+
+}  // namespace
+
+json trackFixJson(const TrackFix& f) {
+  json j;
+  if (!f.flight.empty()) j["flight"] = f.flight;
+  j["time"] = maps::formatRfc3339(f.time, 3);
+  j["lat"] = round_to(maps::rad2deg(f.lat_rad), 1e-9);
+  j["lon"] = round_to(maps::rad2deg(f.lon_rad), 1e-9);
+  j["h_ell_m"] = round_to(f.h_ell_m, 1e-4);
+  if (f.hpl_m && f.vpl_m) {
+    j["hpl_m"] = round_to(*f.hpl_m, 1e-4);
+    j["vpl_m"] = round_to(*f.vpl_m, 1e-4);
+  }
+  if (!f.ranges.empty()) {
+    json list = json::array();
+    for (const integrity::RawRange& r : f.ranges) {
+      json one = {{"sat", r.sat.str()}, {"pr_m", round_to(r.pr_m, 1e-4)}};
+      if (r.sat_ecef_m) one["ecef_m"] = vec(*r.sat_ecef_m, 1e-4);
+      list.push_back(std::move(one));
+    }
+    j["pseudoranges"] = std::move(list);
+  }
+  auto grade = [](int g) { return std::string(integrity::ins::imuGradeName(static_cast<integrity::ins::ImuGrade>(g))); };
+  if (f.imu) {
+    json inc = json::array();
+    for (const ImuIncrement& i : f.imu->increments) {
+      inc.push_back({i.dt_s, i.dtheta_rad.x(), i.dtheta_rad.y(), i.dtheta_rad.z(), i.dv_mps.x(), i.dv_mps.y(), i.dv_mps.z()});
+    }
+    j["imu"] = {{"grade", grade(f.imu->grade)}, {"increments", std::move(inc)}};
+  } else if (f.ins) {
+    j["imu"] = {{"grade", grade(f.ins->grade)}, {"sigma_n_m", f.ins->sigma_n_m}, {"sigma_e_m", f.ins->sigma_e_m}, {"sigma_u_m", f.ins->sigma_u_m}};
+  }
+  if (f.velocity_enu_mps) j["velocity_enu_mps"] = vec(*f.velocity_enu_mps, 1e-4);
+  if (f.attitude_rad) {
+    j["attitude_deg"] = {{"roll", round_to(maps::rad2deg(f.attitude_rad->x()), 1e-6)},
+                         {"pitch", round_to(maps::rad2deg(f.attitude_rad->y()), 1e-6)},
+                         {"heading", round_to(maps::rad2deg(f.attitude_rad->z()), 1e-6)}};
+  }
+  if (f.baro_h_m) j["baro_h_m"] = round_to(*f.baro_h_m, 1e-4);
+  if (f.mag_heading_rad) j["mag_heading_deg"] = round_to(maps::rad2deg(*f.mag_heading_rad), 1e-6);
+  return j;
 }
 
 }  // namespace skylane::planner

@@ -96,6 +96,10 @@ struct TrackFix {
 /// \throws maps::ParseError naming `source`, the field, the value and what was expected.
 [[nodiscard]] TrackFix parseTrackFixJson(const nlohmann::json& doc, const std::string& source);
 
+/// \brief A fix as one JSON-lines object (the file comment's schema; parseTrackFixJson reads
+/// it back: positions to 1e-9°, heights and ranges to 0.1 mm, increments with full precision).
+[[nodiscard]] nlohmann::json trackFixJson(const TrackFix& fix);
+
 /// \brief Integrity risks behind the NMEA protection levels.
 struct NmeaPlRisk {
   double p_h = 2e-9;    ///< horizontal: K_H = √(−2 ln p_h) (the RAIM fault-free horizontal budget)

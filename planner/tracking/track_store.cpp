@@ -1,5 +1,7 @@
 #include "planner/tracking/track_store.hpp"
 
+#include "maps/time.hpp"
+
 #include <sqlite3.h>
 
 #include <stdexcept>
@@ -155,6 +157,10 @@ void TrackStore::setInputLine(const std::string& name, std::size_t line) {
   bindText(put_input_, 1, name);
   sqlite3_bind_int64(put_input_, 2, static_cast<sqlite3_int64>(line));
   if (sqlite3_step(put_input_) != SQLITE_DONE) fail("cannot store the input position");
+}
+
+void TrackStore::write(const TrackEvent& event, const std::string& json_line) {
+  appendEvent(event.type, event.flight, event.time ? maps::formatRfc3339(*event.time, 3) : std::string(), json_line);
 }
 
 }  // namespace skylane::planner

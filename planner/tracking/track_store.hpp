@@ -9,6 +9,8 @@
 /// Tables: flights(id, report file, approval report JSON, state JSON, route JSON),
 /// events(seq, flight, time, type, JSON), inputs(name, line).
 
+#include "planner/tracking/event_sink.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <optional>
@@ -29,13 +31,13 @@ struct StoredFlight {
   nlohmann::json route;
 };
 
-/// \brief The database of one tracker.
-class TrackStore {
+/// \brief The database of one tracker; as an event sink it logs every event in the batch.
+class TrackStore final : public EventSink {
  public:
   /// \brief Opens (creates) the database file.
   /// \throws std::runtime_error naming the file and SQLite's message.
   explicit TrackStore(const std::string& path);
-  ~TrackStore();
+  ~TrackStore() override;
   TrackStore(const TrackStore&) = delete;
   TrackStore& operator=(const TrackStore&) = delete;
 
@@ -54,9 +56,13 @@ class TrackStore {
   /// \brief An event as written to the stream (one JSON line) with its type, flight and time.
   void appendEvent(const std::string& type, const std::string& flight, const std::string& time, const std::string& line);
   void setInputLine(const std::string& name, std::size_t line);
+  /// \brief appendEvent() of the event (EventSink).
+  void write(const TrackEvent& event, const std::string& json_line) override;
   /// \brief Commits the batch.
   void commit();
   [[nodiscard]] bool inBatch() const { return in_batch_; }
+  /// \brief The database file.
+  [[nodiscard]] const std::string& path() const { return path_; }
 
  private:
   void exec(const char* sql) const;

@@ -37,6 +37,8 @@
 
 #include "planner/approval.hpp"
 #include "planner/report_formats.hpp"
+#include "planner/tracking/flight_state.hpp"
+#include "planner/tracking/track_event.hpp"
 #include "planner/tracking/track_fix.hpp"
 
 #include <nlohmann/json.hpp>
@@ -49,6 +51,9 @@
 #include <vector>
 
 namespace skylane::planner {
+
+struct TrackedFlight;
+struct FixWork;
 
 /// \brief Hysteresis, persistence and timing of the tracker (the file comment's steps).
 struct TrackerOptions {
@@ -63,58 +68,6 @@ struct TrackerOptions {
   int jump_confirm = 3;             ///< fixes in order on a jumped timeline before it is taken
   double waypoint_radius_m = 30.0;  ///< a mission waypoint is passed once a fix comes this close
   double horizon_m = 50.0;          ///< zones and obstacles this near a volume are listed in its fix event
-};
-
-/// \brief What a `fix` event says (kept typed: the JSON is only made when it is written).
-struct FixRecord {
-  std::size_t line = 0;
-  double lat_rad = 0.0, lon_rad = 0.0, h_ell_m = 0.0;  ///< the position checked (skylane's own with raw ranges)
-  double hpl_m = 0.0, vpl_m = 0.0;
-  PlSource pl_source = PlSource::kOnboard;
-  std::optional<bool> fault_detected;  ///< raw ranges: the first pass's detection (GNSS/INS: step 1's)
-  std::vector<integrity::SatId> excluded;  ///< left out of the position (GNSS/INS FDE, a rerun)
-  std::optional<bool> ins_degraded;    ///< GNSS/INS: seed 001's GNSS-alone mode after an IMU fault
-  geofence::FenceVerdict verdict;
-  int route_version = 0;
-  bool rerun = false;
-  std::string note;
-};
-
-/// \brief One event of the output stream: {"event": type, "flight", "time", …}. A `fix` event
-/// holds a FixRecord; the others their fields in `body`.
-struct TrackEvent {
-  const char* type = "";
-  std::string flight;             ///< empty: none (an unreadable record)
-  std::optional<maps::GpsTime> time;
-  std::optional<FixRecord> fix;
-  nlohmann::json body;  ///< null until a field is set (a `fix` event needs none: no allocation per fix)
-  /// \brief A field of the body.
-  nlohmann::json& operator[](const char* key) { return body[key]; }
-  [[nodiscard]] bool is(const char* t) const { return std::string_view(type) == t; }
-  /// \brief The event as one JSON object.
-  [[nodiscard]] nlohmann::json toJson() const;
-  /// \brief toJson() written on one line, without building the object for a `fix` event (the
-  /// stream's hot path; the same members and numbers). Bytes that are not UTF-8 are replaced.
-  [[nodiscard]] std::string jsonLine() const;
-};
-
-/// \brief A flight's persistent state (what a restarted tracker needs to go on).
-struct FlightState {
-  std::optional<maps::GpsTime> last_time;
-  std::vector<bool> level1_window, level2_window;  ///< oldest first, at most N each
-  std::array<bool, 4> violated{};                  ///< per geofence::Level
-  std::array<int, 4> inside_streak{};
-  std::optional<maps::GpsTime> last_replan;
-  bool stale_reported = false;
-  bool arrived = false;       ///< the last fix was within waypoint_radius_m of the goal
-  std::size_t next_stop = 1;  ///< index into Mission::points of the next point to reach
-  int route_version = 0;      ///< 0: the approved route; n: the n-th accepted replan
-  std::uint64_t fixes = 0, rerun_count = 0, replans = 0;
-  /// Seconds the flight's clock runs ahead of the stream's since it took a new timeline after a
-  /// jump: its fixes move the stream time, and its silence is measured, on the stream's clock.
-  double clock_offset_s = 0.0;
-  std::optional<maps::GpsTime> jump_candidate;  ///< the last fix refused for a time jump (not stored)
-  int jump_count = 0;
 };
 
 /// \brief Tracks many flights in one process.
@@ -163,9 +116,10 @@ class Tracker {
   [[nodiscard]] const TrackerOptions& options() const { return options_; }
 
  private:
-  struct Flight;
+  /// The step that accepts a checked fix: stream time, the stale sweep, the flight's counters.
+  void acceptFix(TrackedFlight& f, FixWork& w);
   TrackerOptions options_;
-  std::map<std::string, std::unique_ptr<Flight>> flights_;
+  std::map<std::string, std::unique_ptr<TrackedFlight>> flights_;
   std::map<std::string, std::shared_ptr<Approver>> approvers_;  ///< by mission file
   std::optional<maps::GpsTime> stream_time_;
   std::optional<maps::GpsTime> last_sweep_;
@@ -175,10 +129,5 @@ class Tracker {
 /// beside the report, with the SHA-256 the report recorded.
 /// \throws maps::ParseError naming the report when it is missing or has changed.
 [[nodiscard]] std::string approvedMissionPath(const ApprovedFlight& plan, const std::string& report_path);
-
-/// \brief FlightState as JSON and back (the tracker database keeps it).
-[[nodiscard]] nlohmann::json flightStateJson(const FlightState& s);
-/// \throws maps::ParseError naming `source` for a malformed state.
-[[nodiscard]] FlightState parseFlightState(const nlohmann::json& j, const std::string& source);
 
 }  // namespace skylane::planner

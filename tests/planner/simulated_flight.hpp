@@ -1,9 +1,9 @@
 #pragma once
-// A simulated flight along an approved route (planner/tracking/flight_sim.hpp) for the tracking
+// A simulated flight along an approved route (planner/rehearsal/flight_sim.hpp) for the tracking
 // tests and bench/bench_track.cpp, from an approval report.
 
 #include "planner/approval.hpp"
-#include "planner/tracking/flight_sim.hpp"
+#include "planner/rehearsal/flight_sim.hpp"
 
 #include <optional>
 #include <string>
@@ -19,17 +19,13 @@ inline std::vector<SimulatedFix> simulateRoute(const planner::ApprovalReport& r,
                                                const std::vector<integrity::sim::FaultSpec>& faults, std::uint64_t seed,
                                                double reported_dh_m = 0.0, const std::string& flight = "F1",
                                                const std::optional<ImuFeed>& imu = std::nullopt) {
-  planner::ApprovedFlight f;
-  f.approved = true;
-  f.departure = r.departure;
-  f.route = r.route;
   planner::FlightSimOptions o;
   o.flight = flight;
   o.seed = seed;
   o.reported_dh_m = reported_dh_m;
   o.faults = faults;
   o.imu = imu;
-  return planner::simulateFlight(f, a, o);
+  return planner::simulateFlight(r, a, o);
 }
 
 }  // namespace skylane::test

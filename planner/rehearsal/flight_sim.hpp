@@ -23,7 +23,7 @@ namespace skylane::planner {
 
 /// \brief What the IMU side of a simulated flight gives the tracker (GNSS/INS fixes).
 struct ImuFeed {
-  integrity::sim::ImuGrade grade = integrity::sim::ImuGrade::kTactical;
+  integrity::ins::ImuGrade grade = integrity::ins::ImuGrade::kTactical;
   bool aiding = true;  ///< barometer and magnetometer in every fix
   /// The onboard navigation's velocity and attitude in each fix (the filter aligns with them):
   /// the truth perturbed with the σ's the filter assumes at alignment (EkfConfig defaults).
@@ -55,8 +55,9 @@ struct SimulatedFix {
                                                        const FlightSimOptions& options,
                                                        const std::function<void(double)>& progress = {});
 
-/// \brief A fix as one JSON-lines object (the schema of track_fix.hpp; parseTrackFixJson reads
-/// it back: positions to 1e-9°, heights and ranges to 0.1 mm, increments with full precision).
-[[nodiscard]] nlohmann::json trackFixJson(const TrackFix& fix);
+/// \brief The same for an approval report's route (a rehearsal before the report is written).
+[[nodiscard]] std::vector<SimulatedFix> simulateFlight(const ApprovalReport& report, const Approver& approver,
+                                                       const FlightSimOptions& options,
+                                                       const std::function<void(double)>& progress = {});
 
 }  // namespace skylane::planner

@@ -1,4 +1,4 @@
-#include "planner/tracking/flight_sim.hpp"
+#include "planner/rehearsal/flight_sim.hpp"
 
 #include "integrity/sim/trajectory.hpp"
 #include "maps/geodesy.hpp"
@@ -78,55 +78,13 @@ std::vector<SimulatedFix> simulateFlight(const ApprovedFlight& flight, const App
   return out;
 }
 
-namespace {
-
-double round_to(double v, double step) { return std::round(v / step) * step; }
-
-json vec(const Eigen::Vector3d& v, double step) {
-  return json::array({round_to(v.x(), step), round_to(v.y(), step), round_to(v.z(), step)});
-}
-
-}  // namespace
-
-json trackFixJson(const TrackFix& f) {
-  json j;
-  if (!f.flight.empty()) j["flight"] = f.flight;
-  j["time"] = maps::formatRfc3339(f.time, 3);
-  j["lat"] = round_to(maps::rad2deg(f.lat_rad), 1e-9);
-  j["lon"] = round_to(maps::rad2deg(f.lon_rad), 1e-9);
-  j["h_ell_m"] = round_to(f.h_ell_m, 1e-4);
-  if (f.hpl_m && f.vpl_m) {
-    j["hpl_m"] = round_to(*f.hpl_m, 1e-4);
-    j["vpl_m"] = round_to(*f.vpl_m, 1e-4);
-  }
-  if (!f.ranges.empty()) {
-    json list = json::array();
-    for (const integrity::RawRange& r : f.ranges) {
-      json one = {{"sat", r.sat.str()}, {"pr_m", round_to(r.pr_m, 1e-4)}};
-      if (r.sat_ecef_m) one["ecef_m"] = vec(*r.sat_ecef_m, 1e-4);
-      list.push_back(std::move(one));
-    }
-    j["pseudoranges"] = std::move(list);
-  }
-  auto grade = [](int g) { return std::string(integrity::sim::imuGradeName(static_cast<integrity::sim::ImuGrade>(g))); };
-  if (f.imu) {
-    json inc = json::array();
-    for (const ImuIncrement& i : f.imu->increments) {
-      inc.push_back({i.dt_s, i.dtheta_rad.x(), i.dtheta_rad.y(), i.dtheta_rad.z(), i.dv_mps.x(), i.dv_mps.y(), i.dv_mps.z()});
-    }
-    j["imu"] = {{"grade", grade(f.imu->grade)}, {"increments", std::move(inc)}};
-  } else if (f.ins) {
-    j["imu"] = {{"grade", grade(f.ins->grade)}, {"sigma_n_m", f.ins->sigma_n_m}, {"sigma_e_m", f.ins->sigma_e_m}, {"sigma_u_m", f.ins->sigma_u_m}};
-  }
-  if (f.velocity_enu_mps) j["velocity_enu_mps"] = vec(*f.velocity_enu_mps, 1e-4);
-  if (f.attitude_rad) {
-    j["attitude_deg"] = {{"roll", round_to(maps::rad2deg(f.attitude_rad->x()), 1e-6)},
-                         {"pitch", round_to(maps::rad2deg(f.attitude_rad->y()), 1e-6)},
-                         {"heading", round_to(maps::rad2deg(f.attitude_rad->z()), 1e-6)}};
-  }
-  if (f.baro_h_m) j["baro_h_m"] = round_to(*f.baro_h_m, 1e-4);
-  if (f.mag_heading_rad) j["mag_heading_deg"] = round_to(maps::rad2deg(*f.mag_heading_rad), 1e-6);
-  return j;
+std::vector<SimulatedFix> simulateFlight(const ApprovalReport& r, const Approver& approver, const FlightSimOptions& o,
+                                         const std::function<void(double)>& progress) {
+  ApprovedFlight f;
+  f.approved = true;
+  f.departure = r.departure;
+  f.route = r.route;
+  return simulateFlight(f, approver, o, progress);
 }
 
 }  // namespace skylane::planner

@@ -1,0 +1,54 @@
+#pragma once
+/// \file
+/// \brief Lines of text from an input: a file, stdin, a FIFO, a UDP port (one or more lines per
+/// datagram) or memory — the transport under the text fix sources (JSON lines, NMEA). A live
+/// input (stdin, FIFO, socket, UDP) returns kTimeout when it is quiet, so that a stop request and
+/// stale flights are noticed.
+
+#include <cstddef>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace skylane::planner {
+
+/// \brief The longest input line taken [bytes]: a fix is a few hundred bytes, with pseudoranges
+/// a few kB.
+constexpr std::size_t kMaxLineBytes = 1 << 20;
+
+/// \brief A source of lines.
+class LineInput {
+ public:
+  enum class Status { kLine, kTimeout, kEnd, kTooLong };
+  virtual ~LineInput() = default;
+  /// \brief The next line (without its line end); kTimeout after `timeout_ms` without one on a
+  /// live input; kTooLong once for a line longer than kMaxLineBytes (the rest of it is dropped).
+  [[nodiscard]] virtual Status next(std::string& line, int timeout_ms) = 0;
+  /// \brief Whether the input can go quiet and come back (stdin, FIFO, socket, UDP).
+  [[nodiscard]] virtual bool live() const = 0;
+  /// \brief Whether the same lines can be read again after a restart (a regular file).
+  [[nodiscard]] virtual bool rereadable() const = 0;
+  /// \brief The input's name in messages and in the resume table ("-", a path, udp://…).
+  [[nodiscard]] virtual const std::string& name() const = 0;
+};
+
+/// \brief Opens "-" (stdin), "udp://IPv4:PORT" (binds the port) or a file path.
+/// \throws maps::ParseError naming --input and what was expected (an address, a readable file).
+[[nodiscard]] std::unique_ptr<LineInput> openLineInput(const std::string& input);
+
+/// \brief Lines held in memory (tests, a service's request body). Not live, not rereadable.
+class MemoryLineInput final : public LineInput {
+ public:
+  MemoryLineInput(std::string name, std::vector<std::string> lines) : name_(std::move(name)), lines_(lines.begin(), lines.end()) {}
+  Status next(std::string& line, int timeout_ms) override;
+  [[nodiscard]] bool live() const override { return false; }
+  [[nodiscard]] bool rereadable() const override { return false; }
+  [[nodiscard]] const std::string& name() const override { return name_; }
+
+ private:
+  std::string name_;
+  std::deque<std::string> lines_;
+};
+
+}  // namespace skylane::planner

@@ -1,0 +1,319 @@
+#include "planner/tracking/track_event.hpp"
+
+#include "maps/json_numbers.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+
+namespace skylane::planner {
+
+using nlohmann::json;
+using maps::metresOrNull;
+using maps::roundToDeg8;
+using maps::roundToMm;
+
+namespace {
+
+bool isBoxLevel(const geofence::Check& c) {
+  return c.level == geofence::Level::kCorridor || c.level == geofence::Level::kAirspace;
+}
+
+}  // namespace
+
+TrackEvent trackEvent(const char* type, const std::string& flight, const maps::GpsTime& t) {
+  TrackEvent e;
+  e.type = type;
+  e.flight = flight;
+  e.time = t;
+  return e;
+}
+
+void to_json(json& j, const FixRecord& f) {
+  j["line"] = f.line;
+  j["lat"] = roundToDeg8(f.lat_rad);
+  j["lon"] = roundToDeg8(f.lon_rad);
+  j["h_ell_m"] = roundToMm(f.h_ell_m);
+  j["hpl_m"] = metresOrNull(f.hpl_m);
+  j["vpl_m"] = metresOrNull(f.vpl_m);
+  j["pl_source"] = plSourceName(f.pl_source);
+  if (f.fault_detected) j["fault_detected"] = *f.fault_detected;
+  if (!f.excluded.empty()) {
+    json ex = json::array();
+    for (const integrity::SatId& s : f.excluded) ex.push_back(s.str());
+    j["excluded"] = ex;
+  }
+  if (f.ins_degraded) j["ins_degraded"] = *f.ins_degraded;
+  j["verdict"] = geofence::verdictName(f.verdict.verdict);
+  j["violated"] = f.verdict.violated ? json(geofence::levelName(*f.verdict.violated)) : json(nullptr);
+  json levels = json::object();
+  json near = json::array();
+  for (const geofence::Check& c : f.verdict.checks) {
+    if (isBoxLevel(c)) {
+      levels[geofence::levelName(c.level)] = {{"verdict", geofence::verdictName(c.verdict)},
+                                             {"margin_h_m", metresOrNull(c.margin_h_m)},
+                                             {"margin_v_m", metresOrNull(c.margin_v_m)},
+                                             {"segment", c.index}};
+    } else {
+      near.push_back({{"level", geofence::levelName(c.level)},
+                      {"subject", c.subject},
+                      {"verdict", geofence::verdictName(c.verdict)},
+                      {"clearance_m", metresOrNull(c.clearance_m.value_or(0.0))}});
+    }
+  }
+  j["levels"] = levels;
+  j["near"] = near;
+  j["route_version"] = f.route_version;
+  if (f.rerun) j["rerun"] = true;
+  if (!f.note.empty()) j["note"] = f.note;
+}
+
+json TrackEvent::toJson() const {
+  json j = body;
+  j["event"] = type;
+  if (!flight.empty()) j["flight"] = flight;
+  if (time) j["time"] = maps::formatRfc3339(*time, 3);
+  if (fix) to_json(j, *fix);
+  return j;
+}
+
+namespace {
+
+/// A JSON writer for the fix event: members in nlohmann's (sorted) order, numbers shortest
+/// round-trip (std::to_chars), ±∞ and NaN as null, strings escaped per RFC 8259 §7.
+class LineWriter {
+ public:
+  explicit LineWriter(std::string& out) : s_(out) {}
+  void key(const char* k) {
+    if (need_comma_) s_ += ',';
+    s_ += '"';
+    s_ += k;
+    s_ += "\":";
+    need_comma_ = false;
+  }
+  void open(char c) {
+    s_ += c;
+    need_comma_ = false;
+  }
+  void close(char c) {
+    s_ += c;
+    need_comma_ = true;
+  }
+  void item() {
+    if (need_comma_) s_ += ',';
+    need_comma_ = false;
+  }
+  void number(double v) {
+    if (!std::isfinite(v)) {
+      s_ += "null";
+    } else {
+      char buf[32];
+      const auto r = std::to_chars(buf, buf + sizeof buf, v);
+      s_.append(buf, r.ptr);
+    }
+    need_comma_ = true;
+  }
+  void integer(long long v) {
+    char buf[24];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    s_.append(buf, r.ptr);
+    need_comma_ = true;
+  }
+  void boolean(bool v) {
+    s_ += v ? "true" : "false";
+    need_comma_ = true;
+  }
+  void null() {
+    s_ += "null";
+    need_comma_ = true;
+  }
+  void string(std::string_view v) {
+    s_ += '"';
+    for (const char ch : v) {
+      const auto c = static_cast<unsigned char>(ch);
+      if (c == '"' || c == '\\') {
+        s_ += '\\';
+        s_ += ch;
+      } else if (c < 0x20) {
+        char buf[8];
+        std::snprintf(buf, sizeof buf, "\\u%04x", c);
+        s_ += buf;
+      } else {
+        s_ += ch;
+      }
+    }
+    s_ += '"';
+    need_comma_ = true;
+  }
+  void metres(double v) { number(std::isfinite(v) ? roundToMm(v) : v); }
+
+ private:
+  std::string& s_;
+  bool need_comma_ = false;
+};
+
+/// Whether the text is well-formed UTF-8 (RFC 3629 §4: no overlong forms, no surrogates, nothing
+/// above U+10FFFF), so it can be written as it is.
+bool validUtf8(std::string_view v) {
+  const auto at = [&v](std::size_t i) { return static_cast<unsigned char>(v[i]); };
+  std::size_t i = 0;
+  while (i < v.size()) {
+    const unsigned char c = at(i);
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    std::size_t n = 0;
+    unsigned char lo = 0x80, hi = 0xBF;  // the range of the second byte
+    if (c >= 0xC2 && c <= 0xDF) n = 1;
+    else if (c == 0xE0) n = 2, lo = 0xA0;
+    else if (c >= 0xE1 && c <= 0xEC) n = 2;
+    else if (c == 0xED) n = 2, hi = 0x9F;
+    else if (c >= 0xEE && c <= 0xEF) n = 2;
+    else if (c == 0xF0) n = 3, lo = 0x90;
+    else if (c >= 0xF1 && c <= 0xF3) n = 3;
+    else if (c == 0xF4) n = 3, hi = 0x8F;
+    else return false;
+    if (i + n >= v.size() || at(i + 1) < lo || at(i + 1) > hi) return false;
+    for (std::size_t k = 2; k <= n; ++k) {
+      if (at(i + k) < 0x80 || at(i + k) > 0xBF) return false;
+    }
+    i += n + 1;
+  }
+  return true;
+}
+
+}  // namespace
+
+namespace {
+
+/// The two box levels of a fix event, as the object "levels".
+void writeLevels(LineWriter& w, const FixRecord& f) {
+  w.key("levels");
+  w.open('{');
+  for (const geofence::Check& c : f.verdict.checks) {
+    if (!isBoxLevel(c)) continue;
+    w.key(geofence::levelName(c.level));
+    w.open('{');
+    w.key("margin_h_m");
+    w.metres(c.margin_h_m);
+    w.key("margin_v_m");
+    w.metres(c.margin_v_m);
+    w.key("segment");
+    w.integer(static_cast<long long>(c.index));
+    w.key("verdict");
+    w.string(geofence::verdictName(c.verdict));
+    w.close('}');
+  }
+  w.close('}');
+}
+
+/// The zones and obstacles near a fix, as the array "near".
+void writeNear(LineWriter& w, const FixRecord& f) {
+  w.key("near");
+  w.open('[');
+  for (const geofence::Check& c : f.verdict.checks) {
+    if (isBoxLevel(c)) continue;
+    w.item();
+    w.open('{');
+    w.key("clearance_m");
+    w.metres(c.clearance_m.value_or(0.0));
+    w.key("level");
+    w.string(geofence::levelName(c.level));
+    w.key("subject");
+    w.string(c.subject);
+    w.key("verdict");
+    w.string(geofence::verdictName(c.verdict));
+    w.close('}');
+  }
+  w.close(']');
+}
+
+/// The members from "event" to "lat" (nlohmann's sorted order).
+void writeFixHead(LineWriter& w, const TrackEvent& e, const FixRecord& f) {
+  w.key("event");
+  w.string(e.type);
+  if (!f.excluded.empty()) {
+    w.key("excluded");
+    w.open('[');
+    for (const integrity::SatId& s : f.excluded) {
+      w.item();
+      w.string(s.str());
+    }
+    w.close(']');
+  }
+  if (f.fault_detected) {
+    w.key("fault_detected");
+    w.boolean(*f.fault_detected);
+  }
+  if (!e.flight.empty()) {
+    w.key("flight");
+    w.string(e.flight);
+  }
+  w.key("h_ell_m");
+  w.number(roundToMm(f.h_ell_m));
+  w.key("hpl_m");
+  w.metres(f.hpl_m);
+  if (f.ins_degraded) {
+    w.key("ins_degraded");
+    w.boolean(*f.ins_degraded);
+  }
+  w.key("lat");
+  w.number(roundToDeg8(f.lat_rad));
+}
+
+/// The members from "line" to "vpl_m".
+void writeFixTail(LineWriter& w, const TrackEvent& e, const FixRecord& f) {
+  w.key("line");
+  w.integer(static_cast<long long>(f.line));
+  w.key("lon");
+  w.number(roundToDeg8(f.lon_rad));
+  writeNear(w, f);
+  if (!f.note.empty()) {
+    w.key("note");
+    w.string(f.note);
+  }
+  w.key("pl_source");
+  w.string(plSourceName(f.pl_source));
+  if (f.rerun) {
+    w.key("rerun");
+    w.boolean(true);
+  }
+  w.key("route_version");
+  w.integer(f.route_version);
+  if (e.time) {
+    w.key("time");
+    w.string(maps::formatRfc3339(*e.time, 3));
+  }
+  w.key("verdict");
+  w.string(geofence::verdictName(f.verdict.verdict));
+  w.key("violated");
+  if (f.verdict.violated) {
+    w.string(geofence::levelName(*f.verdict.violated));
+  } else {
+    w.null();
+  }
+  w.key("vpl_m");
+  w.metres(f.vpl_m);
+}
+
+}  // namespace
+
+std::string TrackEvent::jsonLine() const {
+  const bool plain = fix && validUtf8(flight) && validUtf8(fix->note) &&
+                     std::all_of(fix->verdict.checks.begin(), fix->verdict.checks.end(),
+                                 [](const geofence::Check& c) { return validUtf8(c.subject); });
+  if (!plain) return toJson().dump(-1, ' ', false, json::error_handler_t::replace);
+  std::string out;
+  out.reserve(512);
+  LineWriter w(out);
+  w.open('{');
+  writeFixHead(w, *this, *fix);
+  writeLevels(w, *fix);
+  writeFixTail(w, *this, *fix);
+  w.close('}');
+  return out;
+}
+
+}  // namespace skylane::planner

@@ -1,0 +1,151 @@
+#include "planner/tracking/tracking_session.hpp"
+
+#include "maps/text_file.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+
+namespace skylane::planner {
+
+TrackingSession::TrackingSession(TrackerOptions options, std::unique_ptr<TrackStore> store, int batch, Log log)
+    : tracker_(options), store_(std::move(store)), batch_(batch), log_(std::move(log)) {
+  if (batch_ < 1) throw std::invalid_argument("tracking session: the checkpoint batch must be ≥ 1 fix");
+  if (!log_) log_ = [](const std::string&) {};
+  if (store_) sinks_.push_back(store_.get());
+}
+
+void TrackingSession::resumeFlights() {
+  if (!store_) return;
+  for (const StoredFlight& f : store_->flights()) {
+    // The approval comes from the database (the report file may have gone); the mission must
+    // still be there, unchanged.
+    const std::string id = tracker_.addApproval(f.approval, f.report, f.id);
+    tracker_.restore(id, parseFlightState(f.state, store_->path() + ": flight " + id), f.route);
+    report_of_[id] = f.report;
+    log_("resumed flight " + id + " (" + std::to_string(tracker_.state(id).fixes) + " fixes so far, route version " +
+         std::to_string(tracker_.state(id).route_version) + ")");
+  }
+}
+
+std::string TrackingSession::addApprovalFile(const std::string& report_path, const std::string& id) {
+  const bool resumed = id.empty() ? std::any_of(report_of_.begin(), report_of_.end(),
+                                                [&](const auto& kv) {
+                                                  std::error_code ec;
+                                                  return kv.second == report_path ||
+                                                         std::filesystem::equivalent(kv.second, report_path, ec);
+                                                })
+                                  : report_of_.count(id) > 0;
+  if (resumed) return {};
+  const nlohmann::json report = maps::readJsonFile(report_path);
+  const std::string got = tracker_.addApproval(report, report_path, id);
+  report_of_[got] = report_path;
+  if (store_) {  // kept once; the checkpoints update the state and the route
+    store_->begin();
+    store_->putFlight({got, report_path, report, flightStateJson(tracker_.state(got)), tracker_.routeJson(got)});
+    store_->commit();
+  }
+  return got;
+}
+
+void TrackingSession::beginBatch() {
+  if (store_) store_->begin();
+}
+
+void TrackingSession::emit(const std::vector<TrackEvent>& events) {
+  for (const TrackEvent& e : events) {
+    // Quoted input may hold bytes that are not UTF-8: they are replaced, not fatal.
+    const std::string line = e.jsonLine();
+    for (EventSink* sink : sinks_) {
+      sink->write(e, line);
+      // A closed output (the reader of a pipe went away): stop as on a stop request, the batch saved.
+      if (sink->closed() && !summary_.output_closed) {
+        summary_.output_closed = true;
+        stop_ = true;
+      }
+    }
+    ++summary_.events;
+    if (e.is("rejected_input")) ++summary_.rejected;
+    if (e.is("fix")) ++summary_.accepted;
+    if (!e.flight.empty() && !e.is("rejected_input")) touched_.insert(e.flight);
+  }
+}
+
+void TrackingSession::checkpoint(bool force) {
+  if (!store_ || (!force && pending_ < batch_)) return;
+  for (const std::string& id : touched_) store_->putState(id, flightStateJson(tracker_.state(id)), tracker_.routeJson(id));
+  touched_.clear();
+  if (source_ && resumable_) store_->setInputLine(source_->name(), source_->checkpointLine());
+  store_->commit();
+  for (EventSink* sink : sinks_) {
+    if (sink != store_.get()) sink->flush();
+  }
+  pending_ = 0;
+}
+
+void TrackingSession::submit(const TrackFix& fix) {
+  beginBatch();
+  try {
+    emit(tracker_.process(fix));
+  } catch (const std::exception& e) {  // a fix the tracker cannot take never ends the stream
+    emit({tracker_.rejectedInput(fix.source, fix.line, e.what())});
+    log_("skipped " + fix.source + ": " + e.what());
+  }
+  ++pending_;
+  checkpoint(false);
+}
+
+void TrackingSession::reject(const std::string& where, std::size_t line, const std::string& why) {
+  beginBatch();
+  emit({tracker_.rejectedInput(where, line, why)});
+  log_("skipped " + where + ": " + why);
+  ++pending_;
+}
+
+void TrackingSession::sweepWhileQuiet(double quiet_s) {
+  // A quiet live input: stream time runs on with the wall clock for the stale check.
+  if (!tracker_.streamTime()) return;
+  beginBatch();
+  emit(tracker_.sweepStale(tracker_.streamTime()->plus(quiet_s)));
+  checkpoint(true);
+}
+
+void TrackingSession::finish() {
+  beginBatch();
+  if (tracker_.streamTime()) emit(tracker_.sweepStale(*tracker_.streamTime()));
+  checkpoint(true);
+  for (EventSink* sink : sinks_) sink->flush();
+}
+
+SessionSummary TrackingSession::run(FixSource& source) {
+  source_ = &source;
+  // A rereadable input (not stdin, a FIFO or UDP) resumes where the last committed batch left it.
+  resumable_ = store_ && source.rereadable();
+  const std::size_t resume_line = resumable_ ? store_->inputLine(source.name()) : 0;
+  if (resume_line > 0) {
+    source.resumeAfter(resume_line);
+    log_(source.name() + ": resuming after line " + std::to_string(resume_line));
+  }
+  constexpr int kIdlePollMs = 250;  // how often a quiet live input looks at the stop flag and the clock
+  auto last_wall = std::chrono::steady_clock::now();
+  while (!stop_) {
+    SourceRecord r = source.next(kIdlePollMs);
+    if (r.kind == SourceRecord::Kind::kEnd) break;
+    if (r.kind == SourceRecord::Kind::kIdle) {
+      if (source.live()) sweepWhileQuiet(std::chrono::duration<double>(std::chrono::steady_clock::now() - last_wall).count());
+      continue;
+    }
+    last_wall = std::chrono::steady_clock::now();
+    if (r.kind == SourceRecord::Kind::kBad) {
+      reject(r.where, r.line, r.error);
+    } else {
+      submit(r.fix);
+    }
+  }
+  summary_.stopped = stop_ && !summary_.output_closed;
+  finish();
+  source_ = nullptr;
+  return summary_;
+}
+
+}  // namespace skylane::planner

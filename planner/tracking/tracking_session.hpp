@@ -1,0 +1,97 @@
+#pragma once
+/// \file
+/// \brief The tracking engine as a service loop: a Tracker with its flights, an optional
+/// database (track_store.hpp) it resumes from and checkpoints into, any number of event sinks,
+/// and a fix source it runs until the source ends or a stop is requested. `skylane track` is
+/// option parsing plus this wiring; the HTTP service and the NATS workers wire their own sources
+/// and sinks to the same session.
+///
+/// Checkpoints: every `batch` fixes (and when a live input goes quiet, and at the end) the
+/// touched flights' states and routes and the source's checkpoint line are committed in one
+/// transaction with the batch's events, so a session killed at any moment and restarted on the
+/// same database and a rereadable input resumes every flight where the last committed batch left
+/// it (a fix of an uncommitted batch is processed again, none is lost).
+
+#include "planner/tracking/event_sink.hpp"
+#include "planner/tracking/fix_source.hpp"
+#include "planner/tracking/track_store.hpp"
+#include "planner/tracking/tracker.hpp"
+
+#include <atomic>
+#include <cstddef>
+#include <functional>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace skylane::planner {
+
+/// \brief What a run did.
+struct SessionSummary {
+  std::size_t accepted = 0;  ///< `fix` events
+  std::size_t rejected = 0;  ///< `rejected_input` events
+  std::size_t events = 0;
+  bool stopped = false;        ///< by requestStop()
+  bool output_closed = false;  ///< a sink's reader went away
+};
+
+/// \brief One tracking engine with its persistence and outputs.
+class TrackingSession {
+ public:
+  using Log = std::function<void(const std::string&)>;
+  /// \brief `store` may be null (no persistence); `log` gets one-line progress messages.
+  TrackingSession(TrackerOptions options, std::unique_ptr<TrackStore> store, int batch = 200, Log log = {});
+  TrackingSession(const TrackingSession&) = delete;
+  TrackingSession& operator=(const TrackingSession&) = delete;
+
+  /// \brief Takes back every flight the database holds (approval, state, current route).
+  void resumeFlights();
+  /// \brief Adds an approval report unless the database gave it back already (the same id, or,
+  /// without an id, the same report file); returns the flight id, or empty when resumed.
+  /// \throws maps::ParseError for a bad report or mission.
+  std::string addApprovalFile(const std::string& report_path, const std::string& id = {});
+  /// \brief Events go to `sink` too (not owned; it outlives the session's runs).
+  void addSink(EventSink& sink) { sinks_.push_back(&sink); }
+
+  /// \brief Processes `source` until it ends or a stop is requested, resuming a rereadable
+  /// input at the line the database stored; ends with a stale sweep and a checkpoint.
+  SessionSummary run(FixSource& source);
+  /// \brief Asks run() to stop after the record in hand (async-signal-safe).
+  void requestStop() noexcept { stop_.store(true); }
+  /// \brief The flag requestStop() sets (a signal handler may hold it).
+  [[nodiscard]] std::atomic<bool>& stopFlag() noexcept { return stop_; }
+
+  /// \brief One fix pushed by the caller (a service); `rejected_input` when it cannot be taken.
+  void submit(const TrackFix& fix);
+  /// \brief One record the caller could not read.
+  void reject(const std::string& where, std::size_t line, const std::string& why);
+  /// \brief The stale sweep at the stream time and a checkpoint (the end of a run).
+  void finish();
+
+  [[nodiscard]] Tracker& tracker() { return tracker_; }
+  [[nodiscard]] const Tracker& tracker() const { return tracker_; }
+  [[nodiscard]] const SessionSummary& summary() const { return summary_; }
+
+ private:
+  void emit(const std::vector<TrackEvent>& events);
+  void checkpoint(bool force);
+  void sweepWhileQuiet(double quiet_s);
+  void beginBatch();
+
+  Tracker tracker_;
+  std::unique_ptr<TrackStore> store_;
+  int batch_;
+  Log log_;
+  std::vector<EventSink*> sinks_;
+  std::map<std::string, std::string> report_of_;  ///< flight id → approval report file
+  std::set<std::string> touched_;                 ///< flights changed since the last checkpoint
+  int pending_ = 0;
+  FixSource* source_ = nullptr;  ///< the source being run (its checkpoint line)
+  bool resumable_ = false;
+  std::atomic<bool> stop_{false};
+  SessionSummary summary_;
+};
+
+}  // namespace skylane::planner
