@@ -214,8 +214,8 @@ struct PredictOptions {
   std::optional<double> ground_amsl_m;
 };
 
-void runPredict(const PredictOptions& o) {
-  const integrity::IntegrityMethod method = parseMethod(o.method);
+/// The request the options describe: place, time window, mask, error model, sky mask.
+integrity::PredictRequest predictRequest(const PredictOptions& o) {
   integrity::PredictRequest req;
   if (!(o.lat_deg >= -90 && o.lat_deg <= 90)) throw ParseError("--lat", 0, "--lat", std::to_string(o.lat_deg), "a latitude in [-90, 90] degrees");
   if (!(o.lon_deg >= -180 && o.lon_deg <= 360)) throw ParseError("--lon", 0, "--lon", std::to_string(o.lon_deg), "a longitude in degrees");
@@ -236,16 +236,55 @@ void runPredict(const PredictOptions& o) {
     const maps::Terrain ground = groundModel(o.terrain, o.ground_amsl_m);
     req.sky_mask = skyMaskAt(req.place, o.buildings, ground, !o.terrain.empty(), maps::SkyMaskOptions{});
   }
-  const integrity::OrbitSource orbits = loadOrbits(o.almanacs, o.navs);
-  const double age = orbits.almanacAge_s(req.start);
+  return req;
+}
+
+void warnIfAlmanacOld(const integrity::OrbitSource& orbits, const integrity::GpsTime& start) {
+  const double age = orbits.almanacAge_s(start);
   if (age > 4 * integrity::kSecondsPerWeek) {
     std::cerr << "skylane: warning: the almanac is " << std::lround(age / 86400) << " days from --start; "
               << "positions are extrapolated (use an almanac of the flight's week for real predictions)\n";
   }
-  Progress bar("predict", o.progress);
-  const auto samples = integrity::predictIntegrity(orbits, req, method, std::ref(bar));
-  const integrity::Requirements& limits = req.araim.requirements;
+}
 
+std::string predictCsvLine(const integrity::PredictSample& s, integrity::IntegrityMethod method) {
+  const bool ok = s.pl.pl_computed, ar = method == integrity::IntegrityMethod::kAraim;
+  char buf[320];
+  std::snprintf(buf, sizeof buf, "%s,%d,%.1f,%zu,%.3f,%.3f,%.3f,%.3f,%d,%.3f,%.3f,%d\n",
+                integrity::formatRfc3339(s.t).c_str(), s.t.week, s.t.sow, s.sats.size(), s.dops.hdop, s.dops.vdop,
+                ok ? s.pl.hpl_m : NAN, ok ? s.pl.vpl_m : NAN, s.pl.available ? 1 : 0, ok && ar ? s.pl.emt_m : NAN,
+                ok && ar ? s.pl.sigma_acc_m : NAN, s.pl.fault_modes);
+  return buf;
+}
+
+json predictJsonLine(const integrity::PredictSample& s, const std::string& method_name,
+                     integrity::IntegrityMethod method, bool has_sky_mask) {
+  std::vector<integrity::SatId> ids;
+  for (const auto& l : s.sats) ids.push_back(l.sat);
+  const bool ok = s.pl.pl_computed;
+  json j;
+  j["time"] = integrity::formatRfc3339(s.t);
+  j["method"] = method_name;
+  j["available"] = s.pl.available;
+  j["pl_computed"] = ok;
+  if (!s.pl.reason.empty()) j["reason"] = s.pl.reason;
+  j["hpl_m"] = ok ? r4(s.pl.hpl_m) : json(nullptr);
+  j["vpl_m"] = ok ? r4(s.pl.vpl_m) : json(nullptr);
+  if (method == integrity::IntegrityMethod::kAraim) {
+    j["emt_m"] = ok ? r4(s.pl.emt_m) : json(nullptr);
+    j["sigma_acc_m"] = ok ? r4(s.pl.sigma_acc_m) : json(nullptr);
+    j["fault_modes"] = s.pl.fault_modes;
+  }
+  j["hdop"] = r4(s.dops.hdop);
+  j["vdop"] = r4(s.dops.vdop);
+  j["satellites"] = satList(ids);
+  if (has_sky_mask) j["blocked_by_sky_mask"] = s.blocked;
+  return j;
+}
+
+/// The samples as CSV (with a header line) or JSON lines, to --output or stdout.
+void writePredictSamples(const std::vector<integrity::PredictSample>& samples, const PredictOptions& o,
+                         integrity::IntegrityMethod method, bool has_sky_mask) {
   const auto out_file = openOutput(o.output);
   std::ostream& out = out_file ? *out_file : std::cout;
   if (o.format == "csv") {
@@ -253,58 +292,47 @@ void runPredict(const PredictOptions& o) {
   }
   for (const auto& s : samples) {
     if (o.format == "csv") {
-      const bool ok = s.pl.pl_computed, ar = method == integrity::IntegrityMethod::kAraim;
-      char buf[320];
-      std::snprintf(buf, sizeof buf, "%s,%d,%.1f,%zu,%.3f,%.3f,%.3f,%.3f,%d,%.3f,%.3f,%d\n",
-                    integrity::formatRfc3339(s.t).c_str(), s.t.week, s.t.sow, s.sats.size(), s.dops.hdop, s.dops.vdop,
-                    ok ? s.pl.hpl_m : NAN, ok ? s.pl.vpl_m : NAN, s.pl.available ? 1 : 0, ok && ar ? s.pl.emt_m : NAN,
-                    ok && ar ? s.pl.sigma_acc_m : NAN, s.pl.fault_modes);
-      out << buf;
+      out << predictCsvLine(s, method);
     } else {
-      std::vector<integrity::SatId> ids;
-      for (const auto& l : s.sats) ids.push_back(l.sat);
-      const bool ok = s.pl.pl_computed;
-      json j;
-      j["time"] = integrity::formatRfc3339(s.t);
-      j["method"] = o.method;
-      j["available"] = s.pl.available;
-      j["pl_computed"] = ok;
-      if (!s.pl.reason.empty()) j["reason"] = s.pl.reason;
-      j["hpl_m"] = ok ? r4(s.pl.hpl_m) : json(nullptr);
-      j["vpl_m"] = ok ? r4(s.pl.vpl_m) : json(nullptr);
-      if (method == integrity::IntegrityMethod::kAraim) {
-        j["emt_m"] = ok ? r4(s.pl.emt_m) : json(nullptr);
-        j["sigma_acc_m"] = ok ? r4(s.pl.sigma_acc_m) : json(nullptr);
-        j["fault_modes"] = s.pl.fault_modes;
-      }
-      j["hdop"] = r4(s.dops.hdop);
-      j["vdop"] = r4(s.dops.vdop);
-      j["satellites"] = satList(ids);
-      if (req.sky_mask) j["blocked_by_sky_mask"] = s.blocked;
-      out << j.dump() << "\n";
+      out << predictJsonLine(s, o.method, method, has_sky_mask).dump() << "\n";
     }
   }
-  if (!o.plot.empty()) {
-    std::vector<double> x, hpl, vpl, hal, val, nsat;
-    for (const auto& s : samples) {
-      x.push_back(s.t - req.start);
-      hpl.push_back(s.pl.pl_computed ? s.pl.hpl_m : NAN);
-      vpl.push_back(s.pl.pl_computed ? s.pl.vpl_m : NAN);
-      hal.push_back(limits.hal_m);
-      val.push_back(limits.val_m);
-      nsat.push_back(static_cast<double>(s.sats.size()));
-    }
-    char title[200];
-    std::snprintf(title, sizeof title, "%s protection levels at %.4f°, %.4f°, %.0f m from %s", method == integrity::IntegrityMethod::kAraim ? "ARAIM" : "RAIM",
-                  o.lat_deg, o.lon_deg, o.alt_m, integrity::formatRfc3339(req.start).c_str());
-    const std::string svg = renderTimeSeriesSvg(
-        title, "time since start",
-        x,
-        {Panel{"protection level [m]",
-               {{"HPL", "#1f77b4", hpl}, {"VPL", "#d62728", vpl}, {"HAL", "#1f77b4", hal, true}, {"VAL", "#d62728", val, true}}},
-         Panel{"satellites in view", {{"satellites", "#2ca02c", nsat, false, true}}, 160}});
-    writeText(o.plot, svg, "--plot");
+}
+
+/// The --plot SVG: protection levels against the alert limits, and the satellites in view.
+void writePredictPlot(const std::vector<integrity::PredictSample>& samples, const integrity::PredictRequest& req,
+                      const PredictOptions& o, integrity::IntegrityMethod method) {
+  const integrity::Requirements& limits = req.araim.requirements;
+  std::vector<double> x, hpl, vpl, hal, val, nsat;
+  for (const auto& s : samples) {
+    x.push_back(s.t - req.start);
+    hpl.push_back(s.pl.pl_computed ? s.pl.hpl_m : NAN);
+    vpl.push_back(s.pl.pl_computed ? s.pl.vpl_m : NAN);
+    hal.push_back(limits.hal_m);
+    val.push_back(limits.val_m);
+    nsat.push_back(static_cast<double>(s.sats.size()));
   }
+  char title[200];
+  std::snprintf(title, sizeof title, "%s protection levels at %.4f°, %.4f°, %.0f m from %s", method == integrity::IntegrityMethod::kAraim ? "ARAIM" : "RAIM",
+                o.lat_deg, o.lon_deg, o.alt_m, integrity::formatRfc3339(req.start).c_str());
+  const std::string svg = renderTimeSeriesSvg(
+      title, "time since start",
+      x,
+      {Panel{"protection level [m]",
+             {{"HPL", "#1f77b4", hpl}, {"VPL", "#d62728", vpl}, {"HAL", "#1f77b4", hal, true}, {"VAL", "#d62728", val, true}}},
+       Panel{"satellites in view", {{"satellites", "#2ca02c", nsat, false, true}}, 160}});
+  writeText(o.plot, svg, "--plot");
+}
+
+void runPredict(const PredictOptions& o) {
+  const integrity::IntegrityMethod method = parseMethod(o.method);
+  const integrity::PredictRequest req = predictRequest(o);
+  const integrity::OrbitSource orbits = loadOrbits(o.almanacs, o.navs);
+  warnIfAlmanacOld(orbits, req.start);
+  Progress bar("predict", o.progress);
+  const auto samples = integrity::predictIntegrity(orbits, req, method, std::ref(bar));
+  writePredictSamples(samples, o, method, req.sky_mask.has_value());
+  if (!o.plot.empty()) writePredictPlot(samples, req, o, method);
 }
 
 // ---------------------------------------------------------------------------

@@ -218,16 +218,106 @@ std::string renderSkyPlotSvg(const std::string& title, const std::vector<double>
   return s.str();
 }
 
+namespace {
+
+/// A sequential palette (dark blue → yellow), indexed by log10(count) / log10(max count).
+const char* const kStanfordPalette[] = {"#30123b", "#4145ab", "#4675ed", "#39a2fc", "#1bcfd4",
+                                        "#24eca6", "#61fc6c", "#a4fc3b", "#d1e834", "#f3c63a", "#fe9b2d"};
+constexpr int kStanfordColours = 11;
+
+/// Where one Stanford panel sits: its top-left corner, side and the metres → pixels map.
+struct StanfordFrame {
+  double ox, oy, side;
+  double max_m;
+  double scale;  ///< px per metre
+  [[nodiscard]] double X(double v) const { return ox + std::min(v, max_m) * scale; }
+  [[nodiscard]] double Y(double v) const { return oy + side - std::min(v, max_m) * scale; }
+};
+
+/// The 2-D histogram: one cell per non-empty bin, coloured by its log count.
+void drawStanfordCounts(std::ostream& s, const StanfordPanel& p, const StanfordFrame& f) {
+  std::uint64_t peak = 0;
+  for (std::uint64_t c : p.counts) peak = std::max(peak, c);
+  const double cell = f.side / std::max(1, p.bins);
+  for (int r = 0; r < p.bins; ++r) {
+    for (int c = 0; c < p.bins; ++c) {
+      const std::uint64_t n = p.counts[static_cast<std::size_t>(r) * static_cast<std::size_t>(p.bins) + static_cast<std::size_t>(c)];
+      if (n == 0) continue;
+      const double fr = peak > 1 ? std::log10(static_cast<double>(n)) / std::log10(static_cast<double>(peak)) : 1.0;
+      const int idx = std::clamp(static_cast<int>(fr * (kStanfordColours - 1) + 0.5), 0, kStanfordColours - 1);
+      s << "<rect x=\"" << fmt(f.ox + c * cell) << "\" y=\"" << fmt(f.oy + f.side - (r + 1) * cell) << "\" width=\""
+        << fmt(cell + 0.3) << "\" height=\"" << fmt(cell + 0.3) << "\" fill=\"" << kStanfordPalette[idx] << "\"/>\n";
+    }
+  }
+}
+
+/// Regions: diagonal error = PL, alert limit on both axes, and their names.
+void drawStanfordRegions(std::ostream& s, const StanfordPanel& p, const StanfordFrame& f) {
+  const double al = p.alert_limit_m;
+  s << "<line x1=\"" << f.X(0) << "\" y1=\"" << f.Y(0) << "\" x2=\"" << f.X(p.max_m) << "\" y2=\"" << f.Y(p.max_m)
+    << "\" stroke=\"black\"/>\n";
+  s << "<line x1=\"" << f.X(al) << "\" y1=\"" << f.Y(0) << "\" x2=\"" << f.X(al) << "\" y2=\"" << f.Y(p.max_m)
+    << "\" stroke=\"#c00000\" stroke-dasharray=\"5,3\"/>\n";
+  s << "<line x1=\"" << f.X(0) << "\" y1=\"" << f.Y(al) << "\" x2=\"" << f.X(p.max_m) << "\" y2=\"" << f.Y(al)
+    << "\" stroke=\"#c00000\" stroke-dasharray=\"5,3\"/>\n";
+  auto label = [&](double ex, double pl, const char* text) {
+    s << "<text x=\"" << fmt(f.X(ex)) << "\" y=\"" << fmt(f.Y(pl)) << "\" text-anchor=\"middle\" fill=\"#303030\">"
+      << text << "</text>\n";
+  };
+  label(al * 0.3, al * 0.75, "Normal");
+  label(al * 0.75, al * 0.3, "MI");
+  label(al + (p.max_m - al) * 0.5, al * 0.5, "HMI");
+  label(al * 0.5, al + (p.max_m - al) * 0.6, "Unavailable");
+}
+
+/// Axis ticks and labels, and the panel's footer lines.
+void drawStanfordAxes(std::ostream& s, const StanfordPanel& p, const StanfordFrame& f) {
+  const double step = niceStep(p.max_m, 5);
+  for (double v = 0; v <= p.max_m + 1e-9; v += step) {
+    s << "<text x=\"" << fmt(f.X(v)) << "\" y=\"" << f.oy + f.side + 15 << "\" text-anchor=\"middle\">" << fmt(v) << "</text>\n";
+    s << "<text x=\"" << f.ox - 6 << "\" y=\"" << fmt(f.Y(v) + 4) << "\" text-anchor=\"end\">" << fmt(v) << "</text>\n";
+  }
+  s << "<text x=\"" << f.ox + f.side / 2 << "\" y=\"" << f.oy + f.side + 32 << "\" text-anchor=\"middle\">"
+    << escape(p.error_label) << "</text>\n";
+  s << "<text transform=\"translate(" << f.ox - 42 << "," << f.oy + f.side / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
+    << escape(p.pl_label) << "</text>\n";
+  double fy = f.oy + f.side + 52;
+  for (const std::string& line : p.footer) {
+    s << "<text x=\"" << f.ox << "\" y=\"" << fy << "\" font-size=\"11\">" << escape(line) << "</text>\n";
+    fy += 15;
+  }
+}
+
+void drawStanfordPanel(std::ostream& s, const StanfordPanel& p, const StanfordFrame& f) {
+  s << "<text x=\"" << f.ox + f.side / 2 << "\" y=\"" << f.oy - 10 << "\" text-anchor=\"middle\" font-size=\"13\">"
+    << escape(p.title) << "</text>\n";
+  s << "<rect x=\"" << f.ox << "\" y=\"" << f.oy << "\" width=\"" << f.side << "\" height=\"" << f.side
+    << "\" fill=\"#f4f4f4\" stroke=\"black\"/>\n";
+  drawStanfordCounts(s, p, f);
+  drawStanfordRegions(s, p, f);
+  drawStanfordAxes(s, p, f);
+}
+
+/// The colour scale at x = lx, from the top of the panels down.
+void drawStanfordColourScale(std::ostream& s, double lx, double top) {
+  s << "<text x=\"" << lx << "\" y=\"" << top - 8 << "\">epochs</text>\n";
+  for (int i = 0; i < kStanfordColours; ++i) {
+    s << "<rect x=\"" << lx << "\" y=\"" << top + (kStanfordColours - 1 - i) * 18 << "\" width=\"16\" height=\"18\" fill=\""
+      << kStanfordPalette[i] << "\"/>\n";
+  }
+  s << "<text x=\"" << lx + 20 << "\" y=\"" << top + 12 << "\">max</text>\n";
+  s << "<text x=\"" << lx + 20 << "\" y=\"" << top + kStanfordColours * 18 - 4 << "\">1</text>\n";
+  s << "<text x=\"" << lx << "\" y=\"" << top + kStanfordColours * 18 + 16 << "\" font-size=\"10\">log scale</text>\n";
+}
+
+}  // namespace
+
 std::string renderStanfordSvg(const std::string& title, const std::vector<StanfordPanel>& panels) {
   const double side = 330, left = 70, top = 60, gap_x = 110, gap_y = 150, legend = 80;
   const int columns = panels.size() > 1 ? 2 : 1;
   const int rows = static_cast<int>((panels.size() + 1) / 2);
   const double width = left + columns * (side + gap_x) + legend;
   const double height = top + rows * (side + gap_y);
-  // A sequential palette (dark blue → yellow), indexed by log10(count) / log10(max count).
-  static const char* const kPalette[] = {"#30123b", "#4145ab", "#4675ed", "#39a2fc", "#1bcfd4",
-                                         "#24eca6", "#61fc6c", "#a4fc3b", "#d1e834", "#f3c63a", "#fe9b2d"};
-  constexpr int kColours = 11;
   std::ostringstream s;
   s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
     << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
@@ -236,154 +326,142 @@ std::string renderStanfordSvg(const std::string& title, const std::vector<Stanfo
     const StanfordPanel& p = panels[k];
     const double ox = left + static_cast<double>(k % 2) * (side + gap_x);
     const double oy = top + static_cast<double>(k / 2) * (side + gap_y);
-    const double scale = side / p.max_m;
-    auto X = [&](double v) { return ox + std::min(v, p.max_m) * scale; };
-    auto Y = [&](double v) { return oy + side - std::min(v, p.max_m) * scale; };
-    s << "<text x=\"" << ox + side / 2 << "\" y=\"" << oy - 10 << "\" text-anchor=\"middle\" font-size=\"13\">"
-      << escape(p.title) << "</text>\n";
-    s << "<rect x=\"" << ox << "\" y=\"" << oy << "\" width=\"" << side << "\" height=\"" << side
-      << "\" fill=\"#f4f4f4\" stroke=\"black\"/>\n";
-    std::uint64_t peak = 0;
-    for (std::uint64_t c : p.counts) peak = std::max(peak, c);
-    const double cell = side / std::max(1, p.bins);
-    for (int r = 0; r < p.bins; ++r) {
-      for (int c = 0; c < p.bins; ++c) {
-        const std::uint64_t n = p.counts[static_cast<std::size_t>(r) * static_cast<std::size_t>(p.bins) + static_cast<std::size_t>(c)];
-        if (n == 0) continue;
-        const double f = peak > 1 ? std::log10(static_cast<double>(n)) / std::log10(static_cast<double>(peak)) : 1.0;
-        const int idx = std::clamp(static_cast<int>(f * (kColours - 1) + 0.5), 0, kColours - 1);
-        s << "<rect x=\"" << fmt(ox + c * cell) << "\" y=\"" << fmt(oy + side - (r + 1) * cell) << "\" width=\""
-          << fmt(cell + 0.3) << "\" height=\"" << fmt(cell + 0.3) << "\" fill=\"" << kPalette[idx] << "\"/>\n";
-      }
-    }
-    // Regions: diagonal error = PL, alert limit on both axes.
-    const double al = p.alert_limit_m;
-    s << "<line x1=\"" << X(0) << "\" y1=\"" << Y(0) << "\" x2=\"" << X(p.max_m) << "\" y2=\"" << Y(p.max_m)
-      << "\" stroke=\"black\"/>\n";
-    s << "<line x1=\"" << X(al) << "\" y1=\"" << Y(0) << "\" x2=\"" << X(al) << "\" y2=\"" << Y(p.max_m)
-      << "\" stroke=\"#c00000\" stroke-dasharray=\"5,3\"/>\n";
-    s << "<line x1=\"" << X(0) << "\" y1=\"" << Y(al) << "\" x2=\"" << X(p.max_m) << "\" y2=\"" << Y(al)
-      << "\" stroke=\"#c00000\" stroke-dasharray=\"5,3\"/>\n";
-    auto label = [&](double ex, double pl, const char* text) {
-      s << "<text x=\"" << fmt(X(ex)) << "\" y=\"" << fmt(Y(pl)) << "\" text-anchor=\"middle\" fill=\"#303030\">"
-        << text << "</text>\n";
-    };
-    label(al * 0.3, al * 0.75, "Normal");
-    label(al * 0.75, al * 0.3, "MI");
-    label(al + (p.max_m - al) * 0.5, al * 0.5, "HMI");
-    label(al * 0.5, al + (p.max_m - al) * 0.6, "Unavailable");
-    // Axes.
-    const double step = niceStep(p.max_m, 5);
-    for (double v = 0; v <= p.max_m + 1e-9; v += step) {
-      s << "<text x=\"" << fmt(X(v)) << "\" y=\"" << oy + side + 15 << "\" text-anchor=\"middle\">" << fmt(v) << "</text>\n";
-      s << "<text x=\"" << ox - 6 << "\" y=\"" << fmt(Y(v) + 4) << "\" text-anchor=\"end\">" << fmt(v) << "</text>\n";
-    }
-    s << "<text x=\"" << ox + side / 2 << "\" y=\"" << oy + side + 32 << "\" text-anchor=\"middle\">"
-      << escape(p.error_label) << "</text>\n";
-    s << "<text transform=\"translate(" << ox - 42 << "," << oy + side / 2 << ") rotate(-90)\" text-anchor=\"middle\">"
-      << escape(p.pl_label) << "</text>\n";
-    double fy = oy + side + 52;
-    for (const std::string& line : p.footer) {
-      s << "<text x=\"" << ox << "\" y=\"" << fy << "\" font-size=\"11\">" << escape(line) << "</text>\n";
-      fy += 15;
-    }
+    drawStanfordPanel(s, p, StanfordFrame{ox, oy, side, p.max_m, side / p.max_m});
   }
-  // Colour scale.
-  const double lx = width - legend + 20;
-  s << "<text x=\"" << lx << "\" y=\"" << top - 8 << "\">epochs</text>\n";
-  for (int i = 0; i < kColours; ++i) {
-    s << "<rect x=\"" << lx << "\" y=\"" << top + (kColours - 1 - i) * 18 << "\" width=\"16\" height=\"18\" fill=\""
-      << kPalette[i] << "\"/>\n";
-  }
-  s << "<text x=\"" << lx + 20 << "\" y=\"" << top + 12 << "\">max</text>\n";
-  s << "<text x=\"" << lx + 20 << "\" y=\"" << top + kColours * 18 - 4 << "\">1</text>\n";
-  s << "<text x=\"" << lx << "\" y=\"" << top + kColours * 18 + 16 << "\" font-size=\"10\">log scale</text>\n";
+  drawStanfordColourScale(s, width - legend + 20, top);
   s << "</svg>\n";
   return s.str();
 }
 
-std::string renderPlanMapSvg(const std::string& title, const std::vector<MapShape>& shapes,
-                             const std::vector<MapLine>& lines, const std::vector<MapMarker>& markers, double margin_m,
-                             const std::vector<std::string>& footer) {
-  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
-  auto grow = [&](double x, double y) {
+namespace {
+
+/// The plan map's view: the data's box grown by the margin, and metres → pixels.
+struct MapView {
+  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;  ///< the box [m]
+  double left = 20, top = 50;                               ///< the plot's corner [px]
+  double scale = 1.0;                                       ///< px per metre
+  double w = 0.0, h = 0.0;                                  ///< the plot's size [px]
+
+  void grow(double x, double y) {
     x0 = std::min(x0, x);
     x1 = std::max(x1, x);
     y0 = std::min(y0, y);
     y1 = std::max(y1, y);
-  };
-  for (const MapLine& l : lines) {
-    for (const auto& [x, y] : l.xy) grow(x, y);
   }
-  for (const MapMarker& m : markers) grow(m.x, m.y);
-  if (x0 > x1) grow(0, 0);
-  x0 -= margin_m;
-  x1 += margin_m;
-  y0 -= margin_m;
-  y1 += margin_m;
-  const double plot = 720, left = 20, top = 50, legend_w = 240;
-  const double scale = plot / std::max(x1 - x0, y1 - y0);
-  const double w = (x1 - x0) * scale, h = (y1 - y0) * scale;
-  const double width = left + w + legend_w, height = top + h + 40 + 16.0 * static_cast<double>(footer.size());
-  auto X = [&](double x) { return left + (x - x0) * scale; };
-  auto Y = [&](double y) { return top + (y1 - y) * scale; };
+  [[nodiscard]] double X(double x) const { return left + (x - x0) * scale; }
+  [[nodiscard]] double Y(double y) const { return top + (y1 - y) * scale; }
+};
+
+/// The box of the lines and markers (the origin when there are none), grown by margin_m and
+/// fitted into a square plot of `plot` pixels.
+MapView mapView(const std::vector<MapLine>& lines, const std::vector<MapMarker>& markers, double margin_m, double plot) {
+  MapView v;
+  for (const MapLine& l : lines) {
+    for (const auto& [x, y] : l.xy) v.grow(x, y);
+  }
+  for (const MapMarker& m : markers) v.grow(m.x, m.y);
+  if (v.x0 > v.x1) v.grow(0, 0);
+  v.x0 -= margin_m;
+  v.x1 += margin_m;
+  v.y0 -= margin_m;
+  v.y1 += margin_m;
+  v.scale = plot / std::max(v.x1 - v.x0, v.y1 - v.y0);
+  v.w = (v.x1 - v.x0) * v.scale;
+  v.h = (v.y1 - v.y0) * v.scale;
+  return v;
+}
+
+/// Legend entries in order of first appearance: text, svg swatch.
+using MapLegend = std::vector<std::pair<std::string, std::string>>;
+
+void remember(MapLegend& legend, const std::string& text, const std::string& swatch) {
+  if (text.empty()) return;
+  for (const auto& l : legend) {
+    if (l.first == text) return;
+  }
+  legend.emplace_back(text, swatch);
+}
+
+void drawMapShapes(std::ostream& s, const MapView& v, const std::vector<MapShape>& shapes, MapLegend& legend) {
+  for (const MapShape& sh : shapes) {
+    if (sh.xy.size() < 2) continue;
+    s << "<polygon points=\"";
+    for (const auto& [x, y] : sh.xy) s << fmt(v.X(x)) << "," << fmt(v.Y(y)) << " ";
+    s << "\" fill=\"" << sh.fill << "\" fill-opacity=\"" << sh.fill_opacity << "\" stroke=\"" << sh.stroke << "\""
+      << (sh.dashed ? " stroke-dasharray=\"5,3\"" : "") << "/>\n";
+    remember(legend, sh.legend, "<rect width=\"16\" height=\"12\" fill=\"" + sh.fill + "\" fill-opacity=\"" +
+                                    std::to_string(sh.fill_opacity) + "\" stroke=\"" + sh.stroke + "\"/>");
+  }
+}
+
+void drawMapLines(std::ostream& s, const MapView& v, const std::vector<MapLine>& lines, MapLegend& legend) {
+  for (const MapLine& l : lines) {
+    s << "<polyline fill=\"none\" stroke=\"" << l.stroke << "\" stroke-width=\"" << l.width_px << "\" points=\"";
+    for (const auto& [x, y] : l.xy) s << fmt(v.X(x)) << "," << fmt(v.Y(y)) << " ";
+    s << "\"/>\n";
+    remember(legend, l.legend, "<line x1=\"0\" y1=\"6\" x2=\"16\" y2=\"6\" stroke=\"" + l.stroke + "\" stroke-width=\"" +
+                                   fmt(l.width_px) + "\"/>");
+  }
+}
+
+void drawMapMarkers(std::ostream& s, const MapView& v, const std::vector<MapMarker>& markers) {
+  for (const MapMarker& m : markers) {
+    s << "<circle cx=\"" << fmt(v.X(m.x)) << "\" cy=\"" << fmt(v.Y(m.y)) << "\" r=\"5\" fill=\"" << m.colour << "\"/>\n";
+    s << "<text x=\"" << fmt(v.X(m.x) + 8) << "\" y=\"" << fmt(v.Y(m.y) - 6) << "\">" << escape(m.label) << "</text>\n";
+  }
+}
+
+/// Scale bar (a nice length near a fifth of the view) and north arrow.
+void drawScaleBarAndNorth(std::ostream& s, const MapView& v) {
+  const double bar_m = niceStep((v.x1 - v.x0) / 5.0 * 2.0, 2);
+  const double bx = v.left + 12, by = v.top + v.h - 14;
+  s << "<line x1=\"" << fmt(bx) << "\" y1=\"" << fmt(by) << "\" x2=\"" << fmt(bx + bar_m * v.scale) << "\" y2=\"" << fmt(by)
+    << "\" stroke=\"black\" stroke-width=\"3\"/>\n<text x=\"" << fmt(bx) << "\" y=\"" << fmt(by - 6) << "\">" << fmt(bar_m)
+    << " m</text>\n";
+  const double nx = v.left + v.w - 24, ny = v.top + 16;
+  s << "<path d=\"M" << fmt(nx) << "," << fmt(ny - 10) << " l7,20 l-7,-5 l-7,5 z\" fill=\"black\"/><text x=\"" << fmt(nx)
+    << "\" y=\"" << fmt(ny + 24) << "\" text-anchor=\"middle\">N</text>\n";
+}
+
+/// The legend right of the map and the footer lines below it.
+void drawMapLegendAndFooter(std::ostream& s, const MapView& v, const MapLegend& legend,
+                            const std::vector<std::string>& footer) {
+  double ly = v.top + 10;
+  for (const auto& [text, swatch] : legend) {
+    s << "<g transform=\"translate(" << fmt(v.left + v.w + 14) << "," << fmt(ly) << ")\">" << swatch << "<text x=\"22\" y=\"11\">"
+      << escape(text) << "</text></g>\n";
+    ly += 20;
+  }
+  double fy = v.top + v.h + 22;
+  for (const std::string& line : footer) {
+    s << "<text x=\"" << fmt(v.left) << "\" y=\"" << fmt(fy) << "\" font-size=\"11\">" << escape(line) << "</text>\n";
+    fy += 16;
+  }
+}
+
+}  // namespace
+
+std::string renderPlanMapSvg(const std::string& title, const std::vector<MapShape>& shapes,
+                             const std::vector<MapLine>& lines, const std::vector<MapMarker>& markers, double margin_m,
+                             const std::vector<std::string>& footer) {
+  const double plot = 720, legend_w = 240;
+  const MapView v = mapView(lines, markers, margin_m, plot);
+  const double width = v.left + v.w + legend_w, height = v.top + v.h + 40 + 16.0 * static_cast<double>(footer.size());
   std::ostringstream s;
   s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << fmt(width) << "\" height=\"" << fmt(height)
     << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   s << "<text x=\"" << fmt(width / 2) << "\" y=\"26\" text-anchor=\"middle\" font-size=\"15\">" << escape(title) << "</text>\n";
-  s << "<defs><clipPath id=\"view\"><rect x=\"" << fmt(left) << "\" y=\"" << fmt(top) << "\" width=\"" << fmt(w)
-    << "\" height=\"" << fmt(h) << "\"/></clipPath></defs>\n";
-  s << "<rect x=\"" << fmt(left) << "\" y=\"" << fmt(top) << "\" width=\"" << fmt(w) << "\" height=\"" << fmt(h)
+  s << "<defs><clipPath id=\"view\"><rect x=\"" << fmt(v.left) << "\" y=\"" << fmt(v.top) << "\" width=\"" << fmt(v.w)
+    << "\" height=\"" << fmt(v.h) << "\"/></clipPath></defs>\n";
+  s << "<rect x=\"" << fmt(v.left) << "\" y=\"" << fmt(v.top) << "\" width=\"" << fmt(v.w) << "\" height=\"" << fmt(v.h)
     << "\" fill=\"#fbfbf8\" stroke=\"#999\"/>\n<g clip-path=\"url(#view)\">\n";
-  std::vector<std::pair<std::string, std::string>> legend;  // text, svg swatch
-  auto remember = [&legend](const std::string& text, const std::string& swatch) {
-    if (text.empty()) return;
-    for (const auto& l : legend) {
-      if (l.first == text) return;
-    }
-    legend.emplace_back(text, swatch);
-  };
-  for (const MapShape& sh : shapes) {
-    if (sh.xy.size() < 2) continue;
-    s << "<polygon points=\"";
-    for (const auto& [x, y] : sh.xy) s << fmt(X(x)) << "," << fmt(Y(y)) << " ";
-    s << "\" fill=\"" << sh.fill << "\" fill-opacity=\"" << sh.fill_opacity << "\" stroke=\"" << sh.stroke << "\""
-      << (sh.dashed ? " stroke-dasharray=\"5,3\"" : "") << "/>\n";
-    remember(sh.legend, "<rect width=\"16\" height=\"12\" fill=\"" + sh.fill + "\" fill-opacity=\"" +
-                            std::to_string(sh.fill_opacity) + "\" stroke=\"" + sh.stroke + "\"/>");
-  }
-  for (const MapLine& l : lines) {
-    s << "<polyline fill=\"none\" stroke=\"" << l.stroke << "\" stroke-width=\"" << l.width_px << "\" points=\"";
-    for (const auto& [x, y] : l.xy) s << fmt(X(x)) << "," << fmt(Y(y)) << " ";
-    s << "\"/>\n";
-    remember(l.legend, "<line x1=\"0\" y1=\"6\" x2=\"16\" y2=\"6\" stroke=\"" + l.stroke + "\" stroke-width=\"" +
-                           fmt(l.width_px) + "\"/>");
-  }
+  MapLegend legend;
+  drawMapShapes(s, v, shapes, legend);
+  drawMapLines(s, v, lines, legend);
   s << "</g>\n";
-  for (const MapMarker& m : markers) {
-    s << "<circle cx=\"" << fmt(X(m.x)) << "\" cy=\"" << fmt(Y(m.y)) << "\" r=\"5\" fill=\"" << m.colour << "\"/>\n";
-    s << "<text x=\"" << fmt(X(m.x) + 8) << "\" y=\"" << fmt(Y(m.y) - 6) << "\">" << escape(m.label) << "</text>\n";
-  }
-  // Scale bar (a nice length near a fifth of the view) and north arrow.
-  const double bar_m = niceStep((x1 - x0) / 5.0 * 2.0, 2);
-  const double bx = left + 12, by = top + h - 14;
-  s << "<line x1=\"" << fmt(bx) << "\" y1=\"" << fmt(by) << "\" x2=\"" << fmt(bx + bar_m * scale) << "\" y2=\"" << fmt(by)
-    << "\" stroke=\"black\" stroke-width=\"3\"/>\n<text x=\"" << fmt(bx) << "\" y=\"" << fmt(by - 6) << "\">" << fmt(bar_m)
-    << " m</text>\n";
-  const double nx = left + w - 24, ny = top + 16;
-  s << "<path d=\"M" << fmt(nx) << "," << fmt(ny - 10) << " l7,20 l-7,-5 l-7,5 z\" fill=\"black\"/><text x=\"" << fmt(nx)
-    << "\" y=\"" << fmt(ny + 24) << "\" text-anchor=\"middle\">N</text>\n";
-  double ly = top + 10;
-  for (const auto& [text, swatch] : legend) {
-    s << "<g transform=\"translate(" << fmt(left + w + 14) << "," << fmt(ly) << ")\">" << swatch << "<text x=\"22\" y=\"11\">"
-      << escape(text) << "</text></g>\n";
-    ly += 20;
-  }
-  double fy = top + h + 22;
-  for (const std::string& line : footer) {
-    s << "<text x=\"" << fmt(left) << "\" y=\"" << fmt(fy) << "\" font-size=\"11\">" << escape(line) << "</text>\n";
-    fy += 16;
-  }
+  drawMapMarkers(s, v, markers);
+  drawScaleBarAndNorth(s, v);
+  drawMapLegendAndFooter(s, v, legend, footer);
   s << "</svg>\n";
   return s.str();
 }

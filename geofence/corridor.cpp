@@ -76,6 +76,100 @@ std::pair<double, double> pieceMargins(const PieceAt& p, double reach_m, double 
   return {h, v};
 }
 
+/// The margins of one protection volume (height z ± vpl) against the corridor's pieces (alert
+/// limits hal, val), capped by the operating limits' margin.
+struct MarginField {
+  const std::vector<Eigen::Vector3d>& path;
+  double z, vpl, hal, val;
+  double operating_margin_m;
+
+  [[nodiscard]] std::size_t segmentCount() const { return path.size() - 1; }
+  [[nodiscard]] PieceAt piece(std::size_t i, const Eigen::Vector2d& x) const { return pieceAt(path[i], path[i + 1], x); }
+  [[nodiscard]] std::pair<double, double> marginsOf(const PieceAt& p, double reach_m) const {
+    auto [h, v] = pieceMargins(p, reach_m, z, vpl, hal, val);
+    return std::pair{h, std::min(v, operating_margin_m)};
+  }
+  /// f(q) with reach: max over the pieces of min(h, v) for every point within reach_m of q.
+  [[nodiscard]] double bound(const Eigen::Vector2d& q, double reach_m) const {
+    double f = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < segmentCount(); ++i) {
+      const auto [h, v] = marginsOf(piece(i, q), reach_m);
+      f = std::max(f, std::min(h, v));
+    }
+    return f;
+  }
+};
+
+/// One piece holding the whole volume: exact in the horizontal, the slope term in the
+/// vertical. Sets the best piece's segment and margins in `out`.
+struct BestPiece {
+  double margin_m = -std::numeric_limits<double>::infinity();  ///< min(h, v) of the best piece
+  std::size_t reached = 0;  ///< pieces whose alert limit the volume reaches
+};
+
+BestPiece bestSinglePiece(const MarginField& f, const Eigen::Vector2d& c2, double hpl, Containment& out) {
+  BestPiece best;
+  std::size_t segment = 0;
+  for (std::size_t i = 0; i < f.segmentCount(); ++i) {
+    const PieceAt p = f.piece(i, c2);
+    const auto [h, v] = f.marginsOf(p, hpl);
+    if (std::min(h, v) > best.margin_m) {
+      best.margin_m = std::min(h, v);
+      segment = i;
+      out.margin_h_m = h;
+      out.margin_v_m = v;
+    }
+    if (p.distance_m <= f.hal + hpl) ++best.reached;
+  }
+  out.segment = segment;
+  return best;
+}
+
+/// Bounds on the volume's margin in the union of the pieces: lower ≤ margin ≤ upper.
+struct UnionMargin {
+  double lower, upper;
+};
+
+/// A quadtree cell of the branch and bound: the lower bound on it, centre q, half side.
+struct BoundCell {
+  double lower;
+  Eigen::Vector2d q;
+  double half;
+  bool operator<(const BoundCell& o) const { return lower > o.lower; }  // smallest first
+};
+
+/// Across a joint: no single piece holds the disk (centre c2, radius hpl), but their union may.
+/// The volume's margin in the union is min over the disk of f(x) = max_k min(h_k(x), v_k(x))
+/// (the margins of the point x in piece k); it is bounded on a quadtree cell (centre q,
+/// circumradius ρ) from below by the same maximum with reach ρ (the bounds used above), and
+/// from above by f at any point of the disk. Best-first branch and bound narrows the two to
+/// `accuracy_m`.
+UnionMargin unionMargin(const MarginField& f, const Eigen::Vector2d& c2, double hpl, double accuracy_m) {
+  std::priority_queue<BoundCell> cells;
+  const double half0 = std::max(hpl, accuracy_m);
+  cells.push({f.bound(c2, half0 * std::sqrt(2.0)), c2, half0});
+  double upper = f.bound(c2, 0.0);  // f at the centre
+  double lower = upper;
+  for (int evaluations = 0; !cells.empty(); ++evaluations) {
+    const BoundCell cell = cells.top();
+    lower = cell.lower;
+    if (lower >= upper - accuracy_m || evaluations > 200000) break;
+    cells.pop();
+    // f at the cell's point nearest to its centre inside the disk tightens the upper bound.
+    const Eigen::Vector2d x = (cell.q - c2).norm() > hpl ? Eigen::Vector2d(c2 + hpl * (cell.q - c2).normalized()) : cell.q;
+    upper = std::min(upper, f.bound(x, 0.0));
+    const double half = cell.half / 2;
+    for (const Eigen::Vector2d& o : {Eigen::Vector2d(-1, -1), Eigen::Vector2d(1, -1), Eigen::Vector2d(1, 1), Eigen::Vector2d(-1, 1)}) {
+      const Eigen::Vector2d q = cell.q + o * half;
+      const double rho = half * std::sqrt(2.0);
+      if ((q - c2).norm() - rho > hpl) continue;  // misses the disk
+      cells.push({f.bound(q, rho), q, half});
+    }
+    if (cells.empty()) lower = upper;
+  }
+  return {lower, upper};
+}
+
 }  // namespace
 
 LevelLimits alertLimits(const Vehicle& vehicle, const BoxLevels& levels) {
@@ -164,84 +258,20 @@ Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_
   // The operating limits bound every piece.
   const double operating_margin_m =
       std::min(operating_.ceiling_h_ell_m - (c.z() + vpl), (c.z() - vpl) - operating_.floor_h_ell_m);
+  const MarginField field{path_, c.z(), vpl, hal, val, operating_margin_m};
+  const Eigen::Vector2d c2 = c.head<2>();
 
-  const auto piece = [&](std::size_t i, const Eigen::Vector2d& x) { return pieceAt(path_[i], path_[i + 1], x); };
-  const auto marginsOf = [&](const PieceAt& p, double reach_m) {
-    auto [h, v] = pieceMargins(p, reach_m, c.z(), vpl, hal, val);
-    return std::pair{h, std::min(v, operating_margin_m)};
-  };
-  const auto margins = [&](std::size_t i, const Eigen::Vector2d& x, double reach_m) {
-    return marginsOf(piece(i, x), reach_m);
-  };
-
-  // One piece holding the whole volume: exact in the horizontal, the slope term in the vertical.
-  std::size_t best = 0, reached = 0;
-  double best_m = -std::numeric_limits<double>::infinity();
   Containment out;
-  for (std::size_t i = 0; i < segmentCount(); ++i) {
-    const PieceAt p = piece(i, c.head<2>());
-    const auto [h, v] = marginsOf(p, hpl);
-    if (std::min(h, v) > best_m) {
-      best_m = std::min(h, v);
-      best = i;
-      out.margin_h_m = h;
-      out.margin_v_m = v;
-    }
-    if (p.distance_m <= hal + hpl) ++reached;
-  }
-  out.segment = best;
-  if (best_m < tolerance_m && reached >= 2) {
-    // Across a joint: no single piece holds the disk, but their union may. The volume's margin
-    // in the union is min over the disk of f(x) = max_k min(h_k(x), v_k(x)) (the margins of
-    // the point x in piece k); it is bounded on a quadtree cell (centre q, circumradius ρ) from
-    // below by the same maximum with reach ρ (the bounds used above), and from above by f at
-    // any point of the disk. Best-first branch and bound narrows the two to `accuracy`.
-    const double accuracy_m = std::max(tolerance_m, 1e-3 * hal);
-    const Eigen::Vector2d c2 = c.head<2>();
-    const auto bound = [&](const Eigen::Vector2d& q, double reach_m) {
-      double f = -std::numeric_limits<double>::infinity();
-      for (std::size_t i = 0; i < segmentCount(); ++i) {
-        const auto [h, v] = margins(i, q, reach_m);
-        f = std::max(f, std::min(h, v));
-      }
-      return f;
-    };
-    struct Cell {
-      double lower;
-      Eigen::Vector2d q;
-      double half;
-      bool operator<(const Cell& o) const { return lower > o.lower; }  // smallest first
-    };
-    std::priority_queue<Cell> cells;
-    const double half0 = std::max(hpl, accuracy_m);
-    cells.push({bound(c2, half0 * std::sqrt(2.0)), c2, half0});
-    double upper = bound(c2, 0.0);  // f at the centre
-    double lower = upper;
-    for (int evaluations = 0; !cells.empty(); ++evaluations) {
-      const Cell cell = cells.top();
-      lower = cell.lower;
-      if (lower >= upper - accuracy_m || evaluations > 200000) break;
-      cells.pop();
-      // f at the cell's point nearest to its centre inside the disk tightens the upper bound.
-      const Eigen::Vector2d x = (cell.q - c2).norm() > hpl ? Eigen::Vector2d(c2 + hpl * (cell.q - c2).normalized()) : cell.q;
-      upper = std::min(upper, bound(x, 0.0));
-      const double half = cell.half / 2;
-      for (const Eigen::Vector2d& o : {Eigen::Vector2d(-1, -1), Eigen::Vector2d(1, -1), Eigen::Vector2d(1, 1), Eigen::Vector2d(-1, 1)}) {
-        const Eigen::Vector2d q = cell.q + o * half;
-        const double rho = half * std::sqrt(2.0);
-        if ((q - c2).norm() - rho > hpl) continue;  // misses the disk
-        cells.push({bound(q, rho), q, half});
-      }
-      if (cells.empty()) lower = upper;
-    }
+  const BestPiece best = bestSinglePiece(field, c2, hpl, out);
+  if (best.margin_m < tolerance_m && best.reached >= 2) {
+    const UnionMargin u = unionMargin(field, c2, hpl, std::max(tolerance_m, 1e-3 * hal));
     // lower ≤ the union margin ≤ upper (a point of the volume has margin `upper`); report the
     // certified lower bound.
-    const double m = lower;
-    if (m > best_m) {
+    if (u.lower > best.margin_m) {
       out.across_joint = true;
-      out.margin_h_m = out.margin_v_m = m;
-      out.verdict = lower > tolerance_m ? Verdict::kInside
-                                        : (upper < -tolerance_m ? Verdict::kOutside : Verdict::kIndeterminate);
+      out.margin_h_m = out.margin_v_m = u.lower;
+      out.verdict = u.lower > tolerance_m ? Verdict::kInside
+                                          : (u.upper < -tolerance_m ? Verdict::kOutside : Verdict::kIndeterminate);
       return out;
     }
   }

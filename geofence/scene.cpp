@@ -167,6 +167,22 @@ struct QueryObjects {
   }
 };
 
+/// The query's own checks: a valid volume, a horizon ≥ 0, and heights inside the modelled band.
+void checkQuery(const ProtectionVolume& volume, double horizon_m) {
+  requireValid(volume);
+  const Eigen::Vector3d& p = volume.p_map;
+  if (!(std::isfinite(horizon_m) && horizon_m >= 0)) {
+    throw std::invalid_argument("clearance horizon must be a finite number of metres ≥ 0, got " + std::to_string(horizon_m));
+  }
+  if (p.z() - volume.vpl_m < kSceneFloor_h_ell_m || p.z() + volume.vpl_m > kSceneCeiling_h_ell_m) {
+    std::ostringstream s;
+    s << "protection volume " << p.z() - volume.vpl_m << " … " << p.z() + volume.vpl_m
+      << " m (ellipsoidal) reaches outside the modelled heights " << kSceneFloor_h_ell_m << " … "
+      << kSceneCeiling_h_ell_m << " m";
+    throw std::invalid_argument(s.str());
+  }
+}
+
 }  // namespace
 
 Separation separationMargins(const ProtectionVolume& volume, const airspace::PlanarPrism& piece) {
@@ -182,7 +198,126 @@ struct Scene::Impl {
   std::vector<ScenePiece> pieces;
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
   fcl::DynamicAABBTreeCollisionManagerd manager;
+
+  /// A piece and its separation from the query volume.
+  using Candidate = std::pair<std::size_t, Separation>;
+
+  /// Broad phase: the pieces whose AABBs meet `reach`'s, sorted owner by owner.
+  std::vector<std::size_t> candidates(fcl::CollisionObjectd& reach);
+  /// End of the run of candidates from `first` on that share its owner.
+  [[nodiscard]] std::size_t ownerEnd(const std::vector<std::size_t>& candidates, std::size_t first) const;
+  /// Narrow phase of piece i against the volume `body`, starting from its closed-form separation.
+  [[nodiscard]] Separation settle(std::size_t i, const fcl::CollisionObjectd& body, const ProtectionVolume& volume,
+                                  Separation s) const;
+  /// The hit (or the nearest miss) among one owner's candidates [begin, end); `group` is scratch.
+  [[nodiscard]] std::optional<SceneHit> ownerHit(const std::vector<std::size_t>& candidates, std::size_t begin,
+                                                 std::size_t end, const fcl::CollisionObjectd& body,
+                                                 const ProtectionVolume& volume, double horizon_m,
+                                                 std::vector<Candidate>& group) const;
 };
+
+std::vector<std::size_t> Scene::Impl::candidates(fcl::CollisionObjectd& reach) {
+  std::vector<std::size_t> found;
+  const auto collect = [](fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) -> bool {
+    const void* tag = o1->getUserData() ? o1->getUserData() : o2->getUserData();
+    if (tag) static_cast<std::vector<std::size_t>*>(data)->push_back(reinterpret_cast<std::size_t>(tag) - 1);
+    return false;  // never stop: every overlap is wanted (and nothing here throws)
+  };
+  manager.collide(&reach, &found, collect);
+  std::sort(found.begin(), found.end(), [&](std::size_t a, std::size_t b) {
+    const ScenePiece& pa = pieces[a];
+    const ScenePiece& pb = pieces[b];
+    return std::tie(pa.owner, pa.owner_index, a) < std::tie(pb.owner, pb.owner_index, b);
+  });
+  return found;
+}
+
+std::size_t Scene::Impl::ownerEnd(const std::vector<std::size_t>& found, std::size_t first) const {
+  const ScenePiece& owner = pieces[found[first]];
+  std::size_t last = first;
+  while (last < found.size() && pieces[found[last]].owner == owner.owner &&
+         pieces[found[last]].owner_index == owner.owner_index) {
+    ++last;
+  }
+  return last;
+}
+
+Separation Scene::Impl::settle(std::size_t i, const fcl::CollisionObjectd& body, const ProtectionVolume& volume,
+                               Separation s) const {
+  // FCL 0.7.0's two GJK solvers each stop metres off on some elongated pairs: libccd (its
+  // default) beside a piece kilometres tall (an unlimited ceiling), its own (GST_INDEP) for a
+  // thin tall volume (HPL ≪ VPL) — cases kept in tests/geofence/scene_test.cpp. So libccd
+  // goes first and the other is a second opinion; FCL's answer counts only where it agrees
+  // with the closed form, and the exact predicate settles the rest.
+  static const std::array<fcl::GJKSolverType, 2> kSolvers{fcl::GST_LIBCCD, fcl::GST_INDEP};
+  const airspace::PlanarPrism& prism = pieces[i].prism;
+  // FCL decides when its distance agrees with the closed form (Separation) to kExactBand_m and
+  // both are clear of contact by more than the band, or when it reports contact and the
+  // margins put the volume deep inside; anything else — contact, a near miss, a disagreement,
+  // a failure — goes to the exact predicate. The clearance reported is the closed form.
+  const double deciding_m = std::max(s.margin_h_m, s.margin_v_m);
+  for (const fcl::GJKSolverType solver : kSolvers) {
+    fcl::DistanceRequestd request;
+    request.gjk_solver_type = solver;
+    double d = 0.0;
+    try {
+      fcl::DistanceResultd result;
+      fcl::distance(&body, objects[i].get(), request, result);
+      d = result.min_distance;
+    } catch (const std::exception&) {
+      s.fcl_failed = true;  // FCL's GJK/EPA can throw near contact
+      continue;
+    }
+    s.fcl_distance_m = d;
+    if (d > kExactBand_m && deciding_m > kExactBand_m && std::abs(d - s.clearance_m) <= kExactBand_m) {
+      s.meets = false;
+      return s;
+    }
+    if (d <= 0 && deciding_m < -kExactBand_m) {
+      s.meets = true;
+      s.clearance_m = 0;
+      return s;
+    }
+    if (std::abs(deciding_m) <= kExactBand_m) break;  // near contact: no solver can settle it
+  }
+  s.exact = true;
+  s.meets = airspace::cylinderMeetsPrism(volume.p_map, volume.hpl_m, volume.vpl_m, prism);
+  s.clearance_m = s.meets ? 0.0 : std::hypot(std::max(s.margin_h_m, 0.0), std::max(s.margin_v_m, 0.0));
+  return s;
+}
+
+std::optional<SceneHit> Scene::Impl::ownerHit(const std::vector<std::size_t>& found, std::size_t begin,
+                                              std::size_t end, const fcl::CollisionObjectd& body,
+                                              const ProtectionVolume& volume, double horizon_m,
+                                              std::vector<Candidate>& group) const {
+  const ScenePiece& owner = pieces[found[begin]];
+  group.clear();
+  for (std::size_t k = begin; k < end; ++k) group.emplace_back(found[k], separationMargins(volume, pieces[found[k]].prism));
+  const auto deciding = [](const Separation& s) { return std::max(s.margin_h_m, s.margin_v_m); };
+  std::sort(group.begin(), group.end(), [&](const auto& a, const auto& b) { return deciding(a.second) < deciding(b.second); });
+  std::optional<SceneHit> hit;
+  std::size_t evaluated = 0;
+  for (; evaluated < group.size() && deciding(group[evaluated].second) <= kExactBand_m; ++evaluated) {
+    const Separation s = settle(group[evaluated].first, body, volume, group[evaluated].second);
+    if (s.meets) {
+      hit = SceneHit{owner.owner, owner.owner_index, group[evaluated].first, s};
+      break;
+    }
+    if (!hit || s.clearance_m < hit->separation.clearance_m) hit = SceneHit{owner.owner, owner.owner_index, group[evaluated].first, s};
+  }
+  if (!hit || !hit->separation.meets) {
+    // The nearest of the pieces not yet evaluated, when it may lie within the horizon.
+    const auto nearest = std::min_element(group.begin() + static_cast<std::ptrdiff_t>(std::min(evaluated, group.size())),
+                                          group.end(), [](const auto& a, const auto& b) {
+                                            return a.second.clearance_m < b.second.clearance_m;
+                                          });
+    if (nearest != group.end() && nearest->second.clearance_m <= horizon_m + kExactBand_m &&
+        (!hit || nearest->second.clearance_m < hit->separation.clearance_m)) {
+      hit = SceneHit{owner.owner, owner.owner_index, nearest->first, settle(nearest->first, body, volume, nearest->second)};
+    }
+  }
+  return hit;
+}
 
 Scene::Scene(std::vector<ScenePiece> pieces) : impl_(std::make_unique<Impl>()) {
   impl_->pieces = std::move(pieces);
@@ -210,121 +345,24 @@ const std::vector<ScenePiece>& Scene::pieces() const { return impl_->pieces; }
 
 std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizon_m,
                                    const std::function<bool(PieceOwner, std::size_t)>& accept) const {
-  requireValid(volume);
-  const Eigen::Vector3d& p = volume.p_map;
-  if (!(std::isfinite(horizon_m) && horizon_m >= 0)) {
-    throw std::invalid_argument("clearance horizon must be a finite number of metres ≥ 0, got " + std::to_string(horizon_m));
-  }
-  if (p.z() - volume.vpl_m < kSceneFloor_h_ell_m || p.z() + volume.vpl_m > kSceneCeiling_h_ell_m) {
-    std::ostringstream s;
-    s << "protection volume " << p.z() - volume.vpl_m << " … " << p.z() + volume.vpl_m
-      << " m (ellipsoidal) reaches outside the modelled heights " << kSceneFloor_h_ell_m << " … "
-      << kSceneCeiling_h_ell_m << " m";
-    throw std::invalid_argument(s.str());
-  }
-
+  checkQuery(volume, horizon_m);
   // Broad phase: the volume grown by the horizon, against the AABB tree. The query objects are
   // reused per thread (one allocation per thread, not per query); their AABBs are recomputed
   // after every change of size and place.
   thread_local QueryObjects q;
-  q.place(p, volume.hpl_m + horizon_m, volume.vpl_m + horizon_m, std::max(volume.hpl_m, kFclMinSize_m),
+  q.place(volume.p_map, volume.hpl_m + horizon_m, volume.vpl_m + horizon_m, std::max(volume.hpl_m, kFclMinSize_m),
           std::max(volume.vpl_m, kFclMinSize_m));
-  std::vector<std::size_t> candidates;
-  const auto collect = [](fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) -> bool {
-    const void* tag = o1->getUserData() ? o1->getUserData() : o2->getUserData();
-    if (tag) static_cast<std::vector<std::size_t>*>(data)->push_back(reinterpret_cast<std::size_t>(tag) - 1);
-    return false;  // never stop: every overlap is wanted (and nothing here throws)
-  };
-  impl_->manager.collide(&q.reach, &candidates, collect);
+  const std::vector<std::size_t> candidates = impl_->candidates(q.reach);
 
   // Narrow phase, owner by owner.
-  std::sort(candidates.begin(), candidates.end(), [&](std::size_t a, std::size_t b) {
-    const ScenePiece& pa = impl_->pieces[a];
-    const ScenePiece& pb = impl_->pieces[b];
-    return std::tie(pa.owner, pa.owner_index, a) < std::tie(pb.owner, pb.owner_index, b);
-  });
   std::vector<SceneHit> hits;
-  if (candidates.empty()) return hits;
-  // FCL 0.7.0's two GJK solvers each stop metres off on some elongated pairs: libccd (its
-  // default) beside a piece kilometres tall (an unlimited ceiling), its own (GST_INDEP) for a
-  // thin tall volume (HPL ≪ VPL) — cases kept in tests/geofence/scene_test.cpp. So libccd
-  // goes first and the other is a second opinion; FCL's answer counts only where it agrees
-  // with the closed form, and the exact predicate settles the rest.
-  static const std::array<fcl::GJKSolverType, 2> kSolvers{fcl::GST_LIBCCD, fcl::GST_INDEP};
-  const auto narrow = [&](std::size_t i, Separation s) {
-    const airspace::PlanarPrism& prism = impl_->pieces[i].prism;
-    // FCL decides when its distance agrees with the closed form (Separation) to kExactBand_m and
-    // both are clear of contact by more than the band, or when it reports contact and the
-    // margins put the volume deep inside; anything else — contact, a near miss, a disagreement,
-    // a failure — goes to the exact predicate. The clearance reported is the closed form.
-    const double deciding_m = std::max(s.margin_h_m, s.margin_v_m);
-    for (const fcl::GJKSolverType solver : kSolvers) {
-      fcl::DistanceRequestd request;
-      request.gjk_solver_type = solver;
-      double d = 0.0;
-      try {
-        fcl::DistanceResultd result;
-        fcl::distance(&q.body, impl_->objects[i].get(), request, result);
-        d = result.min_distance;
-      } catch (const std::exception&) {
-        s.fcl_failed = true;  // FCL's GJK/EPA can throw near contact
-        continue;
-      }
-      s.fcl_distance_m = d;
-      if (d > kExactBand_m && deciding_m > kExactBand_m && std::abs(d - s.clearance_m) <= kExactBand_m) {
-        s.meets = false;
-        return s;
-      }
-      if (d <= 0 && deciding_m < -kExactBand_m) {
-        s.meets = true;
-        s.clearance_m = 0;
-        return s;
-      }
-      if (std::abs(deciding_m) <= kExactBand_m) break;  // near contact: no solver can settle it
-    }
-    s.exact = true;
-    s.meets = airspace::cylinderMeetsPrism(p, volume.hpl_m, volume.vpl_m, prism);
-    s.clearance_m = s.meets ? 0.0 : std::hypot(std::max(s.margin_h_m, 0.0), std::max(s.margin_v_m, 0.0));
-    return s;
-  };
-  std::vector<std::pair<std::size_t, Separation>> group;
+  std::vector<Impl::Candidate> group;
   for (std::size_t first = 0; first < candidates.size();) {
     const ScenePiece& owner = impl_->pieces[candidates[first]];
-    std::size_t last = first;
-    while (last < candidates.size() && impl_->pieces[candidates[last]].owner == owner.owner &&
-           impl_->pieces[candidates[last]].owner_index == owner.owner_index) {
-      ++last;
-    }
     const std::size_t begin = first;
-    first = last;
+    first = impl_->ownerEnd(candidates, first);
     if (!accept(owner.owner, owner.owner_index)) continue;
-    group.clear();
-    for (std::size_t k = begin; k < last; ++k) {
-      group.emplace_back(candidates[k], separationMargins(volume, impl_->pieces[candidates[k]].prism));
-    }
-    const auto deciding = [](const Separation& s) { return std::max(s.margin_h_m, s.margin_v_m); };
-    std::sort(group.begin(), group.end(), [&](const auto& a, const auto& b) { return deciding(a.second) < deciding(b.second); });
-    std::optional<SceneHit> hit;
-    std::size_t evaluated = 0;
-    for (; evaluated < group.size() && deciding(group[evaluated].second) <= kExactBand_m; ++evaluated) {
-      const Separation s = narrow(group[evaluated].first, group[evaluated].second);
-      if (s.meets) {
-        hit = SceneHit{owner.owner, owner.owner_index, group[evaluated].first, s};
-        break;
-      }
-      if (!hit || s.clearance_m < hit->separation.clearance_m) hit = SceneHit{owner.owner, owner.owner_index, group[evaluated].first, s};
-    }
-    if (!hit || !hit->separation.meets) {
-      // The nearest of the pieces not yet evaluated, when it may lie within the horizon.
-      const auto nearest = std::min_element(group.begin() + static_cast<std::ptrdiff_t>(std::min(evaluated, group.size())),
-                                            group.end(), [](const auto& a, const auto& b) {
-                                              return a.second.clearance_m < b.second.clearance_m;
-                                            });
-      if (nearest != group.end() && nearest->second.clearance_m <= horizon_m + kExactBand_m &&
-          (!hit || nearest->second.clearance_m < hit->separation.clearance_m)) {
-        hit = SceneHit{owner.owner, owner.owner_index, nearest->first, narrow(nearest->first, nearest->second)};
-      }
-    }
+    const std::optional<SceneHit> hit = impl_->ownerHit(candidates, begin, first, q.body, volume, horizon_m, group);
     if (hit && (hit->separation.meets || hit->separation.clearance_m <= horizon_m)) hits.push_back(*hit);
   }
   return hits;

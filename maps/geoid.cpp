@@ -9,6 +9,7 @@
 #include <ogr_spatialref.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -35,6 +36,95 @@ constexpr double kPoleTol_deg = 1e-9;
 /// degree (to rounding); other angular units (grads, radians) are refused.
 constexpr double kDegreeUnitTol = 1e-9;
 
+/// The grid file, opened read-only, with at least one band.
+GDALDatasetUniquePtr openGrid(const std::string& path) {
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(),
+                                            GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR));
+  if (!ds) throw ParseError(path, 0, "grid", "unreadable (" + detail::gdalMessage("GDAL cannot open it") + ")", kExpectedGrid);
+  if (ds->GetRasterCount() < 1) throw ParseError(path, 0, "grid", "no raster band", kExpectedGrid);
+  return ds;
+}
+
+/// A grid's CRS, when it has one, must be geographic in degrees.
+void requireGeographicDegrees(GDALDataset& ds, const std::string& path) {
+  const OGRSpatialReference* srs = ds.GetSpatialRef();
+  if (srs == nullptr || srs->IsEmpty()) return;
+  const double unit_rad = srs->GetAngularUnits(nullptr);
+  if (!srs->IsGeographic() || std::abs(rad2deg(unit_rad) - 1.0) > kDegreeUnitTol) {
+    const char* name = srs->GetName();
+    throw ParseError(path, 0, "grid.crs", name != nullptr ? name : "not geographic",
+                     std::string("a geographic CRS in degrees; ") + kExpectedGrid);
+  }
+}
+
+/// The geotransform of an axis-aligned grid (GDAL layout).
+std::array<double, 6> axisAlignedGeoTransform(GDALDataset& ds, const std::string& path) {
+  std::array<double, 6> gt = {0, 1, 0, 0, 0, 1};
+  if (ds.GetGeoTransform(gt.data()) != CE_None || gt[2] != 0.0 || gt[4] != 0.0 || !(gt[1] > 0.0) || gt[5] == 0.0) {
+    std::ostringstream v;
+    v << "geotransform (" << gt[0] << ", " << gt[1] << ", " << gt[2] << ", " << gt[3] << ", " << gt[4]
+      << ", " << gt[5] << ")";
+    throw ParseError(path, 0, "grid.geotransform", v.str(),
+                     std::string("an axis-aligned geographic grid; ") + kExpectedGrid);
+  }
+  return gt;
+}
+
+/// Columns in 360° of longitude at dlon_deg spacing: a whole number, at most `cols`.
+int globalPeriodColumns(int cols, double dlon_deg, const std::string& path) {
+  const double period = 360.0 / dlon_deg;
+  const int period_cols = static_cast<int>(std::lround(period));
+  if (std::abs(period - period_cols) > kPeriodTol_cols || cols < period_cols) {
+    std::ostringstream v;
+    v << cols << " columns of " << dlon_deg << " deg";
+    throw ParseError(path, 0, "grid.columns", v.str(),
+                     std::string("a global grid (360 deg of longitude); ") + kExpectedGrid);
+  }
+  return period_cols;
+}
+
+/// The rows must reach to within one row of both poles.
+void requirePoleRows(double lat0_deg, int rows, double dlat_deg, const std::string& path) {
+  const double lat_first = lat0_deg;
+  const double lat_last = lat0_deg + (rows - 1) * dlat_deg;
+  const double row_step = std::abs(dlat_deg);
+  if (std::max(lat_first, lat_last) < 90.0 - row_step - kPoleTol_deg ||
+      std::min(lat_first, lat_last) > -90.0 + row_step + kPoleTol_deg) {
+    std::ostringstream v;
+    v << "rows from lat " << lat_first << " to " << lat_last << " deg";
+    throw ParseError(path, 0, "grid.rows", v.str(),
+                     std::string("a global grid reaching to within one row of both poles; ") + kExpectedGrid);
+  }
+}
+
+/// Band 1, row-major, scaled and offset; a void node is an error.
+std::vector<float> readUndulations(GDALRasterBand& band, int rows, int cols, const std::string& path) {
+  int has_nodata = 0;
+  const double nodata = band.GetNoDataValue(&has_nodata);
+  int has_scale = 0, has_offset = 0;
+  const double scale = band.GetScale(&has_scale);
+  const double offset = band.GetOffset(&has_offset);
+  std::vector<double> row(static_cast<std::size_t>(cols));
+  std::vector<float> n_m(static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols));
+  for (int r = 0; r < rows; ++r) {
+    if (band.RasterIO(GF_Read, 0, r, cols, 1, row.data(), cols, 1, GDT_Float64, 0, 0, nullptr) != CE_None) {
+      throw ParseError(path, 0, "grid.band1", "unreadable row " + std::to_string(r) + " (" +
+                       detail::gdalMessage("read error") + ")", kExpectedGrid);
+    }
+    for (int c = 0; c < cols; ++c) {
+      const double raw = row[static_cast<std::size_t>(c)];
+      if (!std::isfinite(raw) || (has_nodata != 0 && raw == nodata)) {
+        std::ostringstream v;
+        v << "void (nodata) node at row " << r << ", column " << c;
+        throw ParseError(path, 0, "grid.band1", v.str(), std::string("a void-free grid; ") + kExpectedGrid);
+      }
+      n_m[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)] =
+          static_cast<float>(raw * (has_scale != 0 ? scale : 1.0) + (has_offset != 0 ? offset : 0.0));
+    }
+  }
+  return n_m;
+}
+
 }  // namespace
 
 Geoid::Geoid(const std::string& grid_path) : path_(grid_path) {
@@ -43,29 +133,9 @@ Geoid::Geoid(const std::string& grid_path) : path_(grid_path) {
   // into the ParseError instead.
   CPLErrorHandlerPusher quiet(CPLQuietErrorHandler);
   CPLErrorReset();
-  GDALDatasetUniquePtr ds(GDALDataset::Open(grid_path.c_str(),
-                                            GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR));
-  if (!ds) throw ParseError(path_, 0, "grid", "unreadable (" + detail::gdalMessage("GDAL cannot open it") + ")", kExpectedGrid);
-  if (ds->GetRasterCount() < 1) throw ParseError(path_, 0, "grid", "no raster band", kExpectedGrid);
-
-  const OGRSpatialReference* srs = ds->GetSpatialRef();
-  if (srs != nullptr && !srs->IsEmpty()) {
-    const double unit_rad = srs->GetAngularUnits(nullptr);
-    if (!srs->IsGeographic() || std::abs(rad2deg(unit_rad) - 1.0) > kDegreeUnitTol) {
-      const char* name = srs->GetName();
-      throw ParseError(path_, 0, "grid.crs", name != nullptr ? name : "not geographic",
-                       std::string("a geographic CRS in degrees; ") + kExpectedGrid);
-    }
-  }
-
-  double gt[6] = {0, 1, 0, 0, 0, 1};
-  if (ds->GetGeoTransform(gt) != CE_None || gt[2] != 0.0 || gt[4] != 0.0 || !(gt[1] > 0.0) || gt[5] == 0.0) {
-    std::ostringstream v;
-    v << "geotransform (" << gt[0] << ", " << gt[1] << ", " << gt[2] << ", " << gt[3] << ", " << gt[4]
-      << ", " << gt[5] << ")";
-    throw ParseError(path_, 0, "grid.geotransform", v.str(),
-                     std::string("an axis-aligned geographic grid; ") + kExpectedGrid);
-  }
+  GDALDatasetUniquePtr ds = openGrid(path_);
+  requireGeographicDegrees(*ds, path_);
+  const std::array<double, 6> gt = axisAlignedGeoTransform(*ds, path_);
   rows_ = ds->GetRasterYSize();
   cols_ = ds->GetRasterXSize();
   dlon_deg_ = gt[1];
@@ -73,50 +143,9 @@ Geoid::Geoid(const std::string& grid_path) : path_(grid_path) {
   // GDAL pixel centres are the grid nodes (for GTX, GDAL shifts the origin by half a cell).
   lon0_deg_ = gt[0] + 0.5 * gt[1];
   lat0_deg_ = gt[3] + 0.5 * gt[5];
-
-  const double period = 360.0 / dlon_deg_;
-  period_cols_ = static_cast<int>(std::lround(period));
-  if (std::abs(period - period_cols_) > kPeriodTol_cols || cols_ < period_cols_) {
-    std::ostringstream v;
-    v << cols_ << " columns of " << dlon_deg_ << " deg";
-    throw ParseError(path_, 0, "grid.columns", v.str(),
-                     std::string("a global grid (360 deg of longitude); ") + kExpectedGrid);
-  }
-  const double lat_first = lat0_deg_;
-  const double lat_last = lat0_deg_ + (rows_ - 1) * dlat_deg_;
-  const double row_step = std::abs(dlat_deg_);
-  if (std::max(lat_first, lat_last) < 90.0 - row_step - kPoleTol_deg ||
-      std::min(lat_first, lat_last) > -90.0 + row_step + kPoleTol_deg) {
-    std::ostringstream v;
-    v << "rows from lat " << lat_first << " to " << lat_last << " deg";
-    throw ParseError(path_, 0, "grid.rows", v.str(),
-                     std::string("a global grid reaching to within one row of both poles; ") + kExpectedGrid);
-  }
-
-  GDALRasterBand* band = ds->GetRasterBand(1);
-  int has_nodata = 0;
-  const double nodata = band->GetNoDataValue(&has_nodata);
-  int has_scale = 0, has_offset = 0;
-  const double scale = band->GetScale(&has_scale);
-  const double offset = band->GetOffset(&has_offset);
-  std::vector<double> row(static_cast<std::size_t>(cols_));
-  n_m_.resize(static_cast<std::size_t>(rows_) * static_cast<std::size_t>(cols_));
-  for (int r = 0; r < rows_; ++r) {
-    if (band->RasterIO(GF_Read, 0, r, cols_, 1, row.data(), cols_, 1, GDT_Float64, 0, 0, nullptr) != CE_None) {
-      throw ParseError(path_, 0, "grid.band1", "unreadable row " + std::to_string(r) + " (" +
-                       detail::gdalMessage("read error") + ")", kExpectedGrid);
-    }
-    for (int c = 0; c < cols_; ++c) {
-      const double raw = row[static_cast<std::size_t>(c)];
-      if (!std::isfinite(raw) || (has_nodata != 0 && raw == nodata)) {
-        std::ostringstream v;
-        v << "void (nodata) node at row " << r << ", column " << c;
-        throw ParseError(path_, 0, "grid.band1", v.str(), std::string("a void-free grid; ") + kExpectedGrid);
-      }
-      n_m_[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols_) + static_cast<std::size_t>(c)] =
-          static_cast<float>(raw * (has_scale != 0 ? scale : 1.0) + (has_offset != 0 ? offset : 0.0));
-    }
-  }
+  period_cols_ = globalPeriodColumns(cols_, dlon_deg_, path_);
+  requirePoleRows(lat0_deg_, rows_, dlat_deg_, path_);
+  n_m_ = readUndulations(*ds->GetRasterBand(1), rows_, cols_, path_);
 }
 
 const Geoid& Geoid::egm96() {

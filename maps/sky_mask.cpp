@@ -182,126 +182,122 @@ BuildingIndex::BuildingIndex(const std::vector<Building>& buildings, const Geode
   }
 }
 
-void BuildingIndex::raiseMask(SkyMask& mask, const Geodetic& observer, double refraction_k, bool cull) const {
-  if (!std::isfinite(observer.lat_rad) || !std::isfinite(observer.lon_rad) || !std::isfinite(observer.h_ell_m) ||
-      !(refraction_k > 0.0) || !std::isfinite(refraction_k)) {
-    throw std::invalid_argument("BuildingIndex::raiseMask: observer and refraction factor must be finite (k > 0)");
-  }
-  if (items_.empty()) return;
-  const double R = dropRadius_m(observer.lat_rad, refraction_k);
-  const double h_obs = observer.h_ell_m;
-  const int n_bins = mask.bins();
-  const double w = mask.binWidth_rad();
-  // Unit vectors (east, north) along the bins' lower edges.
-  std::vector<Eigen::Vector2d> edge_dir(static_cast<std::size_t>(n_bins));
-  for (int k = 0; k < n_bins; ++k) edge_dir[static_cast<std::size_t>(k)] = {std::sin(k * w), std::cos(k * w)};
+namespace {
 
-  // The observer's horizontal plane: rows 0, 1 of R_PO = R_P,ecef · R_O,ecefᵀ.
-  const Eigen::Vector3d p_OP_o = frame_.toEnu(observer);
-  const Eigen::Matrix3d R_po = rotationEcefToEnu(observer.lat_rad, observer.lon_rad) *
-                               rotationEcefToEnu(frame_.origin().lat_rad, frame_.origin().lon_rad).transpose();
-  const Eigen::Matrix<double, 2, 3> A = R_po.topRows<2>();
-  const double slack = kCullSlack_m + std::abs(h_obs) * (p_OP_o.head<2>().norm() + cell_m_ * (cols_ + rows_)) / R;
-  const auto toObserverPlane = [&](const Eigen::Vector2d& q_en) -> Eigen::Vector2d {
+/// \brief The observer's horizontal plane seen from the index origin, with the mask's bins:
+/// what every building of one query is projected into.
+struct ObserverPlane {
+  double R = 0.0;      ///< drop radius (refraction included) [m]
+  double h_obs = 0.0;  ///< observer's ellipsoidal height [m]
+  int n_bins = 0;
+  double w = 0.0;                        ///< bin width [rad]
+  std::vector<Eigen::Vector2d> edge_dir;  ///< unit vectors (east, north) along the bins' lower edges
+  Eigen::Vector3d p_OP_o;                 ///< the observer in the origin's ENU frame
+  Eigen::Matrix<double, 2, 3> A;          ///< rows 0, 1 of R_PO = R_P,ecef · R_O,ecefᵀ
+
+  /// \brief A point of the origin's EN plane at the observer's height, in the observer's plane.
+  [[nodiscard]] Eigen::Vector2d toObserverPlane(const Eigen::Vector2d& q_en) const {
     return A * (Eigen::Vector3d(q_en.x(), q_en.y(), p_OP_o.z()) - p_OP_o);
-  };
-
-  std::vector<Eigen::Vector2d> xy;  // corners at the observer's height, observer's plane
-  bool all_blocked = false;
-  const auto process = [&](const Item& it) {
-    const std::size_t n = it.p_foot_o.size();
-    xy.resize(n);
-    for (std::size_t i = 0; i < n; ++i) xy[i] = A * (it.p_foot_o[i] + h_obs * it.up_o[i] - p_OP_o);
-    const double dh = it.top_h_ell_m - h_obs;
-    // Inside (or on) the footprint? Crossing number of a ray towards +east, plus the boundary.
-    bool inside = false;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Eigen::Vector2d& a = xy[i];
-      const Eigen::Vector2d& b = xy[(i + 1) % n];
-      const Eigen::Vector2d ab = b - a;
-      const double len2 = ab.squaredNorm();
-      const double t = len2 > 0.0 ? std::clamp(-a.dot(ab) / len2, 0.0, 1.0) : 0.0;
-      if ((a + t * ab).norm() <= kOnBoundary_m) {
-        inside = true;
-        break;
-      }
-      if ((a.y() > 0.0) != (b.y() > 0.0) && a.x() - a.y() * ab.x() / ab.y() > 0.0) inside = !inside;
-    }
-    if (inside && dh > 0.0) {
-      for (int k = 0; k < n_bins; ++k) mask.raise(k, M_PI / 2.0);
-      all_blocked = true;
-      return;
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      Eigen::Vector2d s = xy[i], e = xy[(i + 1) % n];
-      double az_s = wrapAzimuth(std::atan2(s.x(), s.y()));
-      double span = std::remainder(std::atan2(e.x(), e.y()) - az_s, kTwoPi);
-      if (span < 0.0) {  // walk the edge clockwise (increasing azimuth)
-        std::swap(s, e);
-        az_s = wrapAzimuth(std::atan2(s.x(), s.y()));
-        span = -span;
-      }
-      const Eigen::Vector2d se = e - s;
-      const double len2 = se.squaredNorm();
-      const auto k0 = static_cast<long>(std::floor(az_s / w));
-      const auto k1 = static_cast<long>(std::floor((az_s + span) / w));
-      for (long k = k0; k <= k1; ++k) {
-        const auto bin = static_cast<int>(k % n_bins);
-        // The part of the edge inside the wedge [k·w, (k+1)·w): t where the bin's edge rays
-        // cross the segment (cross(u, s + t·se) = 0), or the segment's own ends.
-        const auto tAt = [&](long edge) {
-          const Eigen::Vector2d& u = edge_dir[static_cast<std::size_t>(edge % n_bins)];
-          const double den = cross2(u, se);
-          return den != 0.0 ? std::clamp(-cross2(u, s) / den, 0.0, 1.0) : 0.0;
-        };
-        double t0 = k == k0 ? 0.0 : tAt(k);
-        double t1 = k == k1 ? 1.0 : tAt(k + 1);
-        if (t0 > t1) std::swap(t0, t1);
-        const double t_close = len2 > 0.0 ? std::clamp(-s.dot(se) / len2, t0, t1) : t0;
-        const double d_near = (s + t_close * se).norm();
-        const double d_far = std::max((s + t0 * se).norm(), (s + t1 * se).norm());
-        mask.raise(bin, maxElevation_rad(dh, d_near, d_far, R));
-      }
-    }
-  };
-
-  if (!cull) {
-    for (const Item& it : items_) {
-      process(it);
-      if (all_blocked) return;
-    }
-    return;
   }
+};
 
-  // Rings of cells around the observer's cell, nearest first.
-  const Eigen::Vector2d g = (p_OP_o.head<2>() - grid_min_en_) / cell_m_;
-  const int ci = static_cast<int>(std::floor(std::clamp(g.x(), -1e6, 1e6)));
-  const int cj = static_cast<int>(std::floor(std::clamp(g.y(), -1e6, 1e6)));
-  const int r_max = std::max({std::abs(ci), std::abs(ci - (cols_ - 1)), std::abs(cj), std::abs(cj - (rows_ - 1))});
-  std::vector<char> seen(items_.size(), 0);
-  const double cell_radius = cell_m_ * M_SQRT1_2 + slack;
-  const auto visit = [&](int c, int r) {
-    if (c < 0 || c >= cols_ || r < 0 || r >= rows_) return;
-    const Cell& cell = cells_[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols_) + static_cast<std::size_t>(c)];
-    if (cell.items.empty()) return;
-    const Eigen::Vector2d centre = grid_min_en_ + cell_m_ * Eigen::Vector2d(c + 0.5, r + 0.5);
-    if (circleHidden(mask, toObserverPlane(centre), cell_radius, cell.top_h_ell_m - h_obs, R)) return;
-    for (const std::uint32_t i : cell.items) {
-      if (seen[i] != 0 || all_blocked) continue;
-      seen[i] = 1;
-      const Item& it = items_[i];
-      if (circleHidden(mask, toObserverPlane(it.centre_en), it.radius_m + slack, it.top_h_ell_m - h_obs, R)) continue;
-      process(it);
-    }
-  };
-  for (int ring = 0; ring <= r_max && !all_blocked; ++ring) {
-    // Every cell of this ring is at least (ring − 1) cells away: stop when even the tallest
-    // building there stays below the lowest bin.
-    const double d_ring = (ring - 1) * cell_m_ - slack;
-    if (d_ring > 0.0) {
-      const double lowest = *std::min_element(mask.blocked_rad().begin(), mask.blocked_rad().end());
-      if (maxElevation_rad(max_top_h_ell_m_ - h_obs, d_ring, std::numeric_limits<double>::infinity(), R) <= lowest) break;
-    }
+ObserverPlane observerPlane(const SkyMask& mask, const Geodetic& observer, double refraction_k,
+                            const LocalFrame& frame) {
+  ObserverPlane o;
+  o.R = dropRadius_m(observer.lat_rad, refraction_k);
+  o.h_obs = observer.h_ell_m;
+  o.n_bins = mask.bins();
+  o.w = mask.binWidth_rad();
+  o.edge_dir.resize(static_cast<std::size_t>(o.n_bins));
+  for (int k = 0; k < o.n_bins; ++k) o.edge_dir[static_cast<std::size_t>(k)] = {std::sin(k * o.w), std::cos(k * o.w)};
+  o.p_OP_o = frame.toEnu(observer);
+  const Eigen::Matrix3d R_po = rotationEcefToEnu(observer.lat_rad, observer.lon_rad) *
+                               rotationEcefToEnu(frame.origin().lat_rad, frame.origin().lon_rad).transpose();
+  o.A = R_po.topRows<2>();
+  return o;
+}
+
+/// \brief Is the observer (the origin of the plane) inside or on the footprint `xy`? Crossing
+/// number of a ray towards +east, plus the boundary.
+bool observerInside(const std::vector<Eigen::Vector2d>& xy) {
+  const std::size_t n = xy.size();
+  bool inside = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& a = xy[i];
+    const Eigen::Vector2d& b = xy[(i + 1) % n];
+    const Eigen::Vector2d ab = b - a;
+    const double len2 = ab.squaredNorm();
+    const double t = len2 > 0.0 ? std::clamp(-a.dot(ab) / len2, 0.0, 1.0) : 0.0;
+    if ((a + t * ab).norm() <= kOnBoundary_m) return true;
+    if ((a.y() > 0.0) != (b.y() > 0.0) && a.x() - a.y() * ab.x() / ab.y() > 0.0) inside = !inside;
+  }
+  return inside;
+}
+
+/// \brief Raises the bins one footprint edge s → e spans: each bin to the elevation of the
+/// clipped piece's closest point, the top dh above the observer.
+void raiseByEdge(SkyMask& mask, const ObserverPlane& o, Eigen::Vector2d s, Eigen::Vector2d e, double dh) {
+  double az_s = wrapAzimuth(std::atan2(s.x(), s.y()));
+  double span = std::remainder(std::atan2(e.x(), e.y()) - az_s, kTwoPi);
+  if (span < 0.0) {  // walk the edge clockwise (increasing azimuth)
+    std::swap(s, e);
+    az_s = wrapAzimuth(std::atan2(s.x(), s.y()));
+    span = -span;
+  }
+  const Eigen::Vector2d se = e - s;
+  const double len2 = se.squaredNorm();
+  const auto k0 = static_cast<long>(std::floor(az_s / o.w));
+  const auto k1 = static_cast<long>(std::floor((az_s + span) / o.w));
+  for (long k = k0; k <= k1; ++k) {
+    const auto bin = static_cast<int>(k % o.n_bins);
+    // The part of the edge inside the wedge [k·w, (k+1)·w): t where the bin's edge rays
+    // cross the segment (cross(u, s + t·se) = 0), or the segment's own ends.
+    const auto tAt = [&](long edge) {
+      const Eigen::Vector2d& u = o.edge_dir[static_cast<std::size_t>(edge % o.n_bins)];
+      const double den = cross2(u, se);
+      return den != 0.0 ? std::clamp(-cross2(u, s) / den, 0.0, 1.0) : 0.0;
+    };
+    double t0 = k == k0 ? 0.0 : tAt(k);
+    double t1 = k == k1 ? 1.0 : tAt(k + 1);
+    if (t0 > t1) std::swap(t0, t1);
+    const double t_close = len2 > 0.0 ? std::clamp(-s.dot(se) / len2, t0, t1) : t0;
+    const double d_near = (s + t_close * se).norm();
+    const double d_far = std::max((s + t0 * se).norm(), (s + t1 * se).norm());
+    mask.raise(bin, maxElevation_rad(dh, d_near, d_far, o.R));
+  }
+}
+
+/// \brief Raises `mask` by one building (corners p_foot_o on the ellipsoid, verticals up_o);
+/// true when the observer stands inside it below its top, which blocks every bin. `xy` is
+/// scratch for the corners in the observer's plane.
+bool raiseByBuilding(SkyMask& mask, const ObserverPlane& o, const std::vector<Eigen::Vector3d>& p_foot_o,
+                     const std::vector<Eigen::Vector3d>& up_o, double top_h_ell_m, std::vector<Eigen::Vector2d>& xy) {
+  const std::size_t n = p_foot_o.size();
+  xy.resize(n);
+  for (std::size_t i = 0; i < n; ++i) xy[i] = o.A * (p_foot_o[i] + o.h_obs * up_o[i] - o.p_OP_o);
+  const double dh = top_h_ell_m - o.h_obs;
+  if (observerInside(xy) && dh > 0.0) {
+    for (int k = 0; k < o.n_bins; ++k) mask.raise(k, M_PI / 2.0);
+    return true;
+  }
+  for (std::size_t i = 0; i < n; ++i) raiseByEdge(mask, o, xy[i], xy[(i + 1) % n], dh);
+  return false;
+}
+
+/// \brief Can nothing at least d_ring away, at most dh_max above the observer, rise above the
+/// lowest bin of the mask?
+bool ringBelowMask(const SkyMask& mask, double d_ring, double dh_max, double earth_radius_m) {
+  if (!(d_ring > 0.0)) return false;
+  const double lowest = *std::min_element(mask.blocked_rad().begin(), mask.blocked_rad().end());
+  return maxElevation_rad(dh_max, d_ring, std::numeric_limits<double>::infinity(), earth_radius_m) <= lowest;
+}
+
+/// \brief Visits the cells of the square rings around (ci, cj), nearest first (ring 0 is the
+/// cell itself), up to ring r_max; `stop(ring)` ends the walk before a ring.
+template <class Stop, class Visit>
+void walkRings(int ci, int cj, int r_max, const Stop& stop, const Visit& visit) {
+  for (int ring = 0; ring <= r_max; ++ring) {
+    if (stop(ring)) break;
     if (ring == 0) {
       visit(ci, cj);
       continue;
@@ -315,6 +311,58 @@ void BuildingIndex::raiseMask(SkyMask& mask, const Geodetic& observer, double re
       visit(ci + ring, r);
     }
   }
+}
+
+}  // namespace
+
+void BuildingIndex::raiseMask(SkyMask& mask, const Geodetic& observer, double refraction_k, bool cull) const {
+  if (!std::isfinite(observer.lat_rad) || !std::isfinite(observer.lon_rad) || !std::isfinite(observer.h_ell_m) ||
+      !(refraction_k > 0.0) || !std::isfinite(refraction_k)) {
+    throw std::invalid_argument("BuildingIndex::raiseMask: observer and refraction factor must be finite (k > 0)");
+  }
+  if (items_.empty()) return;
+  const ObserverPlane o = observerPlane(mask, observer, refraction_k, frame_);
+  std::vector<Eigen::Vector2d> xy;  // corners at the observer's height, observer's plane
+  bool all_blocked = false;
+  const auto process = [&](const Item& it) {
+    if (raiseByBuilding(mask, o, it.p_foot_o, it.up_o, it.top_h_ell_m, xy)) all_blocked = true;
+  };
+  if (!cull) {
+    for (const Item& it : items_) {
+      process(it);
+      if (all_blocked) return;
+    }
+    return;
+  }
+
+  // Rings of cells around the observer's cell, nearest first.
+  const double slack = kCullSlack_m + std::abs(o.h_obs) * (o.p_OP_o.head<2>().norm() + cell_m_ * (cols_ + rows_)) / o.R;
+  const Eigen::Vector2d g = (o.p_OP_o.head<2>() - grid_min_en_) / cell_m_;
+  const int ci = static_cast<int>(std::floor(std::clamp(g.x(), -1e6, 1e6)));
+  const int cj = static_cast<int>(std::floor(std::clamp(g.y(), -1e6, 1e6)));
+  const int r_max = std::max({std::abs(ci), std::abs(ci - (cols_ - 1)), std::abs(cj), std::abs(cj - (rows_ - 1))});
+  std::vector<char> seen(items_.size(), 0);
+  const double cell_radius = cell_m_ * M_SQRT1_2 + slack;
+  const auto visit = [&](int c, int r) {
+    if (c < 0 || c >= cols_ || r < 0 || r >= rows_) return;
+    const Cell& cell = cells_[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols_) + static_cast<std::size_t>(c)];
+    if (cell.items.empty()) return;
+    const Eigen::Vector2d centre = grid_min_en_ + cell_m_ * Eigen::Vector2d(c + 0.5, r + 0.5);
+    if (circleHidden(mask, o.toObserverPlane(centre), cell_radius, cell.top_h_ell_m - o.h_obs, o.R)) return;
+    for (const std::uint32_t i : cell.items) {
+      if (seen[i] != 0 || all_blocked) continue;
+      seen[i] = 1;
+      const Item& it = items_[i];
+      if (circleHidden(mask, o.toObserverPlane(it.centre_en), it.radius_m + slack, it.top_h_ell_m - o.h_obs, o.R)) continue;
+      process(it);
+    }
+  };
+  // Every cell of a ring is at least (ring − 1) cells away: stop when even the tallest
+  // building there stays below the lowest bin.
+  const auto out_of_sight = [&](int ring) {
+    return all_blocked || ringBelowMask(mask, (ring - 1) * cell_m_ - slack, max_top_h_ell_m_ - o.h_obs, o.R);
+  };
+  walkRings(ci, cj, r_max, out_of_sight, visit);
 }
 
 // --- terrain ---------------------------------------------------------------------------------

@@ -53,6 +53,23 @@ OGRSpatialReference wgs84LonLat() {
   return srs;
 }
 
+/// A raster's geotransform: pixel (u, v) → raster CRS (x, y), GDAL layout.
+struct GeoTransform {
+  double gt[6] = {0, 1, 0, 0, 0, 1};
+
+  [[nodiscard]] double x(double u, double v) const { return gt[0] + u * gt[1] + v * gt[2]; }
+  [[nodiscard]] double y(double u, double v) const { return gt[3] + u * gt[4] + v * gt[5]; }
+};
+
+/// The raster file, opened read-only, with at least one band.
+GDALDatasetUniquePtr openRaster(const std::string& path) {
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(),
+                                            GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR));
+  if (!ds) throw ParseError(path, 0, "raster", "unreadable (" + detail::gdalMessage("GDAL cannot open it") + ")", kExpectedRaster);
+  if (ds->GetRasterCount() < 1) throw ParseError(path, 0, "raster", "no raster band", kExpectedRaster);
+  return ds;
+}
+
 }  // namespace
 
 struct Terrain::Raster {
@@ -100,7 +117,128 @@ struct Terrain::Raster {
     const double fs = s - c0, ft = t - r0;
     return (1.0 - ft) * ((1.0 - fs) * z00 + fs * z01) + ft * ((1.0 - fs) * z10 + fs * z11);
   }
+
+  // Loading steps of Terrain::fromRaster, in order.
+  /// Driver and size (at most kMaxRasterCells).
+  void readSize(GDALDataset& ds);
+  /// The geotransform; its inverse goes into inv_gt.
+  [[nodiscard]] GeoTransform readGeoTransform(GDALDataset& ds);
+  /// The CRS and the transformation WGS-84 lon/lat → raster CRS; returns the way back (null
+  /// when the raster CRS is WGS-84 lon/lat).
+  [[nodiscard]] CtPtr readCrs(GDALDataset& ds);
+  /// The WGS-84 footprint, traced along the raster's edges.
+  void traceFootprint(const GeoTransform& gt, OGRCoordinateTransformation* to_wgs84);
+  /// Cell size on the ground at the centre: geodesics to the neighbouring cell centres.
+  void measureCell(const GeoTransform& gt, OGRCoordinateTransformation* to_wgs84);
+  /// Band 1, whole, voids as NaN.
+  void readBand(GDALRasterBand& band);
 };
+
+void Terrain::Raster::readSize(GDALDataset& ds) {
+  driver = ds.GetDriver() != nullptr ? ds.GetDriver()->GetDescription() : "?";
+  cols = ds.GetRasterXSize();
+  rows = ds.GetRasterYSize();
+  if (static_cast<long long>(cols) * rows > kMaxRasterCells) {
+    throw ParseError(path, 0, "raster.size", std::to_string(cols) + " x " + std::to_string(rows) + " cells",
+                     "at most " + std::to_string(kMaxRasterCells) + " cells (crop the DEM to the mission area)");
+  }
+}
+
+GeoTransform Terrain::Raster::readGeoTransform(GDALDataset& ds) {
+  GeoTransform g;
+  if (ds.GetGeoTransform(g.gt) != CE_None || GDALInvGeoTransform(g.gt, inv_gt) == FALSE) {
+    throw ParseError(path, 0, "raster.geotransform", "none or singular", kExpectedRaster);
+  }
+  return g;
+}
+
+CtPtr Terrain::Raster::readCrs(GDALDataset& ds) {
+  const OGRSpatialReference wgs84 = wgs84LonLat();
+  CtPtr to_wgs84;
+  const OGRSpatialReference* ds_srs = ds.GetSpatialRef();
+  if (ds_srs == nullptr || ds_srs->IsEmpty()) {
+    identity = true;
+    wrap_lon = true;
+    crs = "none (assumed WGS-84 lon/lat, degrees)";
+    return to_wgs84;
+  }
+  OGRSpatialReference srs(*ds_srs);
+  srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  const char* name = srs.GetName();
+  crs = name != nullptr ? name : "unnamed";
+  wrap_lon = srs.IsGeographic() && std::abs(rad2deg(srs.GetAngularUnits(nullptr)) - 1.0) <= kDegreeUnitTol;
+  identity = srs.IsSame(&wgs84);
+  if (!identity) {
+    to_raster.reset(OGRCreateCoordinateTransformation(&wgs84, &srs));
+    to_wgs84.reset(OGRCreateCoordinateTransformation(&srs, &wgs84));
+    if (!to_raster || !to_wgs84) {
+      throw ParseError(path, 0, "raster.crs", crs + " (" + detail::gdalMessage("no transformation from WGS-84") + ")",
+                       "a CRS PROJ can transform WGS-84 longitude/latitude into");
+    }
+  }
+  return to_wgs84;
+}
+
+void Terrain::Raster::traceFootprint(const GeoTransform& gt, OGRCoordinateTransformation* to_wgs84) {
+  bool first = true;
+  for (int k = 0; k <= kEdgeSamples; ++k) {
+    const double f = static_cast<double>(k) / kEdgeSamples;
+    const double uv[4][2] = {{f * cols, 0.0}, {f * cols, 1.0 * rows}, {0.0, f * rows}, {1.0 * cols, f * rows}};
+    for (const auto& p : uv) {
+      double x = gt.x(p[0], p[1]), y = gt.y(p[0], p[1]);
+      if (to_wgs84 && (!to_wgs84->Transform(1, &x, &y) || !std::isfinite(x) || !std::isfinite(y))) continue;
+      if (first) {
+        lon_min_deg = lon_max_deg = x;
+        lat_min_deg = lat_max_deg = y;
+        first = false;
+      }
+      lon_min_deg = std::min(lon_min_deg, x);
+      lon_max_deg = std::max(lon_max_deg, x);
+      lat_min_deg = std::min(lat_min_deg, y);
+      lat_max_deg = std::max(lat_max_deg, y);
+    }
+  }
+  if (first) throw ParseError(path, 0, "raster.crs", crs, "a raster whose footprint maps to WGS-84 longitude/latitude");
+}
+
+void Terrain::Raster::measureCell(const GeoTransform& gt, OGRCoordinateTransformation* to_wgs84) {
+  const double uc = std::floor(0.5 * cols) + 0.5, vc = std::floor(0.5 * rows) + 0.5;
+  const double uv[3][2] = {{uc, vc}, {uc + 1.0, vc}, {uc, vc + 1.0}};
+  double lon[3], lat[3];
+  bool ok = true;
+  for (int k = 0; k < 3; ++k) {
+    lon[k] = gt.x(uv[k][0], uv[k][1]);
+    lat[k] = gt.y(uv[k][0], uv[k][1]);
+    if (to_wgs84 && (!to_wgs84->Transform(1, &lon[k], &lat[k]))) ok = false;
+    ok = ok && std::isfinite(lon[k]) && std::abs(lat[k]) <= 90.0;
+  }
+  if (ok) {
+    cell_m = std::min(geodesicDistance_m(deg2rad(lat[0]), deg2rad(lon[0]), deg2rad(lat[1]), deg2rad(lon[1])),
+                      geodesicDistance_m(deg2rad(lat[0]), deg2rad(lon[0]), deg2rad(lat[2]), deg2rad(lon[2])));
+  }
+}
+
+void Terrain::Raster::readBand(GDALRasterBand& band) {
+  int has_nodata = 0, has_scale = 0, has_offset = 0;
+  const double nodata = band.GetNoDataValue(&has_nodata);
+  const double scale = band.GetScale(&has_scale);
+  const double offset = band.GetOffset(&has_offset);
+  std::vector<double> row(static_cast<std::size_t>(cols));
+  z_m.resize(static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows));
+  for (int j = 0; j < rows; ++j) {
+    if (band.RasterIO(GF_Read, 0, j, cols, 1, row.data(), cols, 1, GDT_Float64, 0, 0, nullptr) != CE_None) {
+      throw ParseError(path, 0, "raster.band1", "unreadable row " + std::to_string(j) + " (" + detail::gdalMessage("read error") + ")",
+                       kExpectedRaster);
+    }
+    float* out = z_m.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(cols);
+    for (int i = 0; i < cols; ++i) {
+      const double raw = row[static_cast<std::size_t>(i)];
+      const bool is_void = !std::isfinite(raw) || (has_nodata != 0 && raw == nodata);
+      out[i] = is_void ? std::numeric_limits<float>::quiet_NaN()
+                       : static_cast<float>(raw * (has_scale != 0 ? scale : 1.0) + (has_offset != 0 ? offset : 0.0));
+    }
+  }
+}
 
 Terrain Terrain::flat(double alt_amsl_m) {
   if (!std::isfinite(alt_amsl_m)) throw std::invalid_argument("Terrain::flat: altitude AMSL is not finite");
@@ -115,114 +253,16 @@ Terrain Terrain::fromRaster(const std::string& path, HeightDatum datum) {
   // into the ParseError instead.
   CPLErrorHandlerPusher quiet(CPLQuietErrorHandler);
   CPLErrorReset();
-  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(),
-                                            GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR));
-  if (!ds) throw ParseError(path, 0, "raster", "unreadable (" + detail::gdalMessage("GDAL cannot open it") + ")", kExpectedRaster);
-  if (ds->GetRasterCount() < 1) throw ParseError(path, 0, "raster", "no raster band", kExpectedRaster);
-
+  GDALDatasetUniquePtr ds = openRaster(path);
   auto r = std::make_shared<Raster>();
   r->path = path;
-  r->driver = ds->GetDriver() != nullptr ? ds->GetDriver()->GetDescription() : "?";
-  r->cols = ds->GetRasterXSize();
-  r->rows = ds->GetRasterYSize();
-  if (static_cast<long long>(r->cols) * r->rows > kMaxRasterCells) {
-    throw ParseError(path, 0, "raster.size", std::to_string(r->cols) + " x " + std::to_string(r->rows) + " cells",
-                     "at most " + std::to_string(kMaxRasterCells) + " cells (crop the DEM to the mission area)");
-  }
-
-  double gt[6] = {0, 1, 0, 0, 0, 1};
-  if (ds->GetGeoTransform(gt) != CE_None || GDALInvGeoTransform(gt, r->inv_gt) == FALSE) {
-    throw ParseError(path, 0, "raster.geotransform", "none or singular", kExpectedRaster);
-  }
-  const auto edgeX = [&](double u, double v) { return gt[0] + u * gt[1] + v * gt[2]; };
-  const auto edgeY = [&](double u, double v) { return gt[3] + u * gt[4] + v * gt[5]; };
-
-  // --- CRS: WGS-84 lon/lat → raster CRS ---------------------------------------------------
-  const OGRSpatialReference wgs84 = wgs84LonLat();
-  CtPtr to_wgs84;
-  const OGRSpatialReference* ds_srs = ds->GetSpatialRef();
-  if (ds_srs == nullptr || ds_srs->IsEmpty()) {
-    r->identity = true;
-    r->wrap_lon = true;
-    r->crs = "none (assumed WGS-84 lon/lat, degrees)";
-  } else {
-    OGRSpatialReference srs(*ds_srs);
-    srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    const char* name = srs.GetName();
-    r->crs = name != nullptr ? name : "unnamed";
-    r->wrap_lon = srs.IsGeographic() && std::abs(rad2deg(srs.GetAngularUnits(nullptr)) - 1.0) <= kDegreeUnitTol;
-    r->identity = srs.IsSame(&wgs84);
-    if (!r->identity) {
-      r->to_raster.reset(OGRCreateCoordinateTransformation(&wgs84, &srs));
-      to_wgs84.reset(OGRCreateCoordinateTransformation(&srs, &wgs84));
-      if (!r->to_raster || !to_wgs84) {
-        throw ParseError(path, 0, "raster.crs", r->crs + " (" + detail::gdalMessage("no transformation from WGS-84") + ")",
-                         "a CRS PROJ can transform WGS-84 longitude/latitude into");
-      }
-    }
-  }
-  r->lon_centre_deg = edgeX(0.5 * r->cols, 0.5 * r->rows);
-
-  // --- WGS-84 footprint, traced along the raster's edges ----------------------------------
-  bool first = true;
-  for (int k = 0; k <= kEdgeSamples; ++k) {
-    const double f = static_cast<double>(k) / kEdgeSamples;
-    const double uv[4][2] = {{f * r->cols, 0.0}, {f * r->cols, 1.0 * r->rows}, {0.0, f * r->rows}, {1.0 * r->cols, f * r->rows}};
-    for (const auto& p : uv) {
-      double x = edgeX(p[0], p[1]), y = edgeY(p[0], p[1]);
-      if (to_wgs84 && (!to_wgs84->Transform(1, &x, &y) || !std::isfinite(x) || !std::isfinite(y))) continue;
-      if (first) {
-        r->lon_min_deg = r->lon_max_deg = x;
-        r->lat_min_deg = r->lat_max_deg = y;
-        first = false;
-      }
-      r->lon_min_deg = std::min(r->lon_min_deg, x);
-      r->lon_max_deg = std::max(r->lon_max_deg, x);
-      r->lat_min_deg = std::min(r->lat_min_deg, y);
-      r->lat_max_deg = std::max(r->lat_max_deg, y);
-    }
-  }
-  if (first) throw ParseError(path, 0, "raster.crs", r->crs, "a raster whose footprint maps to WGS-84 longitude/latitude");
-
-  // --- cell size on the ground at the centre: geodesics to the neighbouring cell centres ----
-  {
-    const double uc = std::floor(0.5 * r->cols) + 0.5, vc = std::floor(0.5 * r->rows) + 0.5;
-    const double uv[3][2] = {{uc, vc}, {uc + 1.0, vc}, {uc, vc + 1.0}};
-    double lon[3], lat[3];
-    bool ok = true;
-    for (int k = 0; k < 3; ++k) {
-      lon[k] = edgeX(uv[k][0], uv[k][1]);
-      lat[k] = edgeY(uv[k][0], uv[k][1]);
-      if (to_wgs84 && (!to_wgs84->Transform(1, &lon[k], &lat[k]))) ok = false;
-      ok = ok && std::isfinite(lon[k]) && std::abs(lat[k]) <= 90.0;
-    }
-    if (ok) {
-      r->cell_m = std::min(geodesicDistance_m(deg2rad(lat[0]), deg2rad(lon[0]), deg2rad(lat[1]), deg2rad(lon[1])),
-                           geodesicDistance_m(deg2rad(lat[0]), deg2rad(lon[0]), deg2rad(lat[2]), deg2rad(lon[2])));
-    }
-  }
-
-  // --- band 1, whole, voids as NaN -----------------------------------------------------------
-  GDALRasterBand* band = ds->GetRasterBand(1);
-  int has_nodata = 0, has_scale = 0, has_offset = 0;
-  const double nodata = band->GetNoDataValue(&has_nodata);
-  const double scale = band->GetScale(&has_scale);
-  const double offset = band->GetOffset(&has_offset);
-  std::vector<double> row(static_cast<std::size_t>(r->cols));
-  r->z_m.resize(static_cast<std::size_t>(r->cols) * static_cast<std::size_t>(r->rows));
-  for (int j = 0; j < r->rows; ++j) {
-    if (band->RasterIO(GF_Read, 0, j, r->cols, 1, row.data(), r->cols, 1, GDT_Float64, 0, 0, nullptr) != CE_None) {
-      throw ParseError(path, 0, "raster.band1", "unreadable row " + std::to_string(j) + " (" + detail::gdalMessage("read error") + ")",
-                       kExpectedRaster);
-    }
-    float* out = r->z_m.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(r->cols);
-    for (int i = 0; i < r->cols; ++i) {
-      const double raw = row[static_cast<std::size_t>(i)];
-      const bool is_void = !std::isfinite(raw) || (has_nodata != 0 && raw == nodata);
-      out[i] = is_void ? std::numeric_limits<float>::quiet_NaN()
-                       : static_cast<float>(raw * (has_scale != 0 ? scale : 1.0) + (has_offset != 0 ? offset : 0.0));
-    }
-  }
+  r->readSize(*ds);
+  const GeoTransform gt = r->readGeoTransform(*ds);
+  const CtPtr to_wgs84 = r->readCrs(*ds);
+  r->lon_centre_deg = gt.x(0.5 * r->cols, 0.5 * r->rows);
+  r->traceFootprint(gt, to_wgs84.get());
+  r->measureCell(gt, to_wgs84.get());
+  r->readBand(*ds->GetRasterBand(1));
 
   Terrain t;
   t.raster_ = std::move(r);

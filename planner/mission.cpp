@@ -131,180 +131,206 @@ std::optional<MissionPoint> optionalPosition(const JsonNode& params) {
 
 bool samePlace(const MissionPoint& a, const MissionPoint& b) { return a.lat_rad == b.lat_rad && a.lon_rad == b.lon_rad; }
 
-}  // namespace
+/// \brief The walk through a plan's items: the route so far and what it has seen.
+struct PlanWalk {
+  QgcPlanRoute route;
+  std::optional<MissionPoint> home;  ///< mission.plannedHomePosition
+  std::string home_path;             ///< where the planned home is written
+  std::optional<MissionPoint> start;
+  bool returned = false;  ///< a RETURN_TO_LAUNCH was seen: the mission ends there
+  std::optional<double> common_height_m;
+  bool heights_agree = true;
+};
 
-QgcPlanRoute parseQgcPlanRoute(const nlohmann::json& doc, const std::string& source) {
-  const JsonNode root{doc, "$", source};
-  if (!doc.is_object()) root.fail("a QGroundControl plan (an object with fileType \"Plan\" and a mission)");
+/// \brief The `mission` object of a QGroundControl plan document.
+JsonNode planMission(const JsonNode& root) {
+  if (!root.j.is_object()) root.fail("a QGroundControl plan (an object with fileType \"Plan\" and a mission)");
   if (root.has("fileType") && !(root.at("fileType").j.is_string() && root.at("fileType").str() == "Plan")) {
     root.at("fileType").fail("\"Plan\" (a QGroundControl .plan file)");
   }
   const JsonNode mission = root.at("mission");
   if (!mission.j.is_object()) mission.fail("an object with items and plannedHomePosition");
-
-  std::optional<MissionPoint> home;
-  if (mission.has("plannedHomePosition")) {
-    const JsonNode h = mission.at("plannedHomePosition");
-    if (h.array().size() < 2) h.fail("[lat, lon, alt] in degrees and metres");
-    home = qgcPosition(h.item(0), h.item(1));
-  }
-  const auto needHome = [&](const JsonNode& item, const char* why) {
-    if (home) return *home;
-    throw maps::ParseError(source, 0, mission.path + ".plannedHomePosition", "",
-                           std::string("[lat, lon, alt] in degrees and metres (") + why + " at " + item.path + ")");
-  };
-
-  QgcPlanRoute route;
-  std::optional<MissionPoint> start;
-  bool returned = false;  // a RETURN_TO_LAUNCH was seen: the mission ends there
-  std::optional<double> common_height_m;
-  bool heights_agree = true;
-  const auto add = [&](const MissionPoint& p) {
-    if (route.points.empty() || !samePlace(route.points.back(), p)) route.points.push_back(p);
-  };
-
-  const JsonNode items = mission.at("items");
-  for (std::size_t i = 0; i < items.array().size(); ++i) {
-    const JsonNode item = items.item(i);
-    if (!item.j.is_object()) item.fail("a mission item (an object with type SimpleItem)");
-    const std::string type = item.at("type").str();
-    if (type == "ComplexItem") {
-      const std::string kind = item.has("complexItemType") ? maps::quoteJson(item.at("complexItemType").j) : "complex";
-      throw maps::ParseError(source, 0, item.path, kind + " ComplexItem",
-                             "a SimpleItem (surveys, corridor and structure scans are not supported: "
-                             "convert the pattern to waypoints in QGroundControl, or plan its corners as waypoints)");
-    }
-    if (type != "SimpleItem") item.at("type").fail("SimpleItem");
-    const JsonNode command_node = item.at("command");
-    const double command_value = command_node.number();
-    if (command_value != std::floor(command_value) || std::abs(command_value) > 1e6) {
-      command_node.fail("a MAVLink command number");
-    }
-    const int command = static_cast<int>(command_value);
-    if (std::find(std::begin(kPayloadCommands), std::end(kPayloadCommands), command) != std::end(kPayloadCommands)) {
-      continue;
-    }
-    if (command != kNavWaypoint && command != kNavTakeoff && command != kNavLand && command != kNavReturnToLaunch) {
-      command_node.fail("16 NAV_WAYPOINT, 22 NAV_TAKEOFF, 21 NAV_LAND or 20 RETURN_TO_LAUNCH (or a camera, gimbal, "
-                        "ROI, servo or relay command, which is skipped); other commands change the route or its "
-                        "timing and are not supported");
-    }
-    if (returned) {
-      item.fail(std::string("no ") + commandName(command) + " after RETURN_TO_LAUNCH (the vehicle has gone home)");
-    }
-    if (command == kNavReturnToLaunch) {
-      if (!start) start = needHome(item, "RETURN_TO_LAUNCH flies to it");
-      if (route.points.empty()) add(*start);
-      add(needHome(item, "RETURN_TO_LAUNCH flies to it"));
-      returned = true;
-      continue;
-    }
-    const JsonNode params = item.at("params");
-    if (params.array().size() < 7) {
-      params.fail("7 parameters [param1 … param7]: params[4], params[5], params[6] = latitude, longitude, altitude");
-    }
-    if (command == kNavTakeoff) {
-      if (start) item.fail("a NAV_TAKEOFF before every other positional item");
-      (void)altitudeReference(item.at("frame"));
-      const auto p = optionalPosition(params);
-      start = p ? *p : needHome(item, "the start when NAV_TAKEOFF gives no position");
-      add(*start);
-      continue;
-    }
-    if (!start) {
-      start = needHome(item, "the start when no NAV_TAKEOFF gives a position");
-      add(*start);
-    }
-    const QgcAltitudeReference reference = altitudeReference(item.at("frame"));
-    if (command == kNavLand) {
-      if (const auto p = optionalPosition(params)) add(*p);
-      continue;
-    }
-    // NAV_WAYPOINT
-    const JsonNode lat = params.item(4), lon = params.item(5);
-    if (lat.j.is_number() && lon.j.is_number() && lat.j.get<double>() == 0.0 && lon.j.get<double>() == 0.0) {
-      lat.fail("a waypoint position (0, 0 means \"here\" to some autopilots: give the place)");
-    }
-    add(qgcPosition(lat, lon));
-    const double height_m = param(params, 6, "an altitude in metres");
-    if (reference == QgcAltitudeReference::kAmsl) {
-      heights_agree = false;
-    } else if (!common_height_m) {
-      common_height_m = height_m;
-      route.cruise_agl_field = params.path + "[6]";
-    } else if (std::abs(height_m - *common_height_m) > kSameAltitudeTolerance_m) {
-      heights_agree = false;
-    }
-  }
-  if (route.points.size() < 2) {
-    items.fail("at least one NAV_WAYPOINT, NAV_LAND with a position or RETURN_TO_LAUNCH away from the start");
-  }
-  if (heights_agree && common_height_m) {
-    route.cruise_agl_m = *common_height_m;
-  } else {
-    route.cruise_agl_field.clear();
-  }
-  return route;
+  return mission;
 }
 
-Mission parseMission(const nlohmann::json& doc, const std::string& source, const std::string& base_dir,
-                     const JsonFileReader& read_json) {
-  const JsonNode root{doc, "$", source};
+std::optional<MissionPoint> plannedHome(const JsonNode& mission) {
+  if (!mission.has("plannedHomePosition")) return std::nullopt;
+  const JsonNode h = mission.at("plannedHomePosition");
+  if (h.array().size() < 2) h.fail("[lat, lon, alt] in degrees and metres");
+  return qgcPosition(h.item(0), h.item(1));
+}
+
+/// \brief The planned home, which `item` needs because `why`; an error when the plan has none.
+MissionPoint needHome(const PlanWalk& w, const JsonNode& item, const char* why) {
+  if (w.home) return *w.home;
+  throw maps::ParseError(item.source, 0, w.home_path, "",
+                         std::string("[lat, lon, alt] in degrees and metres (") + why + " at " + item.path + ")");
+}
+
+/// \brief Appends a point unless it is where the route already is.
+void addPoint(PlanWalk& w, const MissionPoint& p) {
+  if (w.route.points.empty() || !samePlace(w.route.points.back(), p)) w.route.points.push_back(p);
+}
+
+/// \brief The MAVLink command of a SimpleItem that makes the route; none for a payload command
+/// (skipped). An error for a ComplexItem or any other command.
+std::optional<int> routeCommand(const JsonNode& item) {
+  if (!item.j.is_object()) item.fail("a mission item (an object with type SimpleItem)");
+  const std::string type = item.at("type").str();
+  if (type == "ComplexItem") {
+    const std::string kind = item.has("complexItemType") ? maps::quoteJson(item.at("complexItemType").j) : "complex";
+    throw maps::ParseError(item.source, 0, item.path, kind + " ComplexItem",
+                           "a SimpleItem (surveys, corridor and structure scans are not supported: "
+                           "convert the pattern to waypoints in QGroundControl, or plan its corners as waypoints)");
+  }
+  if (type != "SimpleItem") item.at("type").fail("SimpleItem");
+  const JsonNode command_node = item.at("command");
+  const double command_value = command_node.number();
+  if (command_value != std::floor(command_value) || std::abs(command_value) > 1e6) {
+    command_node.fail("a MAVLink command number");
+  }
+  const int command = static_cast<int>(command_value);
+  if (std::find(std::begin(kPayloadCommands), std::end(kPayloadCommands), command) != std::end(kPayloadCommands)) {
+    return std::nullopt;
+  }
+  if (command != kNavWaypoint && command != kNavTakeoff && command != kNavLand && command != kNavReturnToLaunch) {
+    command_node.fail("16 NAV_WAYPOINT, 22 NAV_TAKEOFF, 21 NAV_LAND or 20 RETURN_TO_LAUNCH (or a camera, gimbal, "
+                      "ROI, servo or relay command, which is skipped); other commands change the route or its "
+                      "timing and are not supported");
+  }
+  return command;
+}
+
+void addReturnToLaunch(PlanWalk& w, const JsonNode& item) {
+  if (!w.start) w.start = needHome(w, item, "RETURN_TO_LAUNCH flies to it");
+  if (w.route.points.empty()) addPoint(w, *w.start);
+  addPoint(w, needHome(w, item, "RETURN_TO_LAUNCH flies to it"));
+  w.returned = true;
+}
+
+void addTakeoff(PlanWalk& w, const JsonNode& item, const JsonNode& params) {
+  if (w.start) item.fail("a NAV_TAKEOFF before every other positional item");
+  (void)altitudeReference(item.at("frame"));
+  const auto p = optionalPosition(params);
+  w.start = p ? *p : needHome(w, item, "the start when NAV_TAKEOFF gives no position");
+  addPoint(w, *w.start);
+}
+
+/// \brief A NAV_WAYPOINT: its place, and its height towards the route's common height.
+void addWaypoint(PlanWalk& w, const JsonNode& params, QgcAltitudeReference reference) {
+  const JsonNode lat = params.item(4), lon = params.item(5);
+  if (lat.j.is_number() && lon.j.is_number() && lat.j.get<double>() == 0.0 && lon.j.get<double>() == 0.0) {
+    lat.fail("a waypoint position (0, 0 means \"here\" to some autopilots: give the place)");
+  }
+  addPoint(w, qgcPosition(lat, lon));
+  const double height_m = param(params, 6, "an altitude in metres");
+  if (reference == QgcAltitudeReference::kAmsl) {
+    w.heights_agree = false;
+  } else if (!w.common_height_m) {
+    w.common_height_m = height_m;
+    w.route.cruise_agl_field = params.path + "[6]";
+  } else if (std::abs(height_m - *w.common_height_m) > kSameAltitudeTolerance_m) {
+    w.heights_agree = false;
+  }
+}
+
+/// \brief One route item (a supported command) added to the walk.
+void addRouteItem(PlanWalk& w, const JsonNode& item, int command) {
+  if (w.returned) {
+    item.fail(std::string("no ") + commandName(command) + " after RETURN_TO_LAUNCH (the vehicle has gone home)");
+  }
+  if (command == kNavReturnToLaunch) {
+    addReturnToLaunch(w, item);
+    return;
+  }
+  const JsonNode params = item.at("params");
+  if (params.array().size() < 7) {
+    params.fail("7 parameters [param1 … param7]: params[4], params[5], params[6] = latitude, longitude, altitude");
+  }
+  if (command == kNavTakeoff) {
+    addTakeoff(w, item, params);
+    return;
+  }
+  if (!w.start) {
+    w.start = needHome(w, item, "the start when no NAV_TAKEOFF gives a position");
+    addPoint(w, *w.start);
+  }
+  const QgcAltitudeReference reference = altitudeReference(item.at("frame"));
+  if (command == kNavLand) {
+    if (const auto p = optionalPosition(params)) addPoint(w, *p);
+    return;
+  }
+  addWaypoint(w, params, reference);
+}
+
+/// \brief The mission's top-level fields, checked against the known ones.
+void requireMissionFields(const JsonNode& root) {
   root.requireKnownFields({"name", "vehicle", "k1", "k2", "start", "goal", "waypoints", "qgc_plan", "altitude",
                            "departure", "departure_window", "zones", "zone_format", "terrain", "ground_amsl_m",
                            "buildings", "authorisations", "orbits", "integrity", "planner"});
-  Mission m;
-  m.source = source;
-  if (root.has("name")) m.name = root.at("name").str();
-  {
-    const JsonNode v = root.at("vehicle");
-    v.requireKnownFields({"lateral_m", "longitudinal_m", "height_m", "cruise_speed_mps", "climb_speed_mps"});
-    m.vehicle.lateral_m = positive(v.at("lateral_m"));
-    m.vehicle.longitudinal_m = positive(v.at("longitudinal_m"));
-    if (v.has("height_m")) m.vehicle.height_m = positive(v.at("height_m"));
-    m.cruise_speed_mps = positive(v.at("cruise_speed_mps"));
-    if (v.has("climb_speed_mps")) m.climb_speed_mps = positive(v.at("climb_speed_mps"));
+}
+
+void readVehicle(const JsonNode& v, Mission& m) {
+  v.requireKnownFields({"lateral_m", "longitudinal_m", "height_m", "cruise_speed_mps", "climb_speed_mps"});
+  m.vehicle.lateral_m = positive(v.at("lateral_m"));
+  m.vehicle.longitudinal_m = positive(v.at("longitudinal_m"));
+  if (v.has("height_m")) m.vehicle.height_m = positive(v.at("height_m"));
+  m.cruise_speed_mps = positive(v.at("cruise_speed_mps"));
+  if (v.has("climb_speed_mps")) m.climb_speed_mps = positive(v.at("climb_speed_mps"));
+}
+
+/// \brief The route: start, waypoints and goal here, or a QGroundControl .plan; exactly one of
+/// the two.
+void requireOneRoute(const JsonNode& root) {
+  std::string given;
+  for (const char* key : {"start", "waypoints", "goal"}) {
+    if (root.has(key)) given += (given.empty() ? "$." : ", $.") + std::string(key);
   }
-  if (root.has("k1")) m.levels.k1 = root.at("k1").number();
-  if (root.has("k2")) m.levels.k2 = root.at("k2").number();
-  // The route: start, waypoints and goal here, or a QGroundControl .plan; exactly one of the two.
-  std::optional<QgcPlanRoute> plan_route;
-  {
-    std::string given;
-    for (const char* key : {"start", "waypoints", "goal"}) {
-      if (root.has(key)) given += (given.empty() ? "$." : ", $.") + std::string(key);
-    }
-    if (root.has("qgc_plan") && !given.empty()) {
-      throw maps::ParseError(source, 0, "$.qgc_plan", maps::quoteJson(root.at("qgc_plan").j),
-                             "either qgc_plan or start/waypoints/goal, not both (" + given + " also given)");
-    }
-    if (!root.has("qgc_plan") && given.empty()) {
-      throw maps::ParseError(source, 0, "$.start", "",
-                             "a route: start and goal (waypoints optional), or qgc_plan naming a QGroundControl .plan");
-    }
+  if (root.has("qgc_plan") && !given.empty()) {
+    throw maps::ParseError(root.source, 0, "$.qgc_plan", maps::quoteJson(root.at("qgc_plan").j),
+                           "either qgc_plan or start/waypoints/goal, not both (" + given + " also given)");
   }
-  if (root.has("qgc_plan")) {
-    const JsonNode q = root.at("qgc_plan");
-    const std::string name = q.str();
-    if (name.empty()) q.fail("the name of a QGroundControl .plan file");
-    m.qgc_plan_file = resolve(base_dir, name);
-    nlohmann::json plan;
-    try {
-      plan = read_json ? read_json(m.qgc_plan_file) : maps::readJsonFile(m.qgc_plan_file);
-    } catch (const maps::ParseError& e) {
-      if (e.source() != m.qgc_plan_file || e.field() != "file") throw;
-      q.fail("a readable QGroundControl .plan file (" + m.qgc_plan_file + " cannot be read)");
-    }
-    plan_route = parseQgcPlanRoute(plan, m.qgc_plan_file);
-    m.points = plan_route->points;
-  } else {
-    m.points.push_back(point(root.at("start")));
-    if (root.has("waypoints")) {
-      const JsonNode w = root.at("waypoints");
-      for (std::size_t i = 0; i < w.array().size(); ++i) m.points.push_back(point(w.item(i)));
-    }
-    m.points.push_back(point(root.at("goal")));
+  if (!root.has("qgc_plan") && given.empty()) {
+    throw maps::ParseError(root.source, 0, "$.start", "",
+                           "a route: start and goal (waypoints optional), or qgc_plan naming a QGroundControl .plan");
   }
+}
+
+/// \brief The route of the .plan file named by `qgc_plan`, read with `read_json`.
+QgcPlanRoute readQgcPlan(const JsonNode& q, const std::string& base_dir, const JsonFileReader& read_json,
+                         Mission& m) {
+  const std::string name = q.str();
+  if (name.empty()) q.fail("the name of a QGroundControl .plan file");
+  m.qgc_plan_file = resolve(base_dir, name);
+  nlohmann::json plan;
+  try {
+    plan = read_json ? read_json(m.qgc_plan_file) : maps::readJsonFile(m.qgc_plan_file);
+  } catch (const maps::ParseError& e) {
+    if (e.source() != m.qgc_plan_file || e.field() != "file") throw;
+    q.fail("a readable QGroundControl .plan file (" + m.qgc_plan_file + " cannot be read)");
+  }
+  QgcPlanRoute plan_route = parseQgcPlanRoute(plan, m.qgc_plan_file);
+  m.points = plan_route.points;
+  return plan_route;
+}
+
+/// \brief The mission's points; the .plan's route when the mission names one.
+std::optional<QgcPlanRoute> readRoute(const JsonNode& root, const std::string& base_dir,
+                                      const JsonFileReader& read_json, Mission& m) {
+  requireOneRoute(root);
+  if (root.has("qgc_plan")) return readQgcPlan(root.at("qgc_plan"), base_dir, read_json, m);
+  m.points.push_back(point(root.at("start")));
+  if (root.has("waypoints")) {
+    const JsonNode w = root.at("waypoints");
+    for (std::size_t i = 0; i < w.array().size(); ++i) m.points.push_back(point(w.item(i)));
+  }
+  m.points.push_back(point(root.at("goal")));
+  return std::nullopt;
+}
+
+/// \brief The altitude block; a .plan's common waypoint height is the cruise height unless the
+/// mission gives one.
+void readAltitudes(const JsonNode& root, const std::optional<QgcPlanRoute>& plan_route, Mission& m) {
   bool cruise_given = false;
   if (root.has("altitude")) {
     const JsonNode a = root.at("altitude");
@@ -329,6 +355,9 @@ Mission parseMission(const nlohmann::json& doc, const std::string& source, const
   if (root.has("altitude") && !(m.min_agl_m <= m.cruise_agl_m && m.cruise_agl_m <= m.max_agl_m)) {
     root.at("altitude").fail("min_agl_m ≤ cruise_agl_m ≤ max_agl_m");
   }
+}
+
+void readDeparture(const JsonNode& root, Mission& m) {
   m.departure_earliest = m.departure_latest = time(root.at("departure"));
   if (root.has("departure_window")) {
     const JsonNode w = root.at("departure_window");
@@ -337,6 +366,10 @@ Mission parseMission(const nlohmann::json& doc, const std::string& source, const
     if (m.departure_latest - m.departure_earliest < 0) w.at("latest").fail("a time not before departure");
     if (w.has("step_s")) m.departure_step_s = positive(w.at("step_s"));
   }
+}
+
+/// \brief Zones, terrain or ground height, buildings, authorisations and orbits.
+void readDataFiles(const JsonNode& root, const std::string& base_dir, Mission& m) {
   if (root.has("zones")) m.zone_files = files(root.at("zones"), base_dir);
   if (root.has("zone_format")) m.zone_format = root.at("zone_format").str();
   if (root.has("terrain") && root.has("ground_amsl_m")) root.fail("an object with at most one of terrain and ground_amsl_m");
@@ -347,63 +380,103 @@ Mission parseMission(const nlohmann::json& doc, const std::string& source, const
     const JsonNode a = root.at("authorisations");
     for (std::size_t i = 0; i < a.array().size(); ++i) m.authorisations.insert(a.item(i).str());
   }
-  {
-    const JsonNode o = root.at("orbits");
-    if (o.array().empty()) o.fail("a non-empty array of almanac or RINEX navigation file names");
-    m.orbit_files = files(o, base_dir);
+  const JsonNode o = root.at("orbits");
+  if (o.array().empty()) o.fail("a non-empty array of almanac or RINEX navigation file names");
+  m.orbit_files = files(o, base_dir);
+}
+
+void readIntegrity(const JsonNode& n, Mission& m) {
+  n.requireKnownFields({"method", "mask_deg", "user_model", "sample_s", "cost_weight", "cost_cell_m"});
+  if (n.has("method")) {
+    const std::string meth = n.at("method").str();
+    if (meth == "raim") m.method = integrity::IntegrityMethod::kRaim;
+    else if (meth == "araim") m.method = integrity::IntegrityMethod::kAraim;
+    else n.at("method").fail("\"raim\" or \"araim\"");
   }
-  if (root.has("integrity")) {
-    const JsonNode n = root.at("integrity");
-    n.requireKnownFields({"method", "mask_deg", "user_model", "sample_s", "cost_weight", "cost_cell_m"});
-    if (n.has("method")) {
-      const std::string meth = n.at("method").str();
-      if (meth == "raim") m.method = integrity::IntegrityMethod::kRaim;
-      else if (meth == "araim") m.method = integrity::IntegrityMethod::kAraim;
-      else n.at("method").fail("\"raim\" or \"araim\"");
-    }
-    if (n.has("mask_deg")) m.mask_deg = n.at("mask_deg").number();
-    if (n.has("user_model")) {
-      const std::string u = n.at("user_model").str();
-      if (u == "dual_frequency") m.model.setUserModel(integrity::UserErrorModel::kDualFrequency);
-      else if (u == "single_frequency") m.model.setUserModel(integrity::UserErrorModel::kSingleFrequency);
-      else n.at("user_model").fail("\"dual_frequency\" or \"single_frequency\"");
-    }
-    if (n.has("sample_s")) m.sample_s = positive(n.at("sample_s"));
-    if (n.has("cost_weight")) {
-      m.cost_weight = n.at("cost_weight").number();
-      if (!(m.cost_weight >= 0.0)) n.at("cost_weight").fail("a weight ≥ 0");
-    }
-    if (n.has("cost_cell_m")) m.cost_cell_m = positive(n.at("cost_cell_m"));
+  if (n.has("mask_deg")) m.mask_deg = n.at("mask_deg").number();
+  if (n.has("user_model")) {
+    const std::string u = n.at("user_model").str();
+    if (u == "dual_frequency") m.model.setUserModel(integrity::UserErrorModel::kDualFrequency);
+    else if (u == "single_frequency") m.model.setUserModel(integrity::UserErrorModel::kSingleFrequency);
+    else n.at("user_model").fail("\"dual_frequency\" or \"single_frequency\"");
   }
-  if (root.has("planner")) {
-    const JsonNode p = root.at("planner");
-    p.requireKnownFields(
-        {"algorithm", "time_limit_s", "iterations", "seed", "resolution_m", "simplify", "margin_m", "max_replans"});
-    if (p.has("algorithm")) {
-      const auto k = parsePlannerKind(p.at("algorithm").str());
-      if (!k) p.at("algorithm").fail("\"rrtstar\", \"informed_rrtstar\", \"bitstar\" or \"prmstar\"");
-      m.planner = *k;
-    }
-    if (p.has("time_limit_s")) m.time_limit_s = positive(p.at("time_limit_s"));
-    if (p.has("iterations")) {
-      const double it = p.at("iterations").number();
-      if (!(it >= 1 && it <= 1e9 && it == std::floor(it))) p.at("iterations").fail("a whole number 1…10⁹");
-      m.iterations = static_cast<std::uint64_t>(it);
-    }
-    if (p.has("seed")) {
-      const double s = p.at("seed").number();
-      if (!(s >= 0 && s < 4294967296.0 && s == std::floor(s))) p.at("seed").fail("a whole number 0…2³²−1");
-      m.seed = static_cast<std::uint64_t>(s);
-    }
-    if (p.has("resolution_m")) m.resolution_m = positive(p.at("resolution_m"));
-    if (p.has("simplify")) m.simplify = p.at("simplify").boolean();
-    if (p.has("margin_m")) m.margin_m = positive(p.at("margin_m"));
-    if (p.has("max_replans")) {
-      const double r = p.at("max_replans").number();
-      if (!(r >= 0 && r <= 20 && r == std::floor(r))) p.at("max_replans").fail("a whole number 0…20");
-      m.max_replans = static_cast<int>(r);
-    }
+  if (n.has("sample_s")) m.sample_s = positive(n.at("sample_s"));
+  if (n.has("cost_weight")) {
+    m.cost_weight = n.at("cost_weight").number();
+    if (!(m.cost_weight >= 0.0)) n.at("cost_weight").fail("a weight ≥ 0");
   }
+  if (n.has("cost_cell_m")) m.cost_cell_m = positive(n.at("cost_cell_m"));
+}
+
+void readPlannerSettings(const JsonNode& p, Mission& m) {
+  p.requireKnownFields(
+      {"algorithm", "time_limit_s", "iterations", "seed", "resolution_m", "simplify", "margin_m", "max_replans"});
+  if (p.has("algorithm")) {
+    const auto k = parsePlannerKind(p.at("algorithm").str());
+    if (!k) p.at("algorithm").fail("\"rrtstar\", \"informed_rrtstar\", \"bitstar\" or \"prmstar\"");
+    m.planner = *k;
+  }
+  if (p.has("time_limit_s")) m.time_limit_s = positive(p.at("time_limit_s"));
+  if (p.has("iterations")) {
+    const double it = p.at("iterations").number();
+    if (!(it >= 1 && it <= 1e9 && it == std::floor(it))) p.at("iterations").fail("a whole number 1…10⁹");
+    m.iterations = static_cast<std::uint64_t>(it);
+  }
+  if (p.has("seed")) {
+    const double s = p.at("seed").number();
+    if (!(s >= 0 && s < 4294967296.0 && s == std::floor(s))) p.at("seed").fail("a whole number 0…2³²−1");
+    m.seed = static_cast<std::uint64_t>(s);
+  }
+  if (p.has("resolution_m")) m.resolution_m = positive(p.at("resolution_m"));
+  if (p.has("simplify")) m.simplify = p.at("simplify").boolean();
+  if (p.has("margin_m")) m.margin_m = positive(p.at("margin_m"));
+  if (p.has("max_replans")) {
+    const double r = p.at("max_replans").number();
+    if (!(r >= 0 && r <= 20 && r == std::floor(r))) p.at("max_replans").fail("a whole number 0…20");
+    m.max_replans = static_cast<int>(r);
+  }
+}
+
+}  // namespace
+
+QgcPlanRoute parseQgcPlanRoute(const nlohmann::json& doc, const std::string& source) {
+  const JsonNode root{doc, "$", source};
+  const JsonNode mission = planMission(root);
+  PlanWalk w;
+  w.home = plannedHome(mission);
+  w.home_path = mission.path + ".plannedHomePosition";
+  const JsonNode items = mission.at("items");
+  for (std::size_t i = 0; i < items.array().size(); ++i) {
+    const JsonNode item = items.item(i);
+    if (const std::optional<int> command = routeCommand(item)) addRouteItem(w, item, *command);
+  }
+  if (w.route.points.size() < 2) {
+    items.fail("at least one NAV_WAYPOINT, NAV_LAND with a position or RETURN_TO_LAUNCH away from the start");
+  }
+  if (w.heights_agree && w.common_height_m) {
+    w.route.cruise_agl_m = *w.common_height_m;
+  } else {
+    w.route.cruise_agl_field.clear();
+  }
+  return w.route;
+}
+
+Mission parseMission(const nlohmann::json& doc, const std::string& source, const std::string& base_dir,
+                     const JsonFileReader& read_json) {
+  const JsonNode root{doc, "$", source};
+  requireMissionFields(root);
+  Mission m;
+  m.source = source;
+  if (root.has("name")) m.name = root.at("name").str();
+  readVehicle(root.at("vehicle"), m);
+  if (root.has("k1")) m.levels.k1 = root.at("k1").number();
+  if (root.has("k2")) m.levels.k2 = root.at("k2").number();
+  const std::optional<QgcPlanRoute> plan_route = readRoute(root, base_dir, read_json, m);
+  readAltitudes(root, plan_route, m);
+  readDeparture(root, m);
+  readDataFiles(root, base_dir, m);
+  if (root.has("integrity")) readIntegrity(root.at("integrity"), m);
+  if (root.has("planner")) readPlannerSettings(root.at("planner"), m);
   return m;
 }
 

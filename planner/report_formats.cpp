@@ -36,10 +36,81 @@ nlohmann::json reasonJson(const Reason& r, const maps::GpsTime& dep) {
   return j;
 }
 
+json routeJson(const ApprovalReport& r) {
+  json route = json::array();
+  for (const RoutePoint& p : r.route) {
+    route.push_back({{"lat", deg(p.lat_rad)},
+                     {"lon", deg(p.lon_rad)},
+                     {"h_ell_m", roundMm(p.h_ell_m)},
+                     {"alt_amsl_m", roundMm(p.alt_amsl_m)},
+                     {"eta", maps::formatRfc3339(r.departure.plus(p.eta_s), 1)},
+                     {"eta_s", roundMm(p.eta_s)}});
+  }
+  return route;
+}
+
+/// One predicted sample with its levels, the alert limits and the airspace margins.
+json predictedSampleJson(const PredictedSample& s, const ApprovalReport& r) {
+  json p{{"time", maps::formatRfc3339(r.departure.plus(s.t_s), 1)},
+         {"lat", deg(s.lat_rad)},
+         {"lon", deg(s.lon_rad)},
+         {"h_ell_m", roundMm(s.h_ell_m)},
+         {"satellites", s.satellites},
+         {"blocked", s.blocked},
+         {"hpl_m", s.pl_available ? json(roundMm(s.hpl_m)) : json(nullptr)},
+         {"vpl_m", s.pl_available ? json(roundMm(s.vpl_m)) : json(nullptr)},
+         {"hal1_m", roundMm(r.limits.level1.hal_m)},
+         {"val1_m", roundMm(r.limits.level1.val_m)},
+         {"hal2_m", roundMm(r.limits.level2.hal_m)},
+         {"val2_m", roundMm(r.limits.level2.val_m)}};
+  for (const geofence::Check& c : s.fence.checks) {
+    if (c.level == geofence::Level::kAirspace) {
+      p["margin_h_m"] = roundMm(c.margin_h_m);
+      p["margin_v_m"] = roundMm(c.margin_v_m);
+    }
+  }
+  return p;
+}
+
+json zonesJson(const ApprovalReport& r) {
+  json zones = json::array();
+  for (const ZoneApproach& z : r.zones) {
+    zones.push_back({{"id", z.identifier}, {"restriction", z.restriction}, {"counted", z.counted},
+                     {"min_clearance_m", roundMm(z.min_clearance_m)}});
+  }
+  return zones;
+}
+
+json plannerJson(const ApprovalReport& r, const Mission& m) {
+  return {{"algorithm", r.planner.algorithm},
+          {"status", r.planner.status},
+          {"straight_line", r.planner.straight_line},
+          {"planning_time_s", std::round(r.planner.planning_time_s * 1e4) / 1e4},
+          {"length_m", roundMm(r.planner.length_m)},
+          {"attempts", r.planner.attempts},
+          {"iterations", r.planner.iterations},
+          {"stopped_by_time", r.planner.stopped_by_time},
+          {"departures_tried", r.planner.departures_tried},
+          {"seed", m.seed}};
+}
+
+/// The inputs' digests: the approval can be audited and replayed against exactly these files.
+json inputsJson(const Mission& m) {
+  json inputs = json::array();
+  auto add = [&inputs](const std::string& role, const std::string& path) {
+    if (!path.empty()) inputs.push_back({{"role", role}, {"file", path}, {"sha256", maps::fileSha256Hex(path)}});
+  };
+  add("mission", m.source);
+  for (const std::string& f : m.zone_files) add("zones", f);
+  add("buildings", m.buildings_file);
+  add("terrain", m.terrain_file);
+  for (const std::string& f : m.orbit_files) add("orbits", f);
+  return inputs;
+}
+
 }  // namespace
 
 nlohmann::json approvalReportJson(const ApprovalReport& r, const Mission& m) {
-  using nlohmann::json;
   json j;
   j["mission"] = m.name;
   j["source"] = m.source;
@@ -50,72 +121,19 @@ nlohmann::json approvalReportJson(const ApprovalReport& r, const Mission& m) {
   for (const Reason& x : r.reasons) j["reasons"].push_back(reasonJson(x, r.departure));
   j["departure"] = maps::formatRfc3339(r.departure);
   if (r.earliest_passing_departure) j["earliest_passing_departure"] = maps::formatRfc3339(*r.earliest_passing_departure);
-  json route = json::array();
-  for (const RoutePoint& p : r.route) {
-    route.push_back({{"lat", deg(p.lat_rad)},
-                     {"lon", deg(p.lon_rad)},
-                     {"h_ell_m", roundMm(p.h_ell_m)},
-                     {"alt_amsl_m", roundMm(p.alt_amsl_m)},
-                     {"eta", maps::formatRfc3339(r.departure.plus(p.eta_s), 1)},
-                     {"eta_s", roundMm(p.eta_s)}});
-  }
-  j["route"] = route;
+  j["route"] = routeJson(r);
   j["corridor"] = {{"level", 1}, {"hal_m", roundMm(r.limits.level1.hal_m)}, {"val_m", roundMm(r.limits.level1.val_m)},
                    {"k", m.levels.k1}, {"centre_line", "route"}};
   j["airspace"] = {{"level", 2}, {"hal_m", roundMm(r.limits.level2.hal_m)}, {"val_m", roundMm(r.limits.level2.val_m)},
                    {"k", m.levels.k2}, {"centre_line", "route"}};
   json predicted = json::array();
-  for (const PredictedSample& s : r.predicted) {
-    json p{{"time", maps::formatRfc3339(r.departure.plus(s.t_s), 1)},
-           {"lat", deg(s.lat_rad)},
-           {"lon", deg(s.lon_rad)},
-           {"h_ell_m", roundMm(s.h_ell_m)},
-           {"satellites", s.satellites},
-           {"blocked", s.blocked},
-           {"hpl_m", s.pl_available ? json(roundMm(s.hpl_m)) : json(nullptr)},
-           {"vpl_m", s.pl_available ? json(roundMm(s.vpl_m)) : json(nullptr)},
-           {"hal1_m", roundMm(r.limits.level1.hal_m)},
-           {"val1_m", roundMm(r.limits.level1.val_m)},
-           {"hal2_m", roundMm(r.limits.level2.hal_m)},
-           {"val2_m", roundMm(r.limits.level2.val_m)}};
-    for (const geofence::Check& c : s.fence.checks) {
-      if (c.level == geofence::Level::kAirspace) {
-        p["margin_h_m"] = roundMm(c.margin_h_m);
-        p["margin_v_m"] = roundMm(c.margin_v_m);
-      }
-    }
-    predicted.push_back(p);
-  }
+  for (const PredictedSample& s : r.predicted) predicted.push_back(predictedSampleJson(s, r));
   j["predicted"] = predicted;
   j["level1_exceedances"] = r.level1_exceedances;
-  json zones = json::array();
-  for (const ZoneApproach& z : r.zones) {
-    zones.push_back({{"id", z.identifier}, {"restriction", z.restriction}, {"counted", z.counted},
-                     {"min_clearance_m", roundMm(z.min_clearance_m)}});
-  }
-  j["zones"] = zones;
-  j["planner"] = {{"algorithm", r.planner.algorithm},
-                  {"status", r.planner.status},
-                  {"straight_line", r.planner.straight_line},
-                  {"planning_time_s", std::round(r.planner.planning_time_s * 1e4) / 1e4},
-                  {"length_m", roundMm(r.planner.length_m)},
-                  {"attempts", r.planner.attempts},
-                  {"iterations", r.planner.iterations},
-                  {"stopped_by_time", r.planner.stopped_by_time},
-                  {"departures_tried", r.planner.departures_tried},
-                  {"seed", m.seed}};
+  j["zones"] = zonesJson(r);
+  j["planner"] = plannerJson(r, m);
   j["elapsed_s"] = std::round(r.elapsed_s * 1e3) / 1e3;
-  // The inputs' digests: the approval can be audited and replayed against exactly these files.
-  json inputs = json::array();
-  auto add = [&inputs](const std::string& role, const std::string& path) {
-    if (!path.empty()) inputs.push_back({{"role", role}, {"file", path}, {"sha256", maps::fileSha256Hex(path)}});
-  };
-  add("mission", m.source);
-  for (const std::string& f : m.zone_files) add("zones", f);
-  add("buildings", m.buildings_file);
-  add("terrain", m.terrain_file);
-  for (const std::string& f : m.orbit_files) add("orbits", f);
-  j["inputs"] = inputs;
+  j["inputs"] = inputsJson(m);
   j["software"] = {{"name", "skylane"}, {"planner_seed", m.seed}};
   return j;
 }

@@ -20,6 +20,7 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 
 namespace skylane::planner {
@@ -113,9 +114,7 @@ bool motionValid(const PathProblem& p, const Eigen::Vector3d& a, const Eigen::Ve
   return true;
 }
 
-}  // namespace
-
-PathResult planPath(const PathProblem& p) {
+void checkProblem(const PathProblem& p) {
   if (!p.is_valid) throw std::invalid_argument("planPath: a state validity predicate is required");
   if (!(p.resolution_m > 0.0) || !std::isfinite(p.resolution_m)) {
     throw std::invalid_argument("planPath: the motion resolution must be a positive number of metres");
@@ -124,31 +123,21 @@ PathResult planPath(const PathProblem& p) {
     throw std::invalid_argument("planPath: the search box is empty (upper ≤ lower on some axis)");
   }
   if (!(p.time_limit_s > 0.0)) throw std::invalid_argument("planPath: the time limit must be > 0 s");
-  PathResult out;
-  out.planner = std::string(plannerName(p.planner));
+}
+
+/// kInvalidStart or kInvalidGoal when that end is outside the box or not valid; nothing when
+/// both are fine.
+std::optional<PathStatus> invalidEnd(const PathProblem& p) {
   auto inside = [&](const Eigen::Vector3d& x) {
     return (x.array() >= p.lower_enu_m.array()).all() && (x.array() <= p.upper_enu_m.array()).all();
   };
-  if (!inside(p.start_enu_m) || !p.is_valid(p.start_enu_m)) {
-    out.status = PathStatus::kInvalidStart;
-    return out;
-  }
-  if (!inside(p.goal_enu_m) || !p.is_valid(p.goal_enu_m)) {
-    out.status = PathStatus::kInvalidGoal;
-    return out;
-  }
-  if (!p.extra_cost && motionValid(p, p.start_enu_m, p.goal_enu_m)) {
-    out.status = PathStatus::kExact;
-    out.points = {p.start_enu_m, p.goal_enu_m};
-    out.length_m = out.cost = polylineLength(out.points);
-    out.straight_line = true;
-    return out;
-  }
+  if (!inside(p.start_enu_m) || !p.is_valid(p.start_enu_m)) return PathStatus::kInvalidStart;
+  if (!inside(p.goal_enu_m) || !p.is_valid(p.goal_enu_m)) return PathStatus::kInvalidGoal;
+  return std::nullopt;
+}
 
-  const std::lock_guard<std::mutex> lock(omplMutex());
-  ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
-  ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(p.seed % 4294967291ULL + 1));
-
+/// The search box as an OMPL state space.
+std::shared_ptr<ob::RealVectorStateSpace> searchSpace(const PathProblem& p) {
   auto space = std::make_shared<ob::RealVectorStateSpace>(3);
   ob::RealVectorBounds bounds(3);
   for (int i = 0; i < 3; ++i) {
@@ -156,7 +145,11 @@ PathResult planPath(const PathProblem& p) {
     bounds.setHigh(i, p.upper_enu_m[i]);
   }
   space->setBounds(bounds);
-  og::SimpleSetup ss(space);
+  return space;
+}
+
+/// Validity checker, motion resolution, start and goal.
+void setProblem(og::SimpleSetup& ss, const ob::StateSpacePtr& space, const PathProblem& p) {
   ss.setStateValidityChecker([&p](const ob::State* s) { return p.is_valid(toVector(s)); });
   // Motions are checked every resolution_m metres: OMPL takes it as a fraction of the extent.
   ss.getSpaceInformation()->setStateValidityCheckingResolution(
@@ -167,7 +160,10 @@ PathResult planPath(const PathProblem& p) {
     goal[i] = p.goal_enu_m[i];
   }
   ss.setStartAndGoalStates(start, goal, 1e-6);
-  const ob::SpaceInformationPtr si = ss.getSpaceInformation();
+}
+
+/// Path length, or length + integrity cost; "good enough" at good_enough_factor × the straight line.
+ob::OptimizationObjectivePtr objectiveFor(const ob::SpaceInformationPtr& si, const PathProblem& p) {
   ob::OptimizationObjectivePtr objective;
   if (p.extra_cost) {
     objective = std::make_shared<IntegrityCostObjective>(si, p.extra_cost, p.cost_step_m);
@@ -176,17 +172,23 @@ PathResult planPath(const PathProblem& p) {
   }
   const double straight = (p.goal_enu_m - p.start_enu_m).norm();
   objective->setCostThreshold(ob::Cost(p.good_enough_factor > 1.0 ? p.good_enough_factor * straight : 0.0));
-  ss.setOptimizationObjective(objective);
+  return objective;
+}
+
+ob::PlannerPtr makePlanner(PlannerKind kind, const ob::SpaceInformationPtr& si) {
   ob::PlannerPtr planner;
-  switch (p.planner) {
+  switch (kind) {
     case PlannerKind::kRrtStar: planner = std::make_shared<og::RRTstar>(si); break;
     case PlannerKind::kInformedRrtStar: planner = std::make_shared<og::InformedRRTstar>(si); break;
     case PlannerKind::kBitStar: planner = std::make_shared<og::BITstar>(si); break;
     case PlannerKind::kPrmStar: planner = std::make_shared<og::PRMstar>(si); break;
   }
-  ss.setPlanner(planner);
-  ss.setup();
+  return planner;
+}
 
+/// Solves until the iteration budget or the time limit; records time, iterations and which
+/// limit stopped it.
+ob::PlannerStatus solveWithinLimits(og::SimpleSetup& ss, const PathProblem& p, PathResult& out) {
   const auto t0 = std::chrono::steady_clock::now();
   std::atomic<std::uint64_t> checks{0};
   std::atomic<bool> by_time{false};
@@ -203,21 +205,66 @@ PathResult planPath(const PathProblem& p) {
   out.planning_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.iterations = checks;
   out.stopped_by_time = by_time;
-  if (status != ob::PlannerStatus::EXACT_SOLUTION && status != ob::PlannerStatus::APPROXIMATE_SOLUTION) {
-    out.status = PathStatus::kNoSolution;
-    return out;
-  }
-  out.status = status == ob::PlannerStatus::EXACT_SOLUTION ? PathStatus::kExact : PathStatus::kApproximate;
+  return status;
+}
+
+/// The solution path (simplified when asked), its length and cost.
+void takeSolution(og::SimpleSetup& ss, const ob::OptimizationObjectivePtr& objective, const PathProblem& p,
+                  PathResult& out) {
   og::PathGeometric& path = ss.getSolutionPath();
   if (p.simplify) {
     const auto t1 = std::chrono::steady_clock::now();
-    og::PathSimplifier simplifier(si, ob::GoalPtr(), objective);
+    og::PathSimplifier simplifier(ss.getSpaceInformation(), ob::GoalPtr(), objective);
     simplifier.simplifyMax(path);
     out.simplify_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   }
   for (std::size_t i = 0; i < path.getStateCount(); ++i) out.points.push_back(toVector(path.getState(i)));
   out.length_m = polylineLength(out.points);
   out.cost = path.cost(objective).value();
+}
+
+/// Plans with OMPL (the straight line did not do).
+void planWithOmpl(const PathProblem& p, PathResult& out) {
+  const std::lock_guard<std::mutex> lock(omplMutex());
+  ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
+  ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(p.seed % 4294967291ULL + 1));
+
+  const std::shared_ptr<ob::RealVectorStateSpace> space = searchSpace(p);
+  og::SimpleSetup ss(space);
+  setProblem(ss, space, p);
+  const ob::SpaceInformationPtr si = ss.getSpaceInformation();
+  const ob::OptimizationObjectivePtr objective = objectiveFor(si, p);
+  ss.setOptimizationObjective(objective);
+  ss.setPlanner(makePlanner(p.planner, si));
+  ss.setup();
+
+  const ob::PlannerStatus status = solveWithinLimits(ss, p, out);
+  if (status != ob::PlannerStatus::EXACT_SOLUTION && status != ob::PlannerStatus::APPROXIMATE_SOLUTION) {
+    out.status = PathStatus::kNoSolution;
+    return;
+  }
+  out.status = status == ob::PlannerStatus::EXACT_SOLUTION ? PathStatus::kExact : PathStatus::kApproximate;
+  takeSolution(ss, objective, p, out);
+}
+
+}  // namespace
+
+PathResult planPath(const PathProblem& p) {
+  checkProblem(p);
+  PathResult out;
+  out.planner = std::string(plannerName(p.planner));
+  if (const std::optional<PathStatus> invalid = invalidEnd(p)) {
+    out.status = *invalid;
+    return out;
+  }
+  if (!p.extra_cost && motionValid(p, p.start_enu_m, p.goal_enu_m)) {
+    out.status = PathStatus::kExact;
+    out.points = {p.start_enu_m, p.goal_enu_m};
+    out.length_m = out.cost = polylineLength(out.points);
+    out.straight_line = true;
+    return out;
+  }
+  planWithOmpl(p, out);
   return out;
 }
 

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <string>
 
 namespace skylane::integrity {
 namespace {
@@ -75,6 +77,144 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
   return std::isfinite(out.sigma[0]) && std::isfinite(out.sigma[2]);
 }
 
+/// Why ARAIM cannot run on this geometry (too few satellites, a constellation with a single
+/// one), or nothing.
+std::optional<std::string> geometryShortfall(const Geometry& g) {
+  const int n = g.numSats(), m = g.numStates();
+  if (n < m + 1) {
+    return "too few satellites: " + std::to_string(n) + " in view, ARAIM needs at least " + std::to_string(m + 1) +
+           " for " + std::to_string(m) + " unknowns (3 + one clock per constellation)";
+  }
+  for (Constellation c : g.clocks) {
+    const auto count = std::count_if(g.sats.begin(), g.sats.end(), [&](const SatId& s) { return s.constellation == c; });
+    if (count == 1) {
+      return std::string("constellation ") + constellationName(c) +
+             " has a single satellite: it only fixes its own clock and cannot be checked";
+    }
+  }
+  return std::nullopt;
+}
+
+AllInView allInView(const Geometry& g) {
+  AllInView aiv;
+  const Eigen::VectorXd w = g.sigma_int.array().square().inverse();
+  aiv.A = g.G.transpose() * w.asDiagonal();
+  aiv.N = aiv.A * g.G;
+  return aiv;
+}
+
+/// The all-in-view projection, sigmas, nominal biases and vertical accuracy sigma.
+void setAllInViewErrors(AraimResult& out, const Geometry& g, const SubsetSolution& all, const Eigen::VectorXd& c_acc) {
+  out.S0 = all.S;
+  for (int q = 0; q < 3; ++q) {
+    out.sigma0[q] = all.sigma[q];
+    out.bias0[q] = out.S0.row(q).cwiseAbs().dot(g.bnom);  // b_q^(0) = Σ|S_q,i| b_nom,i
+  }
+  out.sigma_acc_v_m = std::sqrt(out.S0.row(2).cwiseAbs2().dot(c_acc));
+}
+
+/// Fault modes from the ISM.
+FaultModeSet faultModes(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg) {
+  std::vector<Constellation> cons;
+  std::vector<double> p_sat;
+  for (const SatId& s : g.sats) {
+    cons.push_back(s.constellation);
+    p_sat.push_back(model.of(s.constellation).psat);
+  }
+  std::vector<double> p_const(kNumConstellations);
+  for (Constellation c : kAllConstellations) p_const[static_cast<std::size_t>(c)] = model.of(c).pconst;
+  return determineFaultModes(cons, p_sat, p_const, cfg.requirements.p_thres, cfg.rule);
+}
+
+/// One subset solution per monitorable fault mode; an unmonitorable mode's prior goes to the
+/// unmonitored probability.
+void monitorFaultModes(AraimResult& out, const Geometry& g, const AllInView& aiv, const FaultModeSet& fm,
+                       const Eigen::VectorXd& c_acc) {
+  out.n_fault_max = fm.n_fault_max;
+  out.p_not_monitored = fm.p_not_monitored;
+  for (const FaultMode& mode : fm.modes) {
+    SubsetSolution s;
+    s.removed = mode.removed;
+    s.prior = mode.prior;
+    s.event_prior = mode.event_prior;
+    if (!subsetSolution(g, aiv, mode.removed, s)) {
+      out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
+      continue;
+    }
+    const Eigen::MatrixXd dS = s.S - out.S0;
+    for (int q = 0; q < 3; ++q) {
+      s.sigma_ss[q] = std::sqrt(dS.row(q).cwiseAbs2().dot(c_acc));  // ADD Eq. 21 (C_acc)
+      s.bias[q] = s.S.row(q).cwiseAbs().dot(g.bnom);
+      s.sigma_acc[q] = std::sqrt(s.S.row(q).cwiseAbs2().dot(c_acc));
+    }
+    out.subsets.push_back(std::move(s));
+  }
+}
+
+/// Solution separation thresholds of every subset.
+void setThresholds(AraimResult& out, const Requirements& req) {
+  out.fault_modes = static_cast<int>(out.subsets.size());
+  const double nfm = std::max(1, out.fault_modes);
+  out.k_fa_h = normalTailInverse(req.pfa_hor / (4.0 * nfm));   // ADD Eq. 26
+  out.k_fa_v = normalTailInverse(req.pfa_vert / (2.0 * nfm));  // ADD Eq. 27
+  for (SubsetSolution& s : out.subsets) {
+    s.threshold = {out.k_fa_h * s.sigma_ss[0], out.k_fa_h * s.sigma_ss[1], out.k_fa_v * s.sigma_ss[2]};
+  }
+}
+
+/// Protection levels per axis and the EMT; false (with the reason) when the unmonitored
+/// probability leaves no budget.
+bool solveProtectionLevels(AraimResult& out, const Requirements& req) {
+  // Risk budgets (ADD Eq. 31–32): the unmonitored probability is taken off the top.
+  const double scale = 1.0 - out.p_not_monitored / (req.phmi_vert + req.phmi_hor);
+  if (!(scale > 0.0)) {
+    out.reason = "the unmonitored fault probability " + std::to_string(out.p_not_monitored) +
+                 " exceeds the integrity budget";
+    return false;
+  }
+  const double budget_v = req.phmi_vert * scale;
+  const double budget_h = 0.5 * req.phmi_hor * scale;  // per horizontal axis
+  std::array<double, 3> pl{}, pl_eq{};
+  for (int q = 0; q < 3; ++q) {
+    std::vector<RiskTerm> terms;
+    terms.reserve(out.subsets.size() + 1);
+    terms.push_back({2.0, 0.0, out.bias0[q], out.sigma0[q]});
+    for (const SubsetSolution& s : out.subsets) terms.push_back({s.prior, s.threshold[q], s.bias[q], s.sigma[q]});
+    pl[q] = solveProtectionLevel(terms, q == 2 ? budget_v : budget_h, req.tol_pl_m, &pl_eq[q]);
+  }
+  out.hpl_axis_m = {pl[0], pl[1]};
+  out.hpl_m = std::hypot(pl[0], pl[1]);
+  out.vpl_m = pl[2];
+  out.hpl_equal_allocation_m = std::hypot(pl_eq[0], pl_eq[1]);
+  out.vpl_equal_allocation_m = pl_eq[2];
+  // EMT (ADD Eq. 35): the largest vertical threshold among modes whose probability is at least
+  // P_EMT. The ISM rate ∏p_e is compared (a single-satellite mode at P_sat = P_EMT = 1e-5 counts;
+  // its exclusive prior, 1e-5·∏(1 − p), is a hair below and would not).
+  for (const SubsetSolution& s : out.subsets) {
+    if (s.event_prior >= req.p_emt) out.emt_m = std::max(out.emt_m, s.threshold[2]);
+  }
+  return true;
+}
+
+/// Available when the levels are within the alert limits (and, unless horizontal only, the EMT
+/// and the accuracy within theirs); else the first limit exceeded is the reason.
+void judgeAvailability(AraimResult& out, const AraimConfig& cfg) {
+  const Requirements& req = cfg.requirements;
+  if (cfg.horizontal_only) {
+    out.available = out.hpl_m <= req.hal_m;
+    if (!out.available) out.reason = "HPL exceeds HAL";
+    return;
+  }
+  out.available = out.vpl_m <= req.val_m && out.hpl_m <= req.hal_m && out.emt_m <= req.emt_m &&
+                  out.sigma_acc_v_m <= req.sigma_acc_m;
+  if (!out.available) {
+    out.reason = out.vpl_m > req.val_m     ? "VPL exceeds VAL"
+                 : out.hpl_m > req.hal_m   ? "HPL exceeds HAL"
+                 : out.emt_m > req.emt_m   ? "EMT exceeds its limit"
+                                           : "sigma_acc exceeds its limit";
+  }
+}
+
 }  // namespace
 
 double integrityRisk(const std::vector<RiskTerm>& terms, double pl) {
@@ -105,121 +245,27 @@ double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, d
 
 AraimResult araimProtectionLevels(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg) {
   AraimResult out;
-  const Requirements& req = cfg.requirements;
-  const int n = g.numSats(), m = g.numStates();
-  if (n < m + 1) {
-    out.reason = "too few satellites: " + std::to_string(n) + " in view, ARAIM needs at least " + std::to_string(m + 1) +
-                 " for " + std::to_string(m) + " unknowns (3 + one clock per constellation)";
+  if (const std::optional<std::string> why = geometryShortfall(g)) {
+    out.reason = *why;
     return out;
   }
-  for (Constellation c : g.clocks) {
-    const auto count = std::count_if(g.sats.begin(), g.sats.end(), [&](const SatId& s) { return s.constellation == c; });
-    if (count == 1) {
-      out.reason = std::string("constellation ") + constellationName(c) +
-                   " has a single satellite: it only fixes its own clock and cannot be checked";
-      return out;
-    }
-  }
-  AllInView aiv;
-  const Eigen::VectorXd w = g.sigma_int.array().square().inverse();
-  aiv.A = g.G.transpose() * w.asDiagonal();
-  aiv.N = aiv.A * g.G;
+  const AllInView aiv = allInView(g);
   SubsetSolution all;
   if (!subsetSolution(g, aiv, {}, all)) {
     out.reason = "singular geometry: the satellites do not fix position and clocks";
     return out;
   }
-  out.S0 = all.S;
   const Eigen::VectorXd c_acc = g.sigma_acc.array().square();
-  for (int q = 0; q < 3; ++q) {
-    out.sigma0[q] = all.sigma[q];
-    out.bias0[q] = out.S0.row(q).cwiseAbs().dot(g.bnom);  // b_q^(0) = Σ|S_q,i| b_nom,i
-  }
-  out.sigma_acc_v_m = std::sqrt(out.S0.row(2).cwiseAbs2().dot(c_acc));
-
-  // Fault modes from the ISM.
-  std::vector<Constellation> cons;
-  std::vector<double> p_sat;
-  for (const SatId& s : g.sats) {
-    cons.push_back(s.constellation);
-    p_sat.push_back(model.of(s.constellation).psat);
-  }
-  std::vector<double> p_const(kNumConstellations);
-  for (Constellation c : kAllConstellations) p_const[static_cast<std::size_t>(c)] = model.of(c).pconst;
-  const FaultModeSet fm = determineFaultModes(cons, p_sat, p_const, req.p_thres, cfg.rule);
-  out.n_fault_max = fm.n_fault_max;
-  out.p_not_monitored = fm.p_not_monitored;
-  for (const FaultMode& mode : fm.modes) {
-    SubsetSolution s;
-    s.removed = mode.removed;
-    s.prior = mode.prior;
-    s.event_prior = mode.event_prior;
-    if (!subsetSolution(g, aiv, mode.removed, s)) {
-      out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
-      continue;
-    }
-    const Eigen::MatrixXd dS = s.S - out.S0;
-    for (int q = 0; q < 3; ++q) {
-      s.sigma_ss[q] = std::sqrt(dS.row(q).cwiseAbs2().dot(c_acc));  // ADD Eq. 21 (C_acc)
-      s.bias[q] = s.S.row(q).cwiseAbs().dot(g.bnom);
-      s.sigma_acc[q] = std::sqrt(s.S.row(q).cwiseAbs2().dot(c_acc));
-    }
-    out.subsets.push_back(std::move(s));
-  }
-  out.fault_modes = static_cast<int>(out.subsets.size());
-  const double nfm = std::max(1, out.fault_modes);
-  out.k_fa_h = normalTailInverse(req.pfa_hor / (4.0 * nfm));   // ADD Eq. 26
-  out.k_fa_v = normalTailInverse(req.pfa_vert / (2.0 * nfm));  // ADD Eq. 27
-  for (SubsetSolution& s : out.subsets) {
-    s.threshold = {out.k_fa_h * s.sigma_ss[0], out.k_fa_h * s.sigma_ss[1], out.k_fa_v * s.sigma_ss[2]};
-  }
-
-  // Risk budgets (ADD Eq. 31–32): the unmonitored probability is taken off the top.
-  const double scale = 1.0 - out.p_not_monitored / (req.phmi_vert + req.phmi_hor);
-  if (!(scale > 0.0)) {
-    out.reason = "the unmonitored fault probability " + std::to_string(out.p_not_monitored) +
-                 " exceeds the integrity budget";
-    return out;
-  }
-  const double budget_v = req.phmi_vert * scale;
-  const double budget_h = 0.5 * req.phmi_hor * scale;  // per horizontal axis
-  std::array<double, 3> pl{}, pl_eq{};
-  for (int q = 0; q < 3; ++q) {
-    std::vector<RiskTerm> terms;
-    terms.reserve(out.subsets.size() + 1);
-    terms.push_back({2.0, 0.0, out.bias0[q], out.sigma0[q]});
-    for (const SubsetSolution& s : out.subsets) terms.push_back({s.prior, s.threshold[q], s.bias[q], s.sigma[q]});
-    pl[q] = solveProtectionLevel(terms, q == 2 ? budget_v : budget_h, req.tol_pl_m, &pl_eq[q]);
-  }
-  out.hpl_axis_m = {pl[0], pl[1]};
-  out.hpl_m = std::hypot(pl[0], pl[1]);
-  out.vpl_m = pl[2];
-  out.hpl_equal_allocation_m = std::hypot(pl_eq[0], pl_eq[1]);
-  out.vpl_equal_allocation_m = pl_eq[2];
-  // EMT (ADD Eq. 35): the largest vertical threshold among modes whose probability is at least
-  // P_EMT. The ISM rate ∏p_e is compared (a single-satellite mode at P_sat = P_EMT = 1e-5 counts;
-  // its exclusive prior, 1e-5·∏(1 − p), is a hair below and would not).
-  for (const SubsetSolution& s : out.subsets) {
-    if (s.event_prior >= req.p_emt) out.emt_m = std::max(out.emt_m, s.threshold[2]);
-  }
+  setAllInViewErrors(out, g, all, c_acc);
+  monitorFaultModes(out, g, aiv, faultModes(g, model, cfg), c_acc);
+  setThresholds(out, cfg.requirements);
+  if (!solveProtectionLevels(out, cfg.requirements)) return out;
   out.pl_computed = std::isfinite(out.hpl_m) && std::isfinite(out.vpl_m);
   if (!out.pl_computed) {
     out.reason = "protection level is not finite";
     return out;
   }
-  if (cfg.horizontal_only) {
-    out.available = out.hpl_m <= req.hal_m;
-    if (!out.available) out.reason = "HPL exceeds HAL";
-  } else {
-    out.available = out.vpl_m <= req.val_m && out.hpl_m <= req.hal_m && out.emt_m <= req.emt_m &&
-                    out.sigma_acc_v_m <= req.sigma_acc_m;
-    if (!out.available) {
-      out.reason = out.vpl_m > req.val_m     ? "VPL exceeds VAL"
-                   : out.hpl_m > req.hal_m   ? "HPL exceeds HAL"
-                   : out.emt_m > req.emt_m   ? "EMT exceeds its limit"
-                                             : "sigma_acc exceeds its limit";
-    }
-  }
+  judgeAvailability(out, cfg);
   return out;
 }
 

@@ -117,6 +117,83 @@ struct Reader {
   }
 };
 
+NmeaGga readGga(const Reader& r) {
+  NmeaGga g;
+  g.utc = r.time(1);
+  g.lat_rad = r.angle(2, 2, 'N', 'S', "latitude", 90.0);
+  g.lon_rad = r.angle(4, 3, 'E', 'W', "longitude", 180.0);
+  g.quality = r.integer(6, "fix quality", 0, 9).value_or(0);
+  g.satellites = r.integer(7, "satellites used", 0, 999).value_or(0);
+  g.hdop = r.real(8, "HDOP");
+  g.alt_msl_m = r.real(9, "altitude above the geoid");
+  if (g.alt_msl_m && r.text(10) != "M") throw ParseError(r.source, 0, r.name(10, "altitude unit"), r.text(10), "'M'");
+  g.geoid_separation_m = r.real(11, "geoid separation");
+  if (g.geoid_separation_m && r.text(12) != "M") {
+    throw ParseError(r.source, 0, r.name(12, "separation unit"), r.text(12), "'M'");
+  }
+  if (g.lat_rad.has_value() != g.lon_rad.has_value()) {
+    throw ParseError(r.source, 0, r.name(2, "position"), "", "both latitude and longitude, or neither");
+  }
+  return g;
+}
+
+NmeaGst readGst(const Reader& r) {
+  NmeaGst g;
+  g.utc = r.time(1);
+  g.rms_m = r.real(2, "RMS");
+  g.semi_major_m = r.real(3, "semi-major σ");
+  g.semi_minor_m = r.real(4, "semi-minor σ");
+  g.orientation_deg = r.real(5, "orientation");
+  g.sigma_lat_m = r.real(6, "latitude σ");
+  g.sigma_lon_m = r.real(7, "longitude σ");
+  g.sigma_alt_m = r.real(8, "altitude σ");
+  for (const auto* v : {&g.rms_m, &g.semi_major_m, &g.semi_minor_m, &g.sigma_lat_m, &g.sigma_lon_m, &g.sigma_alt_m}) {
+    if (*v && **v < 0) throw ParseError(r.source, 0, "GST", r.text(2), "error statistics ≥ 0");
+  }
+  return g;
+}
+
+NmeaGbs readGbs(const Reader& r) {
+  NmeaGbs g;
+  g.utc = r.time(1);
+  g.err_lat_m = r.real(2, "expected latitude error");
+  g.err_lon_m = r.real(3, "expected longitude error");
+  g.err_alt_m = r.real(4, "expected altitude error");
+  g.failed_satellite = r.integer(5, "failed satellite", 0, 999);
+  g.p_missed_detection = r.real(6, "probability of missed detection");
+  if (g.p_missed_detection && (*g.p_missed_detection < 0 || *g.p_missed_detection > 1)) {
+    throw ParseError(r.source, 0, r.name(6, "probability of missed detection"), r.text(6), "a probability 0…1");
+  }
+  g.bias_m = r.real(7, "bias");
+  g.bias_sigma_m = r.real(8, "bias σ");
+  return g;
+}
+
+NmeaDate readRmc(const Reader& r) {
+  NmeaDate d;
+  d.utc = r.time(1);
+  const std::string& t = r.text(9);
+  if (t.size() != 6 || t.find_first_not_of("0123456789") != std::string::npos) {
+    throw ParseError(r.source, 0, r.name(9, "date ddmmyy"), t, "a date ddmmyy");
+  }
+  d.day = std::atoi(t.substr(0, 2).c_str());
+  d.month = std::atoi(t.substr(2, 2).c_str());
+  const int yy = std::atoi(t.substr(4, 2).c_str());
+  d.year = yy < 80 ? 2000 + yy : 1900 + yy;  // NMEA's two-digit year: 1980–2079
+  if (!isValidCalendar({d.year, d.month, d.day, 0, 0, 0.0})) throw ParseError(r.source, 0, r.name(9, "date ddmmyy"), t, "a valid date");
+  return d;
+}
+
+NmeaDate readZda(const Reader& r) {
+  NmeaDate d;
+  d.utc = r.time(1);
+  d.day = r.integer(2, "day", 1, 31).value_or(0);
+  d.month = r.integer(3, "month", 1, 12).value_or(0);
+  d.year = r.integer(4, "year", 1980, 2200).value_or(0);
+  if (!isValidCalendar({d.year, d.month, d.day, 0, 0, 0.0})) throw ParseError(r.source, 0, r.name(2, "date"), r.text(2), "a valid date");
+  return d;
+}
+
 }  // namespace
 
 NmeaSentence parseNmeaSentence(const std::string& line, const std::string& source) {
@@ -127,78 +204,11 @@ NmeaSentence parseNmeaSentence(const std::string& line, const std::string& sourc
   }
   const std::string type = address.substr(2);
   const Reader r{f, source, type};
-  if (type == "GGA") {
-    NmeaGga g;
-    g.utc = r.time(1);
-    g.lat_rad = r.angle(2, 2, 'N', 'S', "latitude", 90.0);
-    g.lon_rad = r.angle(4, 3, 'E', 'W', "longitude", 180.0);
-    g.quality = r.integer(6, "fix quality", 0, 9).value_or(0);
-    g.satellites = r.integer(7, "satellites used", 0, 999).value_or(0);
-    g.hdop = r.real(8, "HDOP");
-    g.alt_msl_m = r.real(9, "altitude above the geoid");
-    if (g.alt_msl_m && r.text(10) != "M") throw ParseError(source, 0, r.name(10, "altitude unit"), r.text(10), "'M'");
-    g.geoid_separation_m = r.real(11, "geoid separation");
-    if (g.geoid_separation_m && r.text(12) != "M") {
-      throw ParseError(source, 0, r.name(12, "separation unit"), r.text(12), "'M'");
-    }
-    if (g.lat_rad.has_value() != g.lon_rad.has_value()) {
-      throw ParseError(source, 0, r.name(2, "position"), "", "both latitude and longitude, or neither");
-    }
-    return g;
-  }
-  if (type == "GST") {
-    NmeaGst g;
-    g.utc = r.time(1);
-    g.rms_m = r.real(2, "RMS");
-    g.semi_major_m = r.real(3, "semi-major σ");
-    g.semi_minor_m = r.real(4, "semi-minor σ");
-    g.orientation_deg = r.real(5, "orientation");
-    g.sigma_lat_m = r.real(6, "latitude σ");
-    g.sigma_lon_m = r.real(7, "longitude σ");
-    g.sigma_alt_m = r.real(8, "altitude σ");
-    for (const auto* v : {&g.rms_m, &g.semi_major_m, &g.semi_minor_m, &g.sigma_lat_m, &g.sigma_lon_m, &g.sigma_alt_m}) {
-      if (*v && **v < 0) throw ParseError(source, 0, "GST", r.text(2), "error statistics ≥ 0");
-    }
-    return g;
-  }
-  if (type == "GBS") {
-    NmeaGbs g;
-    g.utc = r.time(1);
-    g.err_lat_m = r.real(2, "expected latitude error");
-    g.err_lon_m = r.real(3, "expected longitude error");
-    g.err_alt_m = r.real(4, "expected altitude error");
-    g.failed_satellite = r.integer(5, "failed satellite", 0, 999);
-    g.p_missed_detection = r.real(6, "probability of missed detection");
-    if (g.p_missed_detection && (*g.p_missed_detection < 0 || *g.p_missed_detection > 1)) {
-      throw ParseError(source, 0, r.name(6, "probability of missed detection"), r.text(6), "a probability 0…1");
-    }
-    g.bias_m = r.real(7, "bias");
-    g.bias_sigma_m = r.real(8, "bias σ");
-    return g;
-  }
-  if (type == "RMC") {
-    NmeaDate d;
-    d.utc = r.time(1);
-    const std::string& t = r.text(9);
-    if (t.size() != 6 || t.find_first_not_of("0123456789") != std::string::npos) {
-      throw ParseError(source, 0, r.name(9, "date ddmmyy"), t, "a date ddmmyy");
-    }
-    d.day = std::atoi(t.substr(0, 2).c_str());
-    d.month = std::atoi(t.substr(2, 2).c_str());
-    const int yy = std::atoi(t.substr(4, 2).c_str());
-    d.year = yy < 80 ? 2000 + yy : 1900 + yy;  // NMEA's two-digit year: 1980–2079
-    if (!isValidCalendar({d.year, d.month, d.day, 0, 0, 0.0})) throw ParseError(source, 0, r.name(9, "date ddmmyy"), t, "a valid date");
-    return d;
-  }
-  if (type == "ZDA") {
-    NmeaDate d;
-    d.utc = r.time(1);
-    d.day = r.integer(2, "day", 1, 31).value_or(0);
-    d.month = r.integer(3, "month", 1, 12).value_or(0);
-    d.year = r.integer(4, "year", 1980, 2200).value_or(0);
-    if (!isValidCalendar({d.year, d.month, d.day, 0, 0, 0.0})) throw ParseError(source, 0, r.name(2, "date"), r.text(2), "a valid date");
-    return d;
-  }
+  if (type == "GGA") return readGga(r);
+  if (type == "GST") return readGst(r);
+  if (type == "GBS") return readGbs(r);
+  if (type == "RMC") return readRmc(r);
+  if (type == "ZDA") return readZda(r);
   return NmeaOther{type};
 }
 

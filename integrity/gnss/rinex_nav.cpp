@@ -128,19 +128,9 @@ void parseHeaderIono(NavigationData& nav, const std::string& line, const std::st
   }
 }
 
-}  // namespace
-
-void NavigationData::merge(const NavigationData& other) {
-  ephemerides.insert(ephemerides.end(), other.ephemerides.begin(), other.ephemerides.end());
-  if (!klobuchar) klobuchar = other.klobuchar;
-  if (!nequick_ai) nequick_ai = other.nequick_ai;
-  if (!leap_seconds) leap_seconds = other.leap_seconds;
-  skipped_records += other.skipped_records;
-}
-
-NavigationData parseRinexNav(const std::string& text, const std::string& src) {
-  const Lines L(text);
-  NavigationData nav;
+/// The RINEX VERSION / TYPE line: a GPS (RINEX 2) or mixed (RINEX 3) navigation file; returns
+/// whether it is RINEX 3.
+bool readVersionLine(const Lines& L, const std::string& src, NavigationData& nav) {
   if (L.v.empty()) throw ParseError(src, 1, "RINEX VERSION / TYPE", "", "a RINEX navigation header (file is empty)");
   const std::string& first = L.v[0];
   if (label(first) != "RINEX VERSION / TYPE") {
@@ -159,7 +149,11 @@ NavigationData parseRinexNav(const std::string& text, const std::string& src) {
   if (!v3 && field(first, 40, 1) == "G" && first.find("GLONASS") != std::string::npos) {
     throw ParseError(src, 1, "file type", "GLONASS", "a GPS navigation file (RINEX 2 type N)");
   }
+  return v3;
+}
 
+/// The header lines up to END OF HEADER; returns the index of the first record line.
+std::size_t readHeader(const Lines& L, const std::string& src, bool v3, NavigationData& nav) {
   std::size_t i = 1;
   for (; i < L.v.size(); ++i) {
     const std::string lab = label(L.v[i]);
@@ -167,61 +161,102 @@ NavigationData parseRinexNav(const std::string& text, const std::string& src) {
     parseHeaderIono(nav, L.v[i], lab, src, static_cast<int>(i + 1), v3);
   }
   if (i == L.v.size()) throw ParseError(src, static_cast<int>(i), "END OF HEADER", "", "the end of the header");
-  ++i;
+  return i + 1;
+}
 
+/// RINEX 3: a record of a system skylane does not use is counted and skipped (its continuation
+/// lines start with blanks); returns the index of the line after it.
+std::size_t skipRecord(const Lines& L, std::size_t i, const std::string& src, NavigationData& nav) {
+  const std::string& line = L.v[i];
+  if (!std::isalpha(static_cast<unsigned char>(line[0]))) {
+    throw ParseError(src, static_cast<int>(i + 1), "SV", trim(field(line, 0, 3)),
+                     "a satellite system letter (G, E, R, C, J, S, I)");
+  }
+  ++nav.skipped_records;
+  ++i;
+  while (i < L.v.size() && !L.v[i].empty() && L.v[i][0] == ' ') ++i;
+  return i;
+}
+
+/// RINEX 3 SV / EPOCH / SV CLK line: satellite and toc; returns the column of af0.
+std::size_t readSvEpochV3(const std::string& line, const std::string& src, int ln, Constellation cons,
+                          BroadcastEphemeris& e, CalendarTime& toc) {
+  e.sat.constellation = cons;
+  e.sat.prn = parseInt(field(line, 1, 2), src, ln, "SV PRN");
+  toc.year = parseInt(field(line, 4, 4), src, ln, "toc year");
+  toc.month = parseInt(field(line, 9, 2), src, ln, "toc month");
+  toc.day = parseInt(field(line, 12, 2), src, ln, "toc day");
+  toc.hour = parseInt(field(line, 15, 2), src, ln, "toc hour");
+  toc.minute = parseInt(field(line, 18, 2), src, ln, "toc minute");
+  toc.second = parseInt(field(line, 21, 2), src, ln, "toc second");
+  return 23;
+}
+
+/// RINEX 2 PRN / EPOCH / SV CLK line: satellite and toc; returns the column of af0.
+std::size_t readSvEpochV2(const std::string& line, const std::string& src, int ln, BroadcastEphemeris& e,
+                          CalendarTime& toc) {
+  e.sat.constellation = Constellation::kGps;
+  e.sat.prn = parseInt(field(line, 0, 2), src, ln, "PRN");
+  toc.year = rinexFullYear(parseInt(field(line, 3, 2), src, ln, "toc year"));
+  toc.month = parseInt(field(line, 6, 2), src, ln, "toc month");
+  toc.day = parseInt(field(line, 9, 2), src, ln, "toc day");
+  toc.hour = parseInt(field(line, 12, 2), src, ln, "toc hour");
+  toc.minute = parseInt(field(line, 15, 2), src, ln, "toc minute");
+  toc.second = parseFortranReal(field(line, 17, 5), src, ln, "toc second");
+  return 22;
+}
+
+/// One ephemeris record from line i (or a skipped RINEX 3 record of another system); returns
+/// the index of the line after it.
+std::size_t readRecord(const Lines& L, std::size_t i, const std::string& src, bool v3, NavigationData& nav) {
+  const std::string& line = L.v[i];
+  const int ln = static_cast<int>(i + 1);
+  BroadcastEphemeris e;
+  e.source_line = ln;
+  CalendarTime toc;
+  std::size_t vcol = 0;  // column of af0
+  if (v3) {
+    const auto cons = constellationFromLetter(line[0]);
+    if (!cons || (*cons != Constellation::kGps && *cons != Constellation::kGalileo)) return skipRecord(L, i, src, nav);
+    vcol = readSvEpochV3(line, src, ln, *cons, e, toc);
+  } else {
+    vcol = readSvEpochV2(line, src, ln, e, toc);
+  }
+  if (e.sat.prn < 1 || e.sat.prn > 99) {
+    throw ParseError(src, ln, "PRN", std::to_string(e.sat.prn), "a PRN between 1 and 99");
+  }
+  checkCalendar(toc, src, ln);
+  e.toc = gpsFromCalendar(toc);  // GPS and Galileo toc are in their own (aligned) system time
+  e.af0_s = parseFortranReal(field(line, vcol, 19), src, ln, "SV clock bias");
+  e.af1_sps = parseFortranReal(field(line, vcol + 19, 19), src, ln, "SV clock drift");
+  e.af2_sps2 = parseFortranReal(field(line, vcol + 38, 19), src, ln, "SV clock drift rate");
+  const auto orbit = readOrbitLines(L, i + 1, v3 ? 4 : 3, src);
+  fillEphemeris(e, orbit, src, ln);
+  nav.ephemerides.push_back(e);
+  return i + 8;
+}
+
+}  // namespace
+
+void NavigationData::merge(const NavigationData& other) {
+  ephemerides.insert(ephemerides.end(), other.ephemerides.begin(), other.ephemerides.end());
+  if (!klobuchar) klobuchar = other.klobuchar;
+  if (!nequick_ai) nequick_ai = other.nequick_ai;
+  if (!leap_seconds) leap_seconds = other.leap_seconds;
+  skipped_records += other.skipped_records;
+}
+
+NavigationData parseRinexNav(const std::string& text, const std::string& src) {
+  const Lines L(text);
+  NavigationData nav;
+  const bool v3 = readVersionLine(L, src, nav);
+  std::size_t i = readHeader(L, src, v3, nav);
   while (i < L.v.size()) {
-    const std::string& line = L.v[i];
-    const int ln = static_cast<int>(i + 1);
-    if (trim(line).empty()) { ++i; continue; }
-    BroadcastEphemeris e;
-    e.source_line = ln;
-    CalendarTime toc;
-    std::size_t vcol = 0;  // column of af0
-    if (v3) {
-      const char sys = line[0];
-      const auto cons = constellationFromLetter(sys);
-      if (!cons || (*cons != Constellation::kGps && *cons != Constellation::kGalileo)) {
-        // Skip a record of another system: continuation lines start with blanks.
-        if (!std::isalpha(static_cast<unsigned char>(line[0]))) {
-          throw ParseError(src, ln, "SV", trim(field(line, 0, 3)), "a satellite system letter (G, E, R, C, J, S, I)");
-        }
-        ++nav.skipped_records;
-        ++i;
-        while (i < L.v.size() && !L.v[i].empty() && L.v[i][0] == ' ') ++i;
-        continue;
-      }
-      e.sat.constellation = *cons;
-      e.sat.prn = parseInt(field(line, 1, 2), src, ln, "SV PRN");
-      toc.year = parseInt(field(line, 4, 4), src, ln, "toc year");
-      toc.month = parseInt(field(line, 9, 2), src, ln, "toc month");
-      toc.day = parseInt(field(line, 12, 2), src, ln, "toc day");
-      toc.hour = parseInt(field(line, 15, 2), src, ln, "toc hour");
-      toc.minute = parseInt(field(line, 18, 2), src, ln, "toc minute");
-      toc.second = parseInt(field(line, 21, 2), src, ln, "toc second");
-      vcol = 23;
-    } else {
-      e.sat.constellation = Constellation::kGps;
-      e.sat.prn = parseInt(field(line, 0, 2), src, ln, "PRN");
-      toc.year = rinexFullYear(parseInt(field(line, 3, 2), src, ln, "toc year"));
-      toc.month = parseInt(field(line, 6, 2), src, ln, "toc month");
-      toc.day = parseInt(field(line, 9, 2), src, ln, "toc day");
-      toc.hour = parseInt(field(line, 12, 2), src, ln, "toc hour");
-      toc.minute = parseInt(field(line, 15, 2), src, ln, "toc minute");
-      toc.second = parseFortranReal(field(line, 17, 5), src, ln, "toc second");
-      vcol = 22;
+    if (trim(L.v[i]).empty()) {
+      ++i;
+      continue;
     }
-    if (e.sat.prn < 1 || e.sat.prn > 99) {
-      throw ParseError(src, ln, "PRN", std::to_string(e.sat.prn), "a PRN between 1 and 99");
-    }
-    checkCalendar(toc, src, ln);
-    e.toc = gpsFromCalendar(toc);  // GPS and Galileo toc are in their own (aligned) system time
-    e.af0_s = parseFortranReal(field(line, vcol, 19), src, ln, "SV clock bias");
-    e.af1_sps = parseFortranReal(field(line, vcol + 19, 19), src, ln, "SV clock drift");
-    e.af2_sps2 = parseFortranReal(field(line, vcol + 38, 19), src, ln, "SV clock drift rate");
-    const auto orbit = readOrbitLines(L, i + 1, v3 ? 4 : 3, src);
-    fillEphemeris(e, orbit, src, ln);
-    nav.ephemerides.push_back(e);
-    i += 8;
+    i = readRecord(L, i, src, v3, nav);
   }
   return nav;
 }

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -49,6 +50,79 @@ double imuInnovationStatistic(const GnssUpdateRecord& rec) {
   return b.dot(info * b);
 }
 
+namespace {
+
+/// What every fault mode's protection level is built from (ENU axes).
+struct FaultModeTerms {
+  Eigen::Vector3d a_nu;       ///< A ν, A = G_p − K_p: the GNSS-only minus the filter's update
+  Eigen::Matrix3d cov_ff;     ///< fault-free position covariance
+  Eigen::Matrix3d cov_i;      ///< covariance of the GNSS-only solution's difference
+  Eigen::Vector3d bias_ff;    ///< fault-free bias bound
+  Eigen::Vector3d bias_i;     ///< bias bound under a fault
+  Eigen::Vector3d max_slope;  ///< largest LSR characteristic slope per axis
+};
+
+/// Characteristic slope per axis of the LSR test on the same measurements, the largest over
+/// the satellites: |G_p,qm| σ_m / √s_mm, with the residual matrix S_res = I − H (Hᵀ W H)⁻¹ Hᵀ W
+/// of which only the diagonal s_mm = 1 − w_m h_m (Hᵀ W H)⁻¹ h_mᵀ is needed.
+Eigen::Vector3d maxLsrSlopes(const GnssUpdateRecord& rec, const Eigen::MatrixXd& Hpc, const Eigen::MatrixXd& Gp) {
+  const int n = static_cast<int>(rec.H.rows());
+  const Eigen::VectorXd w = rec.sigma.cwiseAbs2().cwiseInverse();
+  const Eigen::Matrix4d lsr_info = Hpc.transpose() * w.asDiagonal() * Hpc;
+  const Eigen::Matrix4d lsr_cov = lsr_info.inverse();
+  Eigen::Matrix3Xd slope(3, n);
+  for (int m = 0; m < n; ++m) {
+    const Eigen::Vector4d hm = Hpc.row(m).transpose();
+    const double smm = std::max(1.0 - w(m) * hm.dot(lsr_cov * hm), 1e-12);
+    slope.col(m) = Gp.col(m).cwiseAbs() * (rec.sigma(m) / std::sqrt(smm));
+  }
+  return slope.rowwise().maxCoeff();
+}
+
+/// The terms of the update `rec`; nothing when its geometry is degenerate.
+std::optional<FaultModeTerms> faultModeTerms(const GnssUpdateRecord& rec, const Eigen::MatrixXd& Hpc) {
+  // G = (H_pcᵀ S⁻¹ H_pc)⁻¹ H_pcᵀ S⁻¹; A = G_p − K_p (ENU rows).
+  const Eigen::MatrixXd& SiH = rec.S_inv_Hpc;
+  const Eigen::Matrix4d info = Hpc.transpose() * SiH;
+  const Eigen::FullPivLU<Eigen::Matrix4d> info_lu(info);
+  if (!info_lu.isInvertible()) return std::nullopt;
+  const Eigen::MatrixXd G = info_lu.solve(SiH.transpose());  // 4 × n
+  const Eigen::MatrixXd Gp = rec.R_enu_ecef * G.topRows<3>();
+  const Eigen::MatrixXd Kp = rec.R_enu_ecef * rec.K.middleRows<3>(kPos);
+  const Eigen::MatrixXd A = Gp - Kp;
+  FaultModeTerms t;
+  t.a_nu = A * rec.innovation;
+  t.cov_ff = rec.P_pos_enu;
+  t.cov_i = rec.P_pos_enu + A * rec.S * A.transpose();
+  const Eigen::MatrixXd M_i = rec.M_pos_enu - A * rec.N_innov;
+  t.bias_ff = rec.M_pos_enu.cwiseAbs() * rec.bias_bnom;
+  t.bias_i = M_i.cwiseAbs() * rec.bias_bnom;
+  t.max_slope = maxLsrSlopes(rec, Hpc, Gp);
+  return t;
+}
+
+/// One mode's protection level per axis, with its horizontal (bh) and vertical (bv) budgets.
+void setModeAxes(ModePl& pl, InsFaultMode mode, const ModeBudget& bh, const ModeBudget& bv, const FaultModeTerms& t,
+                 int dof, const FaultModeConfig& cfg) {
+  for (int q = 0; q < 3; ++q) {
+    const double p = q < 2 ? bh.conditional / 2.0 : bv.conditional;
+    const double k = twoSidedK(p);
+    if (mode == InsFaultMode::kFaultFree) {
+      pl.axis_m[q] = k * std::sqrt(t.cov_ff(q, q)) + t.bias_ff(q);
+      continue;
+    }
+    double v = std::abs(t.a_nu(q)) + k * std::sqrt(t.cov_i(q, q)) + t.bias_i(q);
+    if ((mode == InsFaultMode::kGnssSingle || mode == InsFaultMode::kGnssSingleImu) && p < 1.0) {
+      v += t.max_slope(q) * raimThresholds(dof, cfg.pfa_gnss, p).p_bias;
+    }
+    pl.axis_m[q] = v;
+  }
+  pl.hpl_m = std::hypot(pl.axis_m[0], pl.axis_m[1]);
+  pl.vpl_m = pl.axis_m[2];
+}
+
+}  // namespace
+
 FaultModePls faultModeProtectionLevels(const GnssUpdateRecord& rec, const FaultModeConfig& cfg) {
   FaultModePls out;
   const int n = static_cast<int>(rec.H.rows());
@@ -56,44 +130,14 @@ FaultModePls faultModeProtectionLevels(const GnssUpdateRecord& rec, const FaultM
     out.reason = "fewer than 5 satellites: the LSR test cannot protect the GS mode";
     return out;
   }
-  const Eigen::MatrixXd Hpc = positionClockColumns(rec);
-  // G = (H_pcᵀ S⁻¹ H_pc)⁻¹ H_pcᵀ S⁻¹; A = G_p − K_p (ENU rows).
-  const Eigen::MatrixXd& SiH = rec.S_inv_Hpc;
-  const Eigen::Matrix4d info = Hpc.transpose() * SiH;
-  const Eigen::FullPivLU<Eigen::Matrix4d> info_lu(info);
-  if (!info_lu.isInvertible()) {
+  const std::optional<FaultModeTerms> terms = faultModeTerms(rec, positionClockColumns(rec));
+  if (!terms) {
     out.reason = "degenerate geometry";
     return out;
   }
-  const Eigen::MatrixXd G = info_lu.solve(SiH.transpose());  // 4 × n
-  const Eigen::MatrixXd Gp = rec.R_enu_ecef * G.topRows<3>();
-  const Eigen::MatrixXd Kp = rec.R_enu_ecef * rec.K.middleRows<3>(kPos);
-  const Eigen::MatrixXd A = Gp - Kp;
-  const Eigen::Vector3d a_nu = A * rec.innovation;
-  const Eigen::Matrix3d cov_ff = rec.P_pos_enu;
-  const Eigen::Matrix3d cov_i = rec.P_pos_enu + A * rec.S * A.transpose();
-  const Eigen::MatrixXd M_i = rec.M_pos_enu - A * rec.N_innov;
-  const Eigen::Vector3d bias_ff = rec.M_pos_enu.cwiseAbs() * rec.bias_bnom;
-  const Eigen::Vector3d bias_i = M_i.cwiseAbs() * rec.bias_bnom;
-
-  // LSR test on the same measurements: residual matrix S_res = I − H (Hᵀ W H)⁻¹ Hᵀ W, of which
-  // only the diagonal s_mm = 1 − w_m h_m (Hᵀ W H)⁻¹ h_mᵀ is needed.
-  const Eigen::VectorXd w = rec.sigma.cwiseAbs2().cwiseInverse();
-  const Eigen::Matrix4d lsr_info = Hpc.transpose() * w.asDiagonal() * Hpc;
-  const Eigen::Matrix4d lsr_cov = lsr_info.inverse();
-  const int dof = n - 4;
-  // characteristic slope per axis and satellite: |G_p,qm| σ_m / √s_mm
-  Eigen::Matrix3Xd slope(3, n);
-  for (int m = 0; m < n; ++m) {
-    const Eigen::Vector4d hm = Hpc.row(m).transpose();
-    const double smm = std::max(1.0 - w(m) * hm.dot(lsr_cov * hm), 1e-12);
-    slope.col(m) = Gp.col(m).cwiseAbs() * (rec.sigma(m) / std::sqrt(smm));
-  }
-  const Eigen::Vector3d max_slope = slope.rowwise().maxCoeff();
-
   const RiskAllocation alloc_h = allocateRisk(n, DetectionClass::kIntegrated, false, cfg.risk);
   const RiskAllocation alloc_v = allocateRisk(n, DetectionClass::kIntegrated, true, cfg.risk);
-  out.bias_estimate_up_m = a_nu.z();
+  out.bias_estimate_up_m = terms->a_nu.z();
   out.available = true;
   out.hpl_m = 0.0;
   out.vpl_m = 0.0;
@@ -104,21 +148,7 @@ FaultModePls faultModeProtectionLevels(const GnssUpdateRecord& rec, const FaultM
     const ModeBudget& bv = alloc_v.of(mode);
     pl.needs_pl = bh.considered && (bh.needs_pl || bv.needs_pl);
     if (!pl.needs_pl) continue;
-    for (int q = 0; q < 3; ++q) {
-      const double p = q < 2 ? bh.conditional / 2.0 : bv.conditional;
-      const double k = twoSidedK(p);
-      if (mode == InsFaultMode::kFaultFree) {
-        pl.axis_m[q] = k * std::sqrt(cov_ff(q, q)) + bias_ff(q);
-        continue;
-      }
-      double v = std::abs(a_nu(q)) + k * std::sqrt(cov_i(q, q)) + bias_i(q);
-      if ((mode == InsFaultMode::kGnssSingle || mode == InsFaultMode::kGnssSingleImu) && p < 1.0) {
-        v += max_slope(q) * raimThresholds(dof, cfg.pfa_gnss, p).p_bias;
-      }
-      pl.axis_m[q] = v;
-    }
-    pl.hpl_m = std::hypot(pl.axis_m[0], pl.axis_m[1]);
-    pl.vpl_m = pl.axis_m[2];
+    setModeAxes(pl, mode, bh, bv, *terms, n - 4, cfg);
     if (pl.hpl_m > out.hpl_m) {
       out.hpl_m = pl.hpl_m;
       out.deciding_h = mode;
