@@ -1,4 +1,5 @@
 #include "planner/approval.hpp"
+#include "planner/approval_impl.hpp"
 
 #include "geofence/obstruction_files.hpp"
 #include "integrity/predict.hpp"
@@ -22,13 +23,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// Least radius round a replan's start within which only the vehicle's point must be clear [m].
 constexpr double kMinExempt_m = 10.0;
 
-/// φ(r) of the file comment: grows without bound as PL approaches the alert limit.
-double integrityPenalty(double r) {
-  if (!(r < 0.99)) return 1e4;
-  const double q = r / (1.0 - r);
-  return q * q;
-}
-
 std::string fmtMetres(double v) {
   std::ostringstream s;
   s.setf(std::ios::fixed);
@@ -45,192 +39,175 @@ std::string fmtTime(double t_s) {
   return s.str();
 }
 
+/// φ(r) of the file comment: grows without bound as PL approaches the alert limit.
+double integrityPenalty(double r) {
+  if (!(r < 0.99)) return 1e4;
+  const double q = r / (1.0 - r);
+  return q * q;
+}
+
 }  // namespace
 
-struct Approver::Impl {
-  Mission m;
-  maps::PlaneFrame frame;
-  maps::Terrain terrain;
-  geofence::LevelLimits limits;
-  std::unique_ptr<geofence::Obstructions> obstructions;
-  std::unique_ptr<maps::BuildingIndex> index;
-  integrity::OrbitSource orbits;
-  Eigen::Vector3d lower = Eigen::Vector3d::Zero(), upper = Eigen::Vector3d::Zero();
-  // The predicted-PL grid at cruise height (mid-flight time) and the integrity cost from it.
-  double cell_m = 50.0;
-  int cols = 0, rows = 0;
-  std::vector<double> cost;
-  std::vector<Eigen::Vector2d> grid_pl;  ///< (HPL, VPL) per cell; NaN when unavailable
-  bool cost_grid_built = false;
-
-  /// The approval steps of approval.hpp from `stops` (map frame) for each departure in turn;
-  /// `from_vehicle`: a replan from where the vehicle is (no later-departure search).
-  ApprovalReport run(const std::vector<Eigen::Vector3d>& stops, const std::vector<maps::GpsTime>& departures,
-                     bool from_vehicle, const std::function<void(const std::string&)>& progress);
-
-  explicit Impl(Mission mission)
-      : m(std::move(mission)),
-        frame(m.points.front().lat_rad, m.points.front().lon_rad),
-        terrain(m.terrain_file.empty() ? maps::Terrain::flat(m.ground_amsl_m) : maps::Terrain::fromRaster(m.terrain_file)) {
-    try {
-      limits = geofence::alertLimits(m.vehicle, m.levels);
-    } catch (const std::invalid_argument& e) {
-      throw maps::ParseError(m.source, 0, "$.k1/$.k2/$.vehicle", "", e.what());
-    }
-    const auto format = airspace::parseZoneFormat(m.zone_format);
-    if (!format) throw maps::ParseError(m.source, 0, "$.zone_format", m.zone_format, "auto, ed269, ed318, geojson or qgc");
-    geofence::ZonePolicy policy;
-    policy.authorisations = m.authorisations;
-    geofence::FenceOptions options;
-    options.horizon_m = 500.0;  // zones within 500 m are reported with their clearance
-    obstructions = std::make_unique<geofence::Obstructions>(
-        geofence::loadObstructions({m.zone_files, *format, m.buildings_file}, frame, terrain, policy, options));
-    if (!obstructions->buildings().empty()) {
-      const maps::Geodetic origin{m.points.front().lat_rad, m.points.front().lon_rad, 0.0};
-      index = std::make_unique<maps::BuildingIndex>(obstructions->buildings(), origin);
-    }
-    orbits = integrity::loadOrbitFiles(m.orbit_files, m.source, "$.orbits");
-    // Search box: every mission point ± margin; heights from the terrain's range over it.
-    Eigen::Vector2d lo(kInf, kInf), hi(-kInf, -kInf);
-    for (const MissionPoint& p : m.points) {
-      const Eigen::Vector2d xy = frame.toPlane(p.lat_rad, p.lon_rad);
-      lo = lo.cwiseMin(xy);
-      hi = hi.cwiseMax(xy);
-    }
-    lo.array() -= m.margin_m;
-    hi.array() += m.margin_m;
-    double g_lo = kInf, g_hi = -kInf;
-    for (int i = 0; i <= 20; ++i) {
-      for (int j = 0; j <= 20; ++j) {
-        const auto g = ground(Eigen::Vector2d(lo.x() + (hi.x() - lo.x()) * i / 20.0, lo.y() + (hi.y() - lo.y()) * j / 20.0));
-        if (!g) continue;
-        g_lo = std::min(g_lo, *g);
-        g_hi = std::max(g_hi, *g);
-      }
-    }
-    if (!std::isfinite(g_lo)) throw maps::ParseError(m.source, 0, "$.terrain", m.terrain_file, "terrain covering the mission area");
-    lower << lo, g_lo + m.min_agl_m - 1.0;
-    upper << hi, g_hi + m.max_agl_m + 1.0;
+Approver::Impl::Impl(Mission mission)
+    : m(std::move(mission)),
+      frame(m.points.front().lat_rad, m.points.front().lon_rad),
+      terrain(m.terrain_file.empty() ? maps::Terrain::flat(m.ground_amsl_m) : maps::Terrain::fromRaster(m.terrain_file)) {
+  try {
+    limits = geofence::alertLimits(m.vehicle, m.levels);
+  } catch (const std::invalid_argument& e) {
+    throw maps::ParseError(m.source, 0, "$.k1/$.k2/$.vehicle", "", e.what());
   }
-
-  std::optional<double> ground(const Eigen::Vector2d& xy) const {
-    const Eigen::Vector2d ll = frame.toLatLon(xy);
-    return terrain.heightEllipsoid_m(ll.x(), ll.y());
+  const auto format = airspace::parseZoneFormat(m.zone_format);
+  if (!format) throw maps::ParseError(m.source, 0, "$.zone_format", m.zone_format, "auto, ed269, ed318, geojson or qgc");
+  geofence::ZonePolicy policy;
+  policy.authorisations = m.authorisations;
+  geofence::FenceOptions options;
+  options.horizon_m = 500.0;  // zones within 500 m are reported with their clearance
+  obstructions = std::make_unique<geofence::Obstructions>(
+      geofence::loadObstructions({m.zone_files, *format, m.buildings_file}, frame, terrain, policy, options));
+  if (!obstructions->buildings().empty()) {
+    const maps::Geodetic origin{m.points.front().lat_rad, m.points.front().lon_rad, 0.0};
+    index = std::make_unique<maps::BuildingIndex>(obstructions->buildings(), origin);
   }
-
-  maps::Geodetic geodetic(const Eigen::Vector3d& p) const {
-    const Eigen::Vector2d ll = frame.toLatLon(p.head<2>());
-    return {ll.x(), ll.y(), p.z()};
+  orbits = integrity::loadOrbitFiles(m.orbit_files, m.source, "$.orbits");
+  // Search box: every mission point ± margin; heights from the terrain's range over it.
+  Eigen::Vector2d lo(kInf, kInf), hi(-kInf, -kInf);
+  for (const MissionPoint& p : m.points) {
+    const Eigen::Vector2d xy = frame.toPlane(p.lat_rad, p.lon_rad);
+    lo = lo.cwiseMin(xy);
+    hi = hi.cwiseMax(xy);
   }
-
-  /// Height band and max AMSL; then the vehicle's level-1 box clear of obstructions over [t0, t1).
-  bool valid(const Eigen::Vector3d& p, const maps::GpsTime& t0, const maps::GpsTime& t1,
-             const std::vector<std::pair<Eigen::Vector3d, double>>& penalties) const {
-    const auto g = ground(p.head<2>());
-    if (!g) return false;
-    const double agl = p.z() - *g;
-    if (agl < m.min_agl_m || agl > m.max_agl_m) return false;
-    if (m.max_amsl_m) {
-      const maps::Geodetic q = geodetic(p);
-      if (maps::Geoid::egm96().amslFromEllipsoidal_m(q.lat_rad, q.lon_rad, p.z()) > *m.max_amsl_m) return false;
-    }
-    for (const auto& [c, r] : penalties) {
-      if ((p - c).norm() < r) return false;
-    }
-    const geofence::TimedVolume v{t0, t1, planningVolume(p)};
-    return !obstructions->firstConflict(v);
-  }
-
-  maps::SkyMask skyMaskAt(const maps::Geodetic& g) const {
-    const bool raster = !m.terrain_file.empty();
-    maps::SkyMaskOptions options;
-    options.floor_rad = maps::deg2rad(m.mask_deg);  // below the receiver's mask nothing matters
-    return maps::computeSkyMask(g, index.get(), raster ? &terrain : nullptr, options);
-  }
-
-  integrity::PredictSample predictAt(const maps::Geodetic& g, const maps::GpsTime& t,
-                                     const std::optional<maps::SkyMask>& mask) const {
-    integrity::PredictRequest req;
-    req.place = g;
-    req.mask_rad = maps::deg2rad(m.mask_deg);
-    req.model = m.model;
-    req.sky_mask = mask;
-    return integrity::predictAt(orbits, req, t, m.method);
-  }
-
-  double ratioOf(const integrity::PredictSample& s) const {
-    if (!s.pl.pl_computed) return kInf;
-    return std::max(s.pl.hpl_m / limits.level2.hal_m, s.pl.vpl_m / limits.level2.val_m);
-  }
-
-  void buildCostGrid(const maps::GpsTime& t_mid) {
-    cell_m = m.cost_cell_m;
-    while ((upper.x() - lower.x()) * (upper.y() - lower.y()) / (cell_m * cell_m) > 20000.0) cell_m *= 1.5;
-    cols = std::max(1, static_cast<int>(std::ceil((upper.x() - lower.x()) / cell_m)));
-    rows = std::max(1, static_cast<int>(std::ceil((upper.y() - lower.y()) / cell_m)));
-    const std::size_t n = static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows);
-    cost.assign(m.cost_weight > 0.0 ? n : 0, 0.0);
-    grid_pl.assign(n, Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
-    const bool masked = index || !m.terrain_file.empty();
-    for (int r = 0; r < rows; ++r) {
-      for (int c = 0; c < cols; ++c) {
-        const Eigen::Vector2d xy(lower.x() + (c + 0.5) * cell_m, lower.y() + (r + 0.5) * cell_m);
-        const auto g = ground(xy);
-        if (!g) continue;
-        const maps::Geodetic place = geodetic(Eigen::Vector3d(xy.x(), xy.y(), *g + m.cruise_agl_m));
-        const integrity::PredictSample s = predictAt(place, t_mid, masked ? std::optional(skyMaskAt(place)) : std::nullopt);
-        const std::size_t k = static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c);
-        if (s.pl.pl_computed) grid_pl[k] = Eigen::Vector2d(s.pl.hpl_m, s.pl.vpl_m);
-        if (!cost.empty()) cost[k] = m.cost_weight * integrityPenalty(ratioOf(s));
-      }
+  lo.array() -= m.margin_m;
+  hi.array() += m.margin_m;
+  double g_lo = kInf, g_hi = -kInf;
+  for (int i = 0; i <= 20; ++i) {
+    for (int j = 0; j <= 20; ++j) {
+      const auto g = ground(Eigen::Vector2d(lo.x() + (hi.x() - lo.x()) * i / 20.0, lo.y() + (hi.y() - lo.y()) * j / 20.0));
+      if (!g) continue;
+      g_lo = std::min(g_lo, *g);
+      g_hi = std::max(g_hi, *g);
     }
   }
+  if (!std::isfinite(g_lo)) throw maps::ParseError(m.source, 0, "$.terrain", m.terrain_file, "terrain covering the mission area");
+  lower << lo, g_lo + m.min_agl_m - 1.0;
+  upper << hi, g_hi + m.max_agl_m + 1.0;
+}
 
-  std::size_t cellOf(const Eigen::Vector3d& p) const {
-    const int c = std::clamp(static_cast<int>((p.x() - lower.x()) / cell_m), 0, cols - 1);
-    const int r = std::clamp(static_cast<int>((p.y() - lower.y()) / cell_m), 0, rows - 1);
-    return static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c);
+std::optional<double> Approver::Impl::ground(const Eigen::Vector2d& xy) const {
+  const Eigen::Vector2d ll = frame.toLatLon(xy);
+  return terrain.heightEllipsoid_m(ll.x(), ll.y());
+}
+
+maps::Geodetic Approver::Impl::geodetic(const Eigen::Vector3d& p) const {
+  const Eigen::Vector2d ll = frame.toLatLon(p.head<2>());
+  return {ll.x(), ll.y(), p.z()};
+}
+
+bool Approver::Impl::valid(const Eigen::Vector3d& p, const maps::GpsTime& t0, const maps::GpsTime& t1,
+                           const std::vector<approval_steps::Penalty>& penalties) const {
+  const auto g = ground(p.head<2>());
+  if (!g) return false;
+  const double agl = p.z() - *g;
+  if (agl < m.min_agl_m || agl > m.max_agl_m) return false;
+  if (m.max_amsl_m) {
+    const maps::Geodetic q = geodetic(p);
+    if (maps::Geoid::egm96().amslFromEllipsoidal_m(q.lat_rad, q.lon_rad, p.z()) > *m.max_amsl_m) return false;
   }
+  for (const auto& [c, r] : penalties) {
+    if ((p - c).norm() < r) return false;
+  }
+  const geofence::TimedVolume v{t0, t1, planningVolume(p)};
+  return !obstructions->firstConflict(v);
+}
 
-  /// The volume a state must keep clear: the level-1 box, grown to the PL predicted there with a
-  /// 20 % allowance for its change over the flight (the samples are checked exactly afterwards).
-  geofence::ProtectionVolume planningVolume(const Eigen::Vector3d& p) const {
-    double h = limits.level1.hal_m, v = limits.level1.val_m;
-    if (!grid_pl.empty()) {
-      const Eigen::Vector2d& pl = grid_pl[cellOf(p)];
-      if (std::isfinite(pl.x())) {
-        h = std::max(h, 1.2 * pl.x());
-        v = std::max(v, 1.2 * pl.y());
-      }
+maps::SkyMask Approver::Impl::skyMaskAt(const maps::Geodetic& g) const {
+  const bool raster = !m.terrain_file.empty();
+  maps::SkyMaskOptions options;
+  options.floor_rad = maps::deg2rad(m.mask_deg);  // below the receiver's mask nothing matters
+  return maps::computeSkyMask(g, index.get(), raster ? &terrain : nullptr, options);
+}
+
+bool Approver::Impl::masked() const { return index || !m.terrain_file.empty(); }
+
+integrity::PredictSample Approver::Impl::predictAt(const maps::Geodetic& g, const maps::GpsTime& t,
+                                                   const std::optional<maps::SkyMask>& mask) const {
+  integrity::PredictRequest req;
+  req.place = g;
+  req.mask_rad = maps::deg2rad(m.mask_deg);
+  req.model = m.model;
+  req.sky_mask = mask;
+  return integrity::predictAt(orbits, req, t, m.method);
+}
+
+double Approver::Impl::ratioOf(const integrity::PredictSample& s) const {
+  if (!s.pl.pl_computed) return kInf;
+  return std::max(s.pl.hpl_m / limits.level2.hal_m, s.pl.vpl_m / limits.level2.val_m);
+}
+
+void Approver::Impl::buildCostGrid(const maps::GpsTime& t_mid) {
+  cell_m = m.cost_cell_m;
+  while ((upper.x() - lower.x()) * (upper.y() - lower.y()) / (cell_m * cell_m) > 20000.0) cell_m *= 1.5;
+  cols = std::max(1, static_cast<int>(std::ceil((upper.x() - lower.x()) / cell_m)));
+  rows = std::max(1, static_cast<int>(std::ceil((upper.y() - lower.y()) / cell_m)));
+  const std::size_t n = static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows);
+  cost.assign(m.cost_weight > 0.0 ? n : 0, 0.0);
+  grid_pl.assign(n, Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  const bool with_masks = masked();
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const Eigen::Vector2d xy(lower.x() + (c + 0.5) * cell_m, lower.y() + (r + 0.5) * cell_m);
+      const auto g = ground(xy);
+      if (!g) continue;
+      const maps::Geodetic place = geodetic(Eigen::Vector3d(xy.x(), xy.y(), *g + m.cruise_agl_m));
+      const integrity::PredictSample s =
+          predictAt(place, t_mid, with_masks ? std::optional(skyMaskAt(place)) : std::nullopt);
+      const std::size_t k = static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c);
+      if (s.pl.pl_computed) grid_pl[k] = Eigen::Vector2d(s.pl.hpl_m, s.pl.vpl_m);
+      if (!cost.empty()) cost[k] = m.cost_weight * integrityPenalty(ratioOf(s));
     }
-    return {p, h, v};
   }
+}
 
-  double extraCost(const Eigen::Vector3d& p) const { return cost[cellOf(p)]; }
+std::size_t Approver::Impl::cellOf(const Eigen::Vector3d& p) const {
+  const int c = std::clamp(static_cast<int>((p.x() - lower.x()) / cell_m), 0, cols - 1);
+  const int r = std::clamp(static_cast<int>((p.y() - lower.y()) / cell_m), 0, rows - 1);
+  return static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c);
+}
 
-  /// ETA per point: horizontal at cruise speed, vertical at climb speed, whichever is slower.
-  std::vector<RoutePoint> timed(const std::vector<Eigen::Vector3d>& pts) const {
-    std::vector<RoutePoint> out;
-    double t = 0.0;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      if (i > 0) {
-        const Eigen::Vector3d d = pts[i] - pts[i - 1];
-        t += std::max(d.head<2>().norm() / m.cruise_speed_mps, std::abs(d.z()) / m.climb_speed_mps);
-      }
-      RoutePoint rp;
-      rp.xyz = pts[i];
-      const maps::Geodetic g = geodetic(pts[i]);
-      rp.lat_rad = g.lat_rad;
-      rp.lon_rad = g.lon_rad;
-      rp.h_ell_m = g.h_ell_m;
-      rp.alt_amsl_m = maps::Geoid::egm96().amslFromEllipsoidal_m(g.lat_rad, g.lon_rad, g.h_ell_m);
-      rp.eta_s = t;
-      out.push_back(rp);
+geofence::ProtectionVolume Approver::Impl::planningVolume(const Eigen::Vector3d& p) const {
+  double h = limits.level1.hal_m, v = limits.level1.val_m;
+  if (!grid_pl.empty()) {
+    const Eigen::Vector2d& pl = grid_pl[cellOf(p)];
+    if (std::isfinite(pl.x())) {
+      h = std::max(h, 1.2 * pl.x());
+      v = std::max(v, 1.2 * pl.y());
     }
-    return out;
   }
+  return {p, h, v};
+}
 
-};
+double Approver::Impl::extraCost(const Eigen::Vector3d& p) const { return cost[cellOf(p)]; }
+
+std::vector<RoutePoint> Approver::Impl::timeRoute(const std::vector<Eigen::Vector3d>& pts) const {
+  std::vector<RoutePoint> out;
+  double t = 0.0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (i > 0) {
+      const Eigen::Vector3d d = pts[i] - pts[i - 1];
+      t += std::max(d.head<2>().norm() / m.cruise_speed_mps, std::abs(d.z()) / m.climb_speed_mps);
+    }
+    RoutePoint rp;
+    rp.xyz = pts[i];
+    const maps::Geodetic g = geodetic(pts[i]);
+    rp.lat_rad = g.lat_rad;
+    rp.lon_rad = g.lon_rad;
+    rp.h_ell_m = g.h_ell_m;
+    rp.alt_amsl_m = maps::Geoid::egm96().amslFromEllipsoidal_m(g.lat_rad, g.lon_rad, g.h_ell_m);
+    rp.eta_s = t;
+    out.push_back(rp);
+  }
+  return out;
+}
 
 Eigen::Vector3d positionAlong(const std::vector<RoutePoint>& route, double t_s) {
   if (route.empty()) throw std::invalid_argument("positionAlong: an empty route");
@@ -251,18 +228,6 @@ const Mission& Approver::mission() const { return impl_->m; }
 const maps::PlaneFrame& Approver::frame() const { return impl_->frame; }
 const geofence::Obstructions& Approver::obstructions() const { return *impl_->obstructions; }
 const integrity::OrbitSource& Approver::orbits() const { return impl_->orbits; }
-
-namespace {
-
-/// Samples the route every sample_s (and at its end), with sky masks computed once.
-struct RouteSamples {
-  std::vector<double> t_s;
-  std::vector<Eigen::Vector3d> xyz;
-  std::vector<maps::Geodetic> geo;
-  std::vector<std::optional<maps::SkyMask>> masks;
-};
-
-}  // namespace
 
 std::vector<Eigen::Vector3d> Approver::missionStops() const {
   const Mission& m = impl_->m;
@@ -318,7 +283,7 @@ ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, co
   // is not a multiple of its step has its last departure before it); a replan's is `now`.
   const maps::GpsTime latest_departure = from_vehicle ? departures.back() : m.departure_latest;
 
-  const bool masked = d.index || !m.terrain_file.empty();
+  const bool with_masks = d.masked();
   if (!cost_grid_built) {
     say("predicted protection levels over the area (integrity cost field)");
     d.buildCostGrid(departures.front().plus(direct_s / 2.0));
@@ -334,10 +299,10 @@ ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, co
     exempt_m = std::max(kMinExempt_m, 2.0 * d.planningVolume(stops.front()).hpl_m);
   }
 
-  std::vector<std::pair<Eigen::Vector3d, double>> penalties;
+  std::vector<approval_steps::Penalty> penalties;
   std::vector<Reason> last_reasons;
   std::vector<RoutePoint> last_route;
-  RouteSamples last_samples;
+  approval_steps::RouteSamples last_samples;
   for (const maps::GpsTime& dep : departures) {
     ++report.planner.departures_tried;
     for (int attempt = 0; attempt <= m.max_replans; ++attempt) {
@@ -419,10 +384,10 @@ ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, co
       }
 
       // Time, sample and check the route.
-      std::vector<RoutePoint> route = d.timed(pts);
+      std::vector<RoutePoint> route = d.timeRoute(pts);
       report.planner.length_m = polylineLength(pts);
       const double total_s = route.back().eta_s;
-      RouteSamples samples;
+      approval_steps::RouteSamples samples;
       for (double t = 0.0;; t += m.sample_s) {
         const double tt = std::min(t, total_s);
         samples.t_s.push_back(tt);
@@ -433,7 +398,7 @@ ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, co
         const Eigen::Vector3d p = positionAlong(route, t);
         samples.xyz.push_back(p);
         samples.geo.push_back(d.geodetic(p));
-        samples.masks.push_back(masked ? std::optional(d.skyMaskAt(samples.geo.back())) : std::nullopt);
+        samples.masks.push_back(with_masks ? std::optional(d.skyMaskAt(samples.geo.back())) : std::nullopt);
       }
       const geofence::Corridor level1(pts, d.limits.level1, {});
       const geofence::Corridor level2(pts, d.limits.level2, {});
@@ -443,7 +408,7 @@ ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, co
       std::vector<double> first_t;    // per reason: first sample time
       std::vector<PredictedSample> predicted;
       int level1_exceedances = 0;
-      std::vector<std::pair<Eigen::Vector3d, double>> violations;
+      std::vector<approval_steps::Penalty> violations;
       for (std::size_t k = 0; k < samples.t_s.size(); ++k) {
         PredictedSample ps;
         ps.t_s = samples.t_s[k];
