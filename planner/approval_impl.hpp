@@ -1,0 +1,210 @@
+#pragma once
+/// \file
+/// \brief Inside the approval (an internal header of planner/, not installed): Approver::Impl —
+/// the mission's map frame, terrain, zones, orbits and integrity cost field — and the state its
+/// steps pass along. approval.cpp loads the mission and answers the map and integrity questions
+/// (ground height, validity of a state, sky masks, predicted PLs, the cost field);
+/// approval_steps.cpp holds the approval itself: Impl::run, a short list of steps, and the steps.
+
+#include "planner/approval.hpp"
+#include "planner/route_planner.hpp"
+
+#include "geofence/corridor.hpp"
+#include "geofence/fence.hpp"
+#include "integrity/predict.hpp"
+#include "maps/buildings.hpp"
+#include "maps/geodesy.hpp"
+#include "maps/sky_mask.hpp"
+#include "maps/terrain.hpp"
+#include "maps/time.hpp"
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace skylane::planner {
+
+/// \brief The per-step state of an approval (see Approver::Impl::run).
+namespace approval_steps {
+
+/// \brief Calls the caller's progress callback, when there is one.
+struct Say {
+  const std::function<void(const std::string&)>& progress;
+  void operator()(const std::string& message) const {
+    if (progress) progress(message);
+  }
+};
+
+/// \brief A place later attempts keep away from after a violation there: centre (map frame) and
+/// radius [m].
+using Penalty = std::pair<Eigen::Vector3d, double>;
+
+/// \brief What every attempt of one approval shares.
+struct ApprovalSetup {
+  std::vector<Eigen::Vector3d> stops;     ///< map frame: the start (or the vehicle), waypoints, goal
+  std::vector<maps::GpsTime> departures;  ///< tried in turn
+  bool from_vehicle = false;              ///< a replan from where the vehicle is
+  double direct_s = 0.0;                  ///< the straight legs at cruise speed
+  /// The end of the zones' activity window: the latest departure plus twice the direct flight
+  /// time plus 2 min (a zone starting later cannot meet the vehicle).
+  maps::GpsTime zones_until;
+  Eigen::Vector3d box_lo = Eigen::Vector3d::Zero();  ///< the planner's search box (map frame)
+  Eigen::Vector3d box_hi = Eigen::Vector3d::Zero();
+  /// Round the vehicle (a replan) only its own point must be clear [m]; 0 for an approval.
+  double exempt_m = 0.0;
+};
+
+/// \brief One attempt's route through the stops, planned leg by leg.
+struct LegPlan {
+  std::vector<Eigen::Vector3d> pts;  ///< start … goal when every leg is exact
+  PathResult last;                   ///< the last leg planned: the one that failed, if one did
+  bool ok = true;                    ///< every leg exact
+  std::size_t failed_leg = 0;        ///< when not ok: index into the stops of that leg's goal
+};
+
+/// \brief The route sampled every sample_s seconds (and at its end), with sky masks computed once.
+struct RouteSamples {
+  std::vector<double> t_s;  ///< after departure
+  std::vector<Eigen::Vector3d> xyz;
+  std::vector<maps::Geodetic> geo;
+  std::vector<std::optional<maps::SkyMask>> masks;
+};
+
+/// \brief Both box levels along a route.
+struct RouteCorridors {
+  geofence::Corridor level1;
+  geofence::Corridor level2;
+};
+
+/// \brief Reasons gathered sample by sample: one per kind and subject, kept where it is worst.
+struct ReasonTally {
+  std::vector<Reason> reasons;
+  std::vector<int> occurrences;   ///< per reason: samples concerned
+  std::vector<double> first_t_s;  ///< per reason: its first sample's time
+
+  /// \brief Adds `reason`, placed at the sample `at`: a new kind and subject is appended; a known
+  /// one counts another sample and is replaced when this one's value is larger.
+  void add(Reason reason, const PredictedSample& at);
+  /// \brief The reasons; one seen at several samples says how many and from when.
+  [[nodiscard]] std::vector<Reason> summarised() const;
+};
+
+/// \brief What checking one route's samples found.
+struct SampleChecks {
+  std::vector<PredictedSample> predicted;
+  ReasonTally reasons;
+  int level1_exceedances = 0;     ///< samples' level-1 checks not inside
+  std::vector<Penalty> violations;  ///< where the route broke a rule, to keep away from next time
+};
+
+/// \brief What one approval carries from attempt to attempt.
+struct AttemptHistory {
+  std::vector<Penalty> penalties;       ///< every attempt's violations so far
+  std::vector<Reason> last_reasons;     ///< the last attempt's
+  std::vector<RoutePoint> last_route;   ///< the last attempt's; empty when it found no route
+  RouteSamples last_samples;            ///< the last route's samples
+};
+
+/// \brief How one attempt ended.
+enum class AttemptOutcome {
+  kApproved,    ///< every sample passed
+  kViolations,  ///< some samples did not: penalise them and replan
+  kNoRoute,     ///< no route (replanning cannot help): the next departure
+};
+
+}  // namespace approval_steps
+
+struct Approver::Impl {
+  Mission m;
+  maps::PlaneFrame frame;
+  maps::Terrain terrain;
+  geofence::LevelLimits limits;
+  std::unique_ptr<geofence::Obstructions> obstructions;
+  std::unique_ptr<maps::BuildingIndex> index;
+  integrity::OrbitSource orbits;
+  Eigen::Vector3d lower = Eigen::Vector3d::Zero(), upper = Eigen::Vector3d::Zero();
+  // The predicted-PL grid at cruise height (mid-flight time) and the integrity cost from it.
+  double cell_m = 50.0;
+  int cols = 0, rows = 0;
+  std::vector<double> cost;
+  std::vector<Eigen::Vector2d> grid_pl;  ///< (HPL, VPL) per cell; NaN when unavailable
+  bool cost_grid_built = false;
+
+  /// \throws maps::ParseError naming the mission's field of a bad input.
+  explicit Impl(Mission mission);
+
+  // --- the mission's map and integrity (approval.cpp) ---
+
+  /// Terrain height (ellipsoidal) under a map point; none outside the terrain model.
+  [[nodiscard]] std::optional<double> ground(const Eigen::Vector2d& xy) const;
+  [[nodiscard]] maps::Geodetic geodetic(const Eigen::Vector3d& p) const;
+  /// Height band and max AMSL; then the vehicle's level-1 box clear of obstructions over [t0, t1).
+  [[nodiscard]] bool valid(const Eigen::Vector3d& p, const maps::GpsTime& t0, const maps::GpsTime& t1,
+                           const std::vector<approval_steps::Penalty>& penalties) const;
+  [[nodiscard]] maps::SkyMask skyMaskAt(const maps::Geodetic& g) const;
+  /// Whether sky masks are computed (there are buildings or a terrain raster).
+  [[nodiscard]] bool masked() const;
+  [[nodiscard]] integrity::PredictSample predictAt(const maps::Geodetic& g, const maps::GpsTime& t,
+                                                   const std::optional<maps::SkyMask>& mask) const;
+  /// max(HPL/HAL₂, VPL/VAL₂); ∞ without a PL.
+  [[nodiscard]] double ratioOf(const integrity::PredictSample& s) const;
+  void buildCostGrid(const maps::GpsTime& t_mid);
+  [[nodiscard]] std::size_t cellOf(const Eigen::Vector3d& p) const;
+  /// The volume a state must keep clear: the level-1 box, grown to the PL predicted there with a
+  /// 20 % allowance for its change over the flight (the samples are checked exactly afterwards).
+  [[nodiscard]] geofence::ProtectionVolume planningVolume(const Eigen::Vector3d& p) const;
+  [[nodiscard]] double extraCost(const Eigen::Vector3d& p) const;
+  /// ETA per point: horizontal at cruise speed, vertical at climb speed, whichever is slower.
+  [[nodiscard]] std::vector<RoutePoint> timeRoute(const std::vector<Eigen::Vector3d>& pts) const;
+
+  // --- the approval (approval_steps.cpp) ---
+
+  /// The approval steps of approval.hpp from `stops` (map frame) for each departure in turn;
+  /// `from_vehicle`: a replan from where the vehicle is (no later-departure search).
+  ApprovalReport run(const std::vector<Eigen::Vector3d>& stops, const std::vector<maps::GpsTime>& departures,
+                     bool from_vehicle, const std::function<void(const std::string&)>& progress);
+
+  [[nodiscard]] approval_steps::ApprovalSetup boundFlightTime(const std::vector<Eigen::Vector3d>& stops,
+                                                              const std::vector<maps::GpsTime>& departures,
+                                                              bool from_vehicle) const;
+  void ensureCostField(const approval_steps::ApprovalSetup& setup, const approval_steps::Say& say);
+  void fitSearchBox(approval_steps::ApprovalSetup& setup) const;
+  bool tryDeparture(const approval_steps::ApprovalSetup& setup, const maps::GpsTime& departure,
+                    approval_steps::AttemptHistory& history, ApprovalReport& report, const approval_steps::Say& say) const;
+  approval_steps::AttemptOutcome attemptRoute(const approval_steps::ApprovalSetup& setup, const maps::GpsTime& departure,
+                                              int attempt, approval_steps::AttemptHistory& history, ApprovalReport& report,
+                                              const approval_steps::Say& say) const;
+  [[nodiscard]] approval_steps::LegPlan planLegs(const approval_steps::ApprovalSetup& setup, const maps::GpsTime& departure,
+                                                 int attempt, const std::vector<approval_steps::Penalty>& penalties,
+                                                 PlannerStats& stats) const;
+  [[nodiscard]] PathProblem legProblem(const approval_steps::ApprovalSetup& setup, const maps::GpsTime& departure,
+                                       int attempt, std::size_t leg, const Eigen::Vector3d& from,
+                                       const std::vector<approval_steps::Penalty>& penalties) const;
+  [[nodiscard]] Reason planningReason(const approval_steps::ApprovalSetup& setup, const maps::GpsTime& departure,
+                                      const approval_steps::LegPlan& plan, const std::string& status) const;
+  [[nodiscard]] approval_steps::RouteSamples sampleRoute(const std::vector<RoutePoint>& route,
+                                                         const approval_steps::Say& say) const;
+  [[nodiscard]] approval_steps::RouteCorridors corridorsAlong(const std::vector<Eigen::Vector3d>& pts) const;
+  [[nodiscard]] approval_steps::SampleChecks checkSamples(const approval_steps::ApprovalSetup& setup,
+                                                          const maps::GpsTime& departure,
+                                                          const std::vector<Eigen::Vector3d>& pts,
+                                                          const approval_steps::RouteSamples& samples,
+                                                          std::vector<ZoneApproach>& zones) const;
+  [[nodiscard]] PredictedSample predictSample(const approval_steps::RouteSamples& samples, std::size_t k,
+                                              const maps::GpsTime& t) const;
+  [[nodiscard]] geofence::FenceVerdict checkFence(const approval_steps::ApprovalSetup& setup,
+                                                  const approval_steps::RouteCorridors& corridors, const maps::GpsTime& t,
+                                                  const PredictedSample& ps, approval_steps::SampleChecks& checks,
+                                                  std::vector<ZoneApproach>& zones) const;
+  void noteZoneApproach(const geofence::Check& c, std::vector<ZoneApproach>& zones) const;
+  [[nodiscard]] std::optional<maps::GpsTime> searchLaterDeparture(const maps::GpsTime& departure,
+                                                                  const approval_steps::AttemptHistory& history) const;
+  [[nodiscard]] bool routePassesAt(const maps::GpsTime& departure, const approval_steps::RouteCorridors& corridors,
+                                   const approval_steps::RouteSamples& samples) const;
+};
+
+}  // namespace skylane::planner

@@ -1,0 +1,452 @@
+// The approval of approval.hpp as named steps: Approver::Impl::run lists them, each is defined
+// below in the order it runs. The state they pass along is in approval_impl.hpp.
+#include "planner/approval_impl.hpp"
+
+#include "maps/time.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+
+namespace skylane::planner {
+
+using approval_steps::ApprovalSetup;
+using approval_steps::AttemptHistory;
+using approval_steps::AttemptOutcome;
+using approval_steps::LegPlan;
+using approval_steps::Penalty;
+using approval_steps::ReasonTally;
+using approval_steps::RouteCorridors;
+using approval_steps::RouteSamples;
+using approval_steps::SampleChecks;
+using approval_steps::Say;
+
+namespace {
+
+/// Least radius round a replan's start within which only the vehicle's point must be clear [m].
+constexpr double kMinExempt_m = 10.0;
+/// What the activity window allows beyond twice the direct flight time (climb, descent,
+/// detours) [s].
+constexpr double kFlightAllowance_s = 120.0;
+/// How far ahead a rejected route's later departures are tried [s]: one day.
+constexpr double kLaterDepartureHorizon_s = 86400.0;
+/// The penalty round a sample without a protection level [m].
+constexpr double kNoPlPenalty_m = 50.0;
+/// Bounds of the penalty round a sample that broke level 2, a zone or an obstacle (its HPL,
+/// clamped) [m]: wide enough to move the route, narrow enough to leave it room.
+constexpr double kMinPenalty_m = 20.0, kMaxPenalty_m = 300.0;
+
+double secondsSince(std::chrono::steady_clock::time_point started) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}
+
+std::string fmtMetres(double v) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(1);
+  s << v << " m";
+  return s.str();
+}
+
+std::string fmtTime(double t_s) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(0);
+  s << "t+" << t_s << " s";
+  return s.str();
+}
+
+/// The penalty round a sample whose protection volume broke a rule.
+double violationRadius(const PredictedSample& ps) { return std::min(kMaxPenalty_m, std::max(ps.hpl_m, kMinPenalty_m)); }
+
+Reason noPlReason(const PredictedSample& ps) {
+  Reason r;
+  r.kind = "integrity";
+  r.subject = "PL";
+  r.message = "no protection level: " + std::to_string(ps.satellites) + " satellites usable (" +
+              std::to_string(ps.blocked) + " hidden by buildings or terrain)";
+  return r;
+}
+
+/// Level 2 broken: by the PL whose margin is smaller.
+Reason airspaceReason(const geofence::Check& c, const PredictedSample& ps, const geofence::AlertLimits& level2) {
+  Reason r;
+  r.kind = "airspace";
+  const bool horizontal = c.margin_h_m < c.margin_v_m;
+  r.subject = horizontal ? "HPL" : "VPL";
+  r.value_m = horizontal ? ps.hpl_m : ps.vpl_m;
+  r.limit_m = horizontal ? level2.hal_m : level2.val_m;
+  r.message = std::string(horizontal ? "HPL " : "VPL ") + fmtMetres(*r.value_m) + " exceeds the level-2 limit " +
+              fmtMetres(*r.limit_m) + " by " + fmtMetres(*r.value_m - *r.limit_m);
+  return r;
+}
+
+/// A zone or an obstacle met by the protection volume.
+Reason obstructionReason(const geofence::Check& c, const PredictedSample& ps) {
+  Reason r;
+  r.kind = c.level == geofence::Level::kZone ? "zone" : "obstacle";
+  r.subject = c.subject;
+  r.value_m = -std::max(c.margin_h_m, c.margin_v_m);
+  r.message = std::string("the protection volume (HPL ") + fmtMetres(ps.hpl_m) + ", VPL " + fmtMetres(ps.vpl_m) +
+              ") meets " + (c.level == geofence::Level::kZone ? "zone " : "obstacle ") + c.subject + " at " +
+              fmtTime(ps.t_s) + "; it must shrink by " + fmtMetres(*r.value_m);
+  return r;
+}
+
+}  // namespace
+
+ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, const std::vector<maps::GpsTime>& departures,
+                                   bool from_vehicle, const std::function<void(const std::string&)>& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  const Say say{progress};
+  ApprovalSetup setup = boundFlightTime(stops, departures, from_vehicle);
+  ensureCostField(setup, say);
+  fitSearchBox(setup);  // after the cost field: a replan's exemption grows with the PL predicted there
+  ApprovalReport report;
+  report.limits = limits;
+  AttemptHistory history;
+  for (const maps::GpsTime& departure : departures) {
+    if (tryDeparture(setup, departure, history, report, say)) break;
+  }
+  // Rejected: the last attempt's reasons; for a fixed departure, the earliest later departure
+  // (within 24 h, in departure steps) at which the same route passes its integrity checks.
+  if (!report.approved) {
+    report.reasons = history.last_reasons;
+    if (!history.last_route.empty() && departures.size() == 1 && !from_vehicle) {
+      say("looking for a later departure");
+      report.earliest_passing_departure = searchLaterDeparture(departures.front(), history);
+    }
+  }
+  report.elapsed_s = secondsSince(started);
+  return report;
+}
+
+ApprovalSetup Approver::Impl::boundFlightTime(const std::vector<Eigen::Vector3d>& stops,
+                                              const std::vector<maps::GpsTime>& departures, bool from_vehicle) const {
+  ApprovalSetup setup;
+  setup.stops = stops;
+  setup.departures = departures;
+  setup.from_vehicle = from_vehicle;
+  double direct_m = 0.0;
+  for (std::size_t i = 1; i < stops.size(); ++i) direct_m += (stops[i] - stops[i - 1]).head<2>().norm();
+  setup.direct_s = direct_m / m.cruise_speed_mps;
+  const double flight_bound_s = 2.0 * setup.direct_s + kFlightAllowance_s;
+  // The zones' activity window reaches the mission's latest departure (a window whose length
+  // is not a multiple of its step has its last departure before it); a replan's is `now`.
+  const maps::GpsTime latest_departure = from_vehicle ? departures.back() : m.departure_latest;
+  setup.zones_until = latest_departure.plus(flight_bound_s);
+  return setup;
+}
+
+/// The integrity cost field is predicted once, at the first approval's mid-flight time.
+void Approver::Impl::ensureCostField(const ApprovalSetup& setup, const Say& say) {
+  if (cost_grid_built) return;
+  say("predicted protection levels over the area (integrity cost field)");
+  buildCostGrid(setup.departures.front().plus(setup.direct_s / 2.0));
+  cost_grid_built = true;
+}
+
+/// From the vehicle: the search box reaches it, and near it only the vehicle's own point must be
+/// clear (it may have drifted so close to a zone that its box is not: the route leads it away).
+void Approver::Impl::fitSearchBox(ApprovalSetup& setup) const {
+  setup.box_lo = lower;
+  setup.box_hi = upper;
+  setup.exempt_m = 0.0;
+  if (!setup.from_vehicle) return;
+  const Eigen::Vector3d& vehicle = setup.stops.front();
+  setup.box_lo = setup.box_lo.cwiseMin(vehicle - Eigen::Vector3d::Constant(1.0));
+  setup.box_hi = setup.box_hi.cwiseMax(vehicle + Eigen::Vector3d::Constant(1.0));
+  setup.exempt_m = std::max(kMinExempt_m, 2.0 * planningVolume(vehicle).hpl_m);
+}
+
+/// One departure: attempt a route, and after violations replan up to max_replans times; true
+/// when approved.
+bool Approver::Impl::tryDeparture(const ApprovalSetup& setup, const maps::GpsTime& departure, AttemptHistory& history,
+                                  ApprovalReport& report, const Say& say) const {
+  ++report.planner.departures_tried;
+  AttemptOutcome outcome = AttemptOutcome::kViolations;
+  for (int attempt = 0; attempt <= m.max_replans && outcome == AttemptOutcome::kViolations; ++attempt) {
+    outcome = attemptRoute(setup, departure, attempt, history, report, say);
+  }
+  return outcome == AttemptOutcome::kApproved;
+}
+
+/// One attempt: plan the legs, time the route, sample and check it; keep it in the report and
+/// the history (approved, or its violations penalised for the next attempt).
+AttemptOutcome Approver::Impl::attemptRoute(const ApprovalSetup& setup, const maps::GpsTime& departure, int attempt,
+                                            AttemptHistory& history, ApprovalReport& report, const Say& say) const {
+  ++report.planner.attempts;
+  say("planning (departure " + maps::formatRfc3339(departure) + ", attempt " + std::to_string(attempt + 1) + ")");
+  const LegPlan plan = planLegs(setup, departure, attempt, history.penalties, report.planner);
+  if (!plan.ok) {
+    history.last_reasons = {planningReason(setup, departure, plan, report.planner.status)};
+    history.last_route.clear();
+    return AttemptOutcome::kNoRoute;  // replanning cannot help; next departure
+  }
+  const std::vector<RoutePoint> route = timeRoute(plan.pts);
+  report.planner.length_m = polylineLength(plan.pts);
+  const RouteSamples samples = sampleRoute(route, say);
+  SampleChecks checks = checkSamples(setup, departure, plan.pts, samples, report.zones);
+  std::vector<Reason> reasons = checks.reasons.summarised();
+  history.last_route = route;
+  history.last_samples = samples;
+  report.route = route;
+  report.predicted = std::move(checks.predicted);
+  report.level1_exceedances = checks.level1_exceedances;
+  report.departure = departure;
+  if (reasons.empty()) {
+    report.approved = true;
+    return AttemptOutcome::kApproved;
+  }
+  history.last_reasons = std::move(reasons);
+  history.penalties.insert(history.penalties.end(), checks.violations.begin(), checks.violations.end());
+  return AttemptOutcome::kViolations;
+}
+
+/// Plan leg by leg through the waypoints; stop at the first leg without an exact path.
+LegPlan Approver::Impl::planLegs(const ApprovalSetup& setup, const maps::GpsTime& departure, int attempt,
+                                 const std::vector<Penalty>& penalties, PlannerStats& stats) const {
+  LegPlan plan;
+  plan.pts = {setup.stops.front()};
+  for (std::size_t leg = 1; leg < setup.stops.size(); ++leg) {
+    plan.last = planPath(legProblem(setup, departure, attempt, leg, plan.pts.back(), penalties));
+    stats.planning_time_s += plan.last.planning_time_s + plan.last.simplify_time_s;
+    stats.iterations += plan.last.iterations;
+    stats.stopped_by_time = stats.stopped_by_time || plan.last.stopped_by_time;
+    if (plan.last.status != PathStatus::kExact) {
+      plan.ok = false;
+      plan.failed_leg = leg;
+      break;
+    }
+    plan.pts.insert(plan.pts.end(), plan.last.points.begin() + 1, plan.last.points.end());
+  }
+  stats.algorithm = std::string(plannerName(m.planner));
+  stats.status = std::string(pathStatusName(plan.last.status));
+  stats.straight_line = plan.last.straight_line && setup.stops.size() == 2;
+  return plan;
+}
+
+/// One leg's query: a state is valid (approval.hpp, step 1) over the zones active from when the
+/// vehicle could first be there to the end of the activity window.
+PathProblem Approver::Impl::legProblem(const ApprovalSetup& setup, const maps::GpsTime& departure, int attempt,
+                                       std::size_t leg, const Eigen::Vector3d& from,
+                                       const std::vector<Penalty>& penalties) const {
+  PathProblem prob;
+  prob.lower_enu_m = setup.box_lo;
+  prob.upper_enu_m = setup.box_hi;
+  prob.start_enu_m = from;
+  prob.goal_enu_m = setup.stops[leg];
+  const Eigen::Vector2d start_xy = setup.stops.front().head<2>();
+  const maps::GpsTime latest = setup.zones_until;
+  const Eigen::Vector3d vehicle = setup.stops.front();
+  const double exempt_m = setup.exempt_m;
+  prob.is_valid = [this, &penalties, start_xy, departure, latest, vehicle, exempt_m](const Eigen::Vector3d& p) {
+    const maps::GpsTime earliest = departure.plus((p.head<2>() - start_xy).norm() / m.cruise_speed_mps);
+    if (exempt_m > 0.0 && (p - vehicle).norm() <= exempt_m) {
+      return !obstructions->firstConflict({earliest, latest, {p, 0.0, 0.0}});
+    }
+    return valid(p, earliest, latest, penalties);
+  };
+  if (!cost.empty()) {
+    prob.extra_cost = [this](const Eigen::Vector3d& p) { return extraCost(p); };
+    prob.cost_step_m = cell_m / 2.0;
+  }
+  prob.resolution_m = m.resolution_m;
+  prob.time_limit_s = m.time_limit_s;
+  prob.max_iterations = m.iterations;
+  prob.seed = m.seed + static_cast<std::uint64_t>(attempt) * 7919u + leg;
+  prob.planner = m.planner;
+  prob.simplify = m.simplify;
+  return prob;
+}
+
+/// Why no route was found: an unflyable start or goal (naming the zone or obstacle it lies in,
+/// when one does), or the planner's budget.
+Reason Approver::Impl::planningReason(const ApprovalSetup& setup, const maps::GpsTime& departure, const LegPlan& plan,
+                                      const std::string& status) const {
+  Reason r;
+  r.kind = "planning";
+  r.subject = status;
+  const PathResult& last = plan.last;
+  if (last.status != PathStatus::kInvalidStart && last.status != PathStatus::kInvalidGoal) {
+    r.message = "no route found within " + std::to_string(last.iterations) + " planner iterations (" + status +
+                (last.stopped_by_time ? ", stopped by the time limit)" : ")");
+    return r;
+  }
+  const bool start = last.status == PathStatus::kInvalidStart;
+  const Eigen::Vector3d p = start ? plan.pts.back() : setup.stops[plan.failed_leg];
+  r.message = std::string(start ? "the start" : "the goal") +
+              " is not flyable at cruise height: it is inside (or within the level-1 box of) an active zone"
+              " or obstacle, or outside the altitude limits";
+  if (const auto c =
+          obstructions->firstConflict({departure, setup.zones_until, {p, limits.level1.hal_m, limits.level1.val_m}})) {
+    r.kind = c->level == geofence::Level::kZone ? "zone" : "obstacle";
+    r.subject = c->subject;
+    r.message = std::string(start ? "the start" : "the goal") + " lies in " +
+                (c->level == geofence::Level::kZone ? "zone " : "obstacle ") + c->subject;
+  }
+  const maps::Geodetic g = geodetic(p);
+  r.lat_rad = g.lat_rad;
+  r.lon_rad = g.lon_rad;
+  r.h_ell_m = g.h_ell_m;
+  return r;
+}
+
+/// Sample times every sample_s and the route's end; the place and sky mask at each.
+RouteSamples Approver::Impl::sampleRoute(const std::vector<RoutePoint>& route, const Say& say) const {
+  const double total_s = route.back().eta_s;
+  RouteSamples samples;
+  for (double t = 0.0;; t += m.sample_s) {
+    const double tt = std::min(t, total_s);
+    samples.t_s.push_back(tt);
+    if (tt >= total_s) break;
+  }
+  say("predicting " + std::to_string(samples.t_s.size()) + " samples");
+  const bool with_masks = masked();
+  for (double t : samples.t_s) {
+    const Eigen::Vector3d p = positionAlong(route, t);
+    samples.xyz.push_back(p);
+    samples.geo.push_back(geodetic(p));
+    samples.masks.push_back(with_masks ? std::optional(skyMaskAt(samples.geo.back())) : std::nullopt);
+  }
+  return samples;
+}
+
+RouteCorridors Approver::Impl::corridorsAlong(const std::vector<Eigen::Vector3d>& pts) const {
+  return {geofence::Corridor(pts, limits.level1, {}), geofence::Corridor(pts, limits.level2, {})};
+}
+
+/// Every sample: its predicted PLs, then (with a PL) the fence check of its protection volume.
+SampleChecks Approver::Impl::checkSamples(const ApprovalSetup& setup, const maps::GpsTime& departure,
+                                          const std::vector<Eigen::Vector3d>& pts, const RouteSamples& samples,
+                                          std::vector<ZoneApproach>& zones) const {
+  const RouteCorridors corridors = corridorsAlong(pts);
+  SampleChecks checks;
+  for (std::size_t k = 0; k < samples.t_s.size(); ++k) {
+    const maps::GpsTime t = departure.plus(samples.t_s[k]);
+    PredictedSample ps = predictSample(samples, k, t);
+    if (ps.pl_available) {
+      ps.fence = checkFence(setup, corridors, t, ps, checks, zones);
+    } else {
+      checks.reasons.add(noPlReason(ps), ps);
+      checks.violations.emplace_back(ps.xyz, kNoPlPenalty_m);
+    }
+    checks.predicted.push_back(std::move(ps));
+  }
+  return checks;
+}
+
+PredictedSample Approver::Impl::predictSample(const RouteSamples& samples, std::size_t k, const maps::GpsTime& t) const {
+  PredictedSample ps;
+  ps.t_s = samples.t_s[k];
+  ps.xyz = samples.xyz[k];
+  ps.lat_rad = samples.geo[k].lat_rad;
+  ps.lon_rad = samples.geo[k].lon_rad;
+  ps.h_ell_m = samples.geo[k].h_ell_m;
+  const integrity::PredictSample pr = predictAt(samples.geo[k], t, samples.masks[k]);
+  ps.pl_available = pr.pl.pl_computed;
+  ps.hpl_m = pr.pl.hpl_m;
+  ps.vpl_m = pr.pl.vpl_m;
+  ps.satellites = static_cast<int>(pr.sats.size());
+  ps.blocked = static_cast<int>(pr.blocked);
+  return ps;
+}
+
+/// The fence at this instant: both levels, zones and obstacles. Level 1 is counted, level 2, the
+/// zones and the obstacles give reasons and penalties; every zone's nearest approach is kept.
+geofence::FenceVerdict Approver::Impl::checkFence(const ApprovalSetup& setup, const RouteCorridors& corridors,
+                                                  const maps::GpsTime& t, const PredictedSample& ps, SampleChecks& checks,
+                                                  std::vector<ZoneApproach>& zones) const {
+  // The fence borrows the obstructions: a copy would rebuild the scene.
+  const geofence::TimedVolume v{t, t, {ps.xyz, ps.hpl_m, ps.vpl_m}};
+  geofence::FenceVerdict fv = geofence::checkVolume(corridors.level1, corridors.level2, *obstructions, v);
+  // A replan's first metres leave the place the vehicle is in; they are not its reasons.
+  const bool leaving = setup.from_vehicle && (ps.xyz - setup.stops.front()).norm() <= setup.exempt_m;
+  for (const geofence::Check& c : fv.checks) {
+    const bool inside = c.verdict == geofence::Verdict::kInside;
+    if (c.level == geofence::Level::kCorridor) {
+      // Level 1 is not a rejection: in flight HPL > HAL₁ reruns the monitoring.
+      if (!inside) ++checks.level1_exceedances;
+    } else if (c.level == geofence::Level::kAirspace) {
+      if (inside) continue;
+      checks.reasons.add(airspaceReason(c, ps, limits.level2), ps);
+      checks.violations.emplace_back(ps.xyz, violationRadius(ps));
+    } else {
+      if (!inside && !leaving) {
+        checks.reasons.add(obstructionReason(c, ps), ps);
+        checks.violations.emplace_back(ps.xyz, violationRadius(ps) + limits.level1.hal_m);
+      }
+      if (c.level == geofence::Level::kZone) noteZoneApproach(c, zones);
+    }
+  }
+  return fv;
+}
+
+void Approver::Impl::noteZoneApproach(const geofence::Check& c, std::vector<ZoneApproach>& zones) const {
+  auto it = std::find_if(zones.begin(), zones.end(), [&](const ZoneApproach& z) { return z.identifier == c.subject; });
+  if (it == zones.end()) {
+    const airspace::Zone& z = obstructions->zones()[c.index];
+    zones.push_back({z.identifier, std::string(airspace::restrictionName(z.restriction)), obstructions->zoneCounts(c.index),
+                     *c.clearance_m});
+  } else {
+    it->min_clearance_m = std::min(it->min_clearance_m, *c.clearance_m);
+  }
+}
+
+void ReasonTally::add(Reason reason, const PredictedSample& at) {
+  reason.t_s = at.t_s;
+  reason.lat_rad = at.lat_rad;
+  reason.lon_rad = at.lon_rad;
+  reason.h_ell_m = at.h_ell_m;
+  // One reason per kind and subject: where and when it is worst, and from when.
+  for (std::size_t i = 0; i < reasons.size(); ++i) {
+    Reason& known = reasons[i];
+    if (known.kind != reason.kind || known.subject != reason.subject) continue;
+    ++occurrences[i];
+    if (reason.value_m && known.value_m && *reason.value_m > *known.value_m) known = std::move(reason);
+    return;
+  }
+  reasons.push_back(std::move(reason));
+  occurrences.push_back(1);
+  first_t_s.push_back(at.t_s);
+}
+
+std::vector<Reason> ReasonTally::summarised() const {
+  std::vector<Reason> out = reasons;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (occurrences[i] > 1) {
+      out[i].message += " (worst of " + std::to_string(occurrences[i]) + " samples from " + fmtTime(first_t_s[i]) + ")";
+    }
+  }
+  return out;
+}
+
+/// The earliest departure, in departure steps within a day, at which the last route passes.
+std::optional<maps::GpsTime> Approver::Impl::searchLaterDeparture(const maps::GpsTime& departure,
+                                                                  const AttemptHistory& history) const {
+  std::vector<Eigen::Vector3d> pts;
+  for (const RoutePoint& p : history.last_route) pts.push_back(p.xyz);
+  const RouteCorridors corridors = corridorsAlong(pts);
+  for (double shift = m.departure_step_s; shift <= kLaterDepartureHorizon_s; shift += m.departure_step_s) {
+    const maps::GpsTime later = departure.plus(shift);
+    if (routePassesAt(later, corridors, history.last_samples)) return later;
+  }
+  return std::nullopt;
+}
+
+/// The same rule as the approval: every sample has a PL, and every check but level 1 holds.
+bool Approver::Impl::routePassesAt(const maps::GpsTime& departure, const RouteCorridors& corridors,
+                                   const RouteSamples& samples) const {
+  for (std::size_t k = 0; k < samples.t_s.size(); ++k) {
+    const maps::GpsTime t = departure.plus(samples.t_s[k]);
+    const integrity::PredictSample pr = predictAt(samples.geo[k], t, samples.masks[k]);
+    if (!pr.pl.pl_computed) return false;
+    const geofence::TimedVolume v{t, t, {samples.xyz[k], pr.pl.hpl_m, pr.pl.vpl_m}};
+    for (const geofence::Check& c : geofence::checkVolume(corridors.level1, corridors.level2, *obstructions, v).checks) {
+      if (c.level != geofence::Level::kCorridor && c.verdict != geofence::Verdict::kInside) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace skylane::planner
