@@ -161,11 +161,7 @@ void runApprove(const ApproveOptions& o) {
     // An operational intent is only for an approved route (F3548 state "Accepted").
     std::filesystem::remove(dir / "operational_intent.json");
     if (r.approved) {
-      const json intent{{"operational_intent", {{"volumes", planner::operationalIntentVolumes(r, approver.frame(), 2, 30.0)},
-                                                 {"state", "Accepted"},
-                                                 {"priority", 0}}},
-                        {"corridor_volumes", planner::operationalIntentVolumes(r, approver.frame(), 1, 30.0)}};
-      std::ofstream(dir / "operational_intent.json") << intent.dump(1) << "\n";
+      std::ofstream(dir / "operational_intent.json") << planner::operationalIntentJson(r, approver.frame()).dump(1) << "\n";
     }
   }
   std::cout << j.dump(2) << "\n";

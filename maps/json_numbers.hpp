@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief The one rounding rule of every JSON output (docs/formats.md "Numbers"): lengths to the
+/// \brief The one rounding rule of every JSON output (docs/method.md §1.3): lengths to the
 /// millimetre, angles in degrees to 1e-8° (about 1 mm on the ground), times to the millisecond,
 /// and a non-finite length (an unlimited floor or ceiling, a PL not computed) as null.
 

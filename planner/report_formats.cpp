@@ -2,6 +2,7 @@
 
 #include "maps/file_digest.hpp"
 #include "maps/json_node.hpp"
+#include "maps/json_numbers.hpp"
 
 #include <cmath>
 #include <filesystem>
@@ -13,7 +14,7 @@ namespace {
 using nlohmann::json;
 
 double round7(double deg) { return std::round(deg * 1e7) / 1e7; }
-double roundMm(double m) { return std::round(m * 1e3) / 1e3; }
+using maps::roundToMm;
 
 nlohmann::json lonLat(const maps::PlaneFrame& frame, const Eigen::Vector2d& xy) {
   const Eigen::Vector2d ll = frame.toLatLon(xy);
@@ -30,9 +31,9 @@ nlohmann::json reasonJson(const Reason& r, const maps::GpsTime& dep) {
   if (r.t_s) j["time"] = maps::formatRfc3339(dep.plus(*r.t_s), 1);
   if (r.lat_rad) j["lat"] = deg(*r.lat_rad);
   if (r.lon_rad) j["lon"] = deg(*r.lon_rad);
-  if (r.h_ell_m) j["h_ell_m"] = roundMm(*r.h_ell_m);
-  if (r.value_m) j["value_m"] = roundMm(*r.value_m);
-  if (r.limit_m) j["limit_m"] = roundMm(*r.limit_m);
+  if (r.h_ell_m) j["h_ell_m"] = roundToMm(*r.h_ell_m);
+  if (r.value_m) j["value_m"] = roundToMm(*r.value_m);
+  if (r.limit_m) j["limit_m"] = roundToMm(*r.limit_m);
   return j;
 }
 
@@ -41,10 +42,10 @@ json routeJson(const ApprovalReport& r) {
   for (const RoutePoint& p : r.route) {
     route.push_back({{"lat", deg(p.lat_rad)},
                      {"lon", deg(p.lon_rad)},
-                     {"h_ell_m", roundMm(p.h_ell_m)},
-                     {"alt_amsl_m", roundMm(p.alt_amsl_m)},
+                     {"h_ell_m", roundToMm(p.h_ell_m)},
+                     {"alt_amsl_m", roundToMm(p.alt_amsl_m)},
                      {"eta", maps::formatRfc3339(r.departure.plus(p.eta_s), 1)},
-                     {"eta_s", roundMm(p.eta_s)}});
+                     {"eta_s", roundToMm(p.eta_s)}});
   }
   return route;
 }
@@ -54,19 +55,19 @@ json predictedSampleJson(const PredictedSample& s, const ApprovalReport& r) {
   json p{{"time", maps::formatRfc3339(r.departure.plus(s.t_s), 1)},
          {"lat", deg(s.lat_rad)},
          {"lon", deg(s.lon_rad)},
-         {"h_ell_m", roundMm(s.h_ell_m)},
+         {"h_ell_m", roundToMm(s.h_ell_m)},
          {"satellites", s.satellites},
          {"blocked", s.blocked},
-         {"hpl_m", s.pl_available ? json(roundMm(s.hpl_m)) : json(nullptr)},
-         {"vpl_m", s.pl_available ? json(roundMm(s.vpl_m)) : json(nullptr)},
-         {"hal1_m", roundMm(r.limits.level1.hal_m)},
-         {"val1_m", roundMm(r.limits.level1.val_m)},
-         {"hal2_m", roundMm(r.limits.level2.hal_m)},
-         {"val2_m", roundMm(r.limits.level2.val_m)}};
+         {"hpl_m", s.pl_available ? json(roundToMm(s.hpl_m)) : json(nullptr)},
+         {"vpl_m", s.pl_available ? json(roundToMm(s.vpl_m)) : json(nullptr)},
+         {"hal1_m", roundToMm(r.limits.level1.hal_m)},
+         {"val1_m", roundToMm(r.limits.level1.val_m)},
+         {"hal2_m", roundToMm(r.limits.level2.hal_m)},
+         {"val2_m", roundToMm(r.limits.level2.val_m)}};
   for (const geofence::Check& c : s.fence.checks) {
     if (c.level == geofence::Level::kAirspace) {
-      p["margin_h_m"] = roundMm(c.margin_h_m);
-      p["margin_v_m"] = roundMm(c.margin_v_m);
+      p["margin_h_m"] = roundToMm(c.margin_h_m);
+      p["margin_v_m"] = roundToMm(c.margin_v_m);
     }
   }
   return p;
@@ -76,7 +77,7 @@ json zonesJson(const ApprovalReport& r) {
   json zones = json::array();
   for (const ZoneApproach& z : r.zones) {
     zones.push_back({{"id", z.identifier}, {"restriction", z.restriction}, {"counted", z.counted},
-                     {"min_clearance_m", roundMm(z.min_clearance_m)}});
+                     {"min_clearance_m", roundToMm(z.min_clearance_m)}});
   }
   return zones;
 }
@@ -86,7 +87,7 @@ json plannerJson(const ApprovalReport& r, const Mission& m) {
           {"status", r.planner.status},
           {"straight_line", r.planner.straight_line},
           {"planning_time_s", std::round(r.planner.planning_time_s * 1e4) / 1e4},
-          {"length_m", roundMm(r.planner.length_m)},
+          {"length_m", roundToMm(r.planner.length_m)},
           {"attempts", r.planner.attempts},
           {"iterations", r.planner.iterations},
           {"stopped_by_time", r.planner.stopped_by_time},
@@ -122,9 +123,9 @@ nlohmann::json approvalReportJson(const ApprovalReport& r, const Mission& m) {
   j["departure"] = maps::formatRfc3339(r.departure);
   if (r.earliest_passing_departure) j["earliest_passing_departure"] = maps::formatRfc3339(*r.earliest_passing_departure);
   j["route"] = routeJson(r);
-  j["corridor"] = {{"level", 1}, {"hal_m", roundMm(r.limits.level1.hal_m)}, {"val_m", roundMm(r.limits.level1.val_m)},
+  j["corridor"] = {{"level", 1}, {"hal_m", roundToMm(r.limits.level1.hal_m)}, {"val_m", roundToMm(r.limits.level1.val_m)},
                    {"k", m.levels.k1}, {"centre_line", "route"}};
-  j["airspace"] = {{"level", 2}, {"hal_m", roundMm(r.limits.level2.hal_m)}, {"val_m", roundMm(r.limits.level2.val_m)},
+  j["airspace"] = {{"level", 2}, {"hal_m", roundToMm(r.limits.level2.hal_m)}, {"val_m", roundToMm(r.limits.level2.val_m)},
                    {"k", m.levels.k2}, {"centre_line", "route"}};
   json predicted = json::array();
   for (const PredictedSample& s : r.predicted) predicted.push_back(predictedSampleJson(s, r));
@@ -152,7 +153,7 @@ nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission
   json features = json::array();
   json line = json::array();
   for (const RoutePoint& p : report.route) {
-    line.push_back({round7(maps::rad2deg(p.lon_rad)), round7(maps::rad2deg(p.lat_rad)), roundMm(p.alt_amsl_m)});
+    line.push_back({round7(maps::rad2deg(p.lon_rad)), round7(maps::rad2deg(p.lat_rad)), roundToMm(p.alt_amsl_m)});
   }
   features.push_back({{"type", "Feature"},
                       {"geometry", {{"type", "LineString"}, {"coordinates", line}}},
@@ -166,10 +167,10 @@ nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission
     const RoutePoint& p = report.route[i];
     features.push_back(
         {{"type", "Feature"},
-         {"geometry", {{"type", "Point"}, {"coordinates", {round7(maps::rad2deg(p.lon_rad)), round7(maps::rad2deg(p.lat_rad)), roundMm(p.alt_amsl_m)}}}},
+         {"geometry", {{"type", "Point"}, {"coordinates", {round7(maps::rad2deg(p.lon_rad)), round7(maps::rad2deg(p.lat_rad)), roundToMm(p.alt_amsl_m)}}}},
          {"properties",
           {{"kind", "route_point"}, {"index", i}, {"eta", maps::formatRfc3339(report.departure.plus(p.eta_s), 1)},
-           {"h_ell_m", roundMm(p.h_ell_m)}, {"alt_amsl_m", roundMm(p.alt_amsl_m)}}}});
+           {"h_ell_m", roundToMm(p.h_ell_m)}, {"alt_amsl_m", roundToMm(p.alt_amsl_m)}}}});
   }
   for (int level : {2, 1}) {
     const geofence::AlertLimits& lim = level == 1 ? report.limits.level1 : report.limits.level2;
@@ -185,10 +186,10 @@ nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission
                            {{"kind", level == 1 ? "corridor" : "airspace"},
                             {"level", level},
                             {"segment", i - 1},
-                            {"hal_m", roundMm(lim.hal_m)},
-                            {"val_m", roundMm(lim.val_m)},
-                            {"h_ell_lower_m", roundMm(std::min(report.route[i - 1].h_ell_m, report.route[i].h_ell_m) - lim.val_m)},
-                            {"h_ell_upper_m", roundMm(std::max(report.route[i - 1].h_ell_m, report.route[i].h_ell_m) + lim.val_m)}}}});
+                            {"hal_m", roundToMm(lim.hal_m)},
+                            {"val_m", roundToMm(lim.val_m)},
+                            {"h_ell_lower_m", roundToMm(std::min(report.route[i - 1].h_ell_m, report.route[i].h_ell_m) - lim.val_m)},
+                            {"h_ell_upper_m", roundToMm(std::max(report.route[i - 1].h_ell_m, report.route[i].h_ell_m) + lim.val_m)}}}});
     }
   }
   for (const Reason& r : report.reasons) {
@@ -218,8 +219,8 @@ nlohmann::json operationalIntentVolumes(const ApprovalReport& report, const maps
     volumes.push_back(
         {{"volume",
           {{"outline_polygon", {{"vertices", vertices}}},
-           {"altitude_lower", {{"value", roundMm(lower)}, {"reference", "W84"}, {"units", "M"}}},
-           {"altitude_upper", {{"value", roundMm(upper)}, {"reference", "W84"}, {"units", "M"}}}}},
+           {"altitude_lower", {{"value", roundToMm(lower)}, {"reference", "W84"}, {"units", "M"}}},
+           {"altitude_upper", {{"value", roundToMm(upper)}, {"reference", "W84"}, {"units", "M"}}}}},
          {"time_start", {{"value", maps::formatRfc3339(report.departure.plus(a.eta_s - time_buffer_s), 0)}, {"format", "RFC3339"}}},
          {"time_end", {{"value", maps::formatRfc3339(report.departure.plus(b.eta_s + time_buffer_s), 0)}, {"format", "RFC3339"}}}});
   }
@@ -277,6 +278,13 @@ ApprovedFlight parseApprovalReport(const nlohmann::json& doc, const std::string&
     }
   }
   return f;
+}
+
+nlohmann::json operationalIntentJson(const ApprovalReport& report, const maps::PlaneFrame& frame) {
+  return {{"operational_intent", {{"volumes", operationalIntentVolumes(report, frame, 2, kIntentTimeBuffer_s)},
+                                  {"state", "Accepted"},
+                                  {"priority", 0}}},
+          {"corridor_volumes", operationalIntentVolumes(report, frame, 1, kIntentTimeBuffer_s)}};
 }
 
 }  // namespace skylane::planner

@@ -51,4 +51,11 @@ struct ApprovedFlight {
 [[nodiscard]] nlohmann::json operationalIntentVolumes(const ApprovalReport& report, const maps::PlaneFrame& frame,
                                                       int level, double time_buffer_s);
 
+/// \brief Seconds an operational intent's volumes reach before and after the route's ETAs.
+constexpr double kIntentTimeBuffer_s = 30.0;
+
+/// \brief The operational intent of an approved route (ASTM F3548-21, state "Accepted"): the
+/// level-2 volumes as `operational_intent.volumes`, and the level-1 volumes as `corridor_volumes`.
+[[nodiscard]] nlohmann::json operationalIntentJson(const ApprovalReport& report, const maps::PlaneFrame& frame);
+
 }  // namespace skylane::planner

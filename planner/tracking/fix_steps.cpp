@@ -429,9 +429,9 @@ namespace {
 
 /// An approved replan becomes the flight's route: both box levels, a new version, empty windows.
 void takeNewRoute(TrackedFlight& f, const ApprovalReport& r, TrackEvent& rp) {
-  const maps::PlaneFrame& frame = f.approver->frame();
-  rp["operational_intent"] = {{"volumes", operationalIntentVolumes(r, frame, 2, 30.0)}, {"state", "Accepted"}, {"priority", 0}};
-  rp["corridor_volumes"] = operationalIntentVolumes(r, frame, 1, 30.0);
+  json intent = operationalIntentJson(r, f.approver->frame());
+  rp["operational_intent"] = std::move(intent["operational_intent"]);
+  rp["corridor_volumes"] = std::move(intent["corridor_volumes"]);
   f.plan.route = r.route;
   f.plan.departure = r.departure;
   f.buildBoxes();
