@@ -251,12 +251,21 @@ TEST_F(TrackCli, AClosedOutputPipeStopsCleanlyAndARestartLosesNoFix) {
   EXPECT_EQ(planner::TrackStore(db).events("rejected_input").size(), 2850u);
 }
 
+/// Shell that waits (up to 20 s) until a process listens on the UDP port: a loaded machine can
+/// take longer than any fixed sleep to start the tracker, and datagrams sent before are lost.
+std::string waitForUdpPort(int port) {
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "%04X", port);
+  return std::string("for i in $(seq 400); do grep -qi ':") + hex + " ' /proc/net/udp && break; sleep 0.05; done; ";
+}
+
 TEST_F(TrackCli, UdpInputAndAStaleFlightOnAQuietLink) {
   const std::string events = *dir_ + "/udp_events.jsonl";
   std::string send;
   for (int k = 0; k < 5; ++k) send += "echo \x27" + goodFix(k).dump() + "\x27 > /dev/udp/127.0.0.1/47811; sleep 0.05; ";
   const RunResult r = sh(kBin + " track --approval " + approval() + " --input udp://127.0.0.1:47811 --stale-after 1 --no-replan > " +
-                         events + " 2>/dev/null & pid=$!; sleep 0.5; " + send + " sleep 2.5; kill -TERM $pid; wait $pid; echo status=$?");
+                         events + " 2>/dev/null & pid=$!; " + waitForUdpPort(47811) + send +
+                         " sleep 2.5; kill -TERM $pid; wait $pid; echo status=$?");
   EXPECT_NE(r.out.find("status=0"), std::string::npos) << r.out;
   const auto ev = readEvents(events);
   EXPECT_EQ(ofType(ev, "fix").size(), 5u);
