@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""Compares two output trees of scripts/run_example.sh: JSON and JSON lines by value (wall-clock
+keys dropped, the base's renamed keys mapped), CSV, SVG and text line by line (wall-clock
+figures masked). Usage: compare_outputs.py BASE_DIR NEW_DIR [RENAMED_KEYS.tsv]"""
+import json
+import os
+import re
+import sys
+
+WALL_CLOCK_KEYS = {"elapsed_s", "planning_time_s"}
+WALL_CLOCK_TEXT = re.compile(r"\b\d+(\.\d+)? ?(s|ms)\b")
+SKIP_SUFFIXES = (".sqlite", ".sqlite-wal", ".sqlite-shm", ".sqlite-journal")
+
+
+def load_renames(path):
+    renames = {}
+    if path and os.path.exists(path):
+        for line in open(path, encoding="utf-8"):
+            if line.strip() and not line.startswith("#"):
+                old, new = line.rstrip("\n").split("\t")[:2]
+                renames[old] = new
+    return renames
+
+
+def normalise(value, renames):
+    if isinstance(value, dict):
+        return {renames.get(k, k): normalise(v, renames) for k, v in value.items() if k not in WALL_CLOCK_KEYS}
+    if isinstance(value, list):
+        return [normalise(v, renames) for v in value]
+    if isinstance(value, str):
+        return renames.get(value, value)
+    return value
+
+
+def json_values(path, renames):
+    text = open(path, encoding="utf-8").read()
+    try:
+        return [normalise(json.loads(text), renames)]
+    except json.JSONDecodeError:
+        return [normalise(json.loads(l), renames) for l in text.splitlines() if l.strip()]
+
+
+def text_lines(path, renames):
+    lines = []
+    for line in open(path, encoding="utf-8", errors="replace").read().splitlines():
+        for old, new in renames.items():
+            line = line.replace(old, new)
+        lines.append(WALL_CLOCK_TEXT.sub("<t>", line))
+    return lines
+
+
+def files(root):
+    out = set()
+    for d, _, names in os.walk(root):
+        for n in names:
+            if not n.endswith(SKIP_SUFFIXES):
+                out.add(os.path.relpath(os.path.join(d, n), root))
+    return out
+
+
+def main():
+    base, new = sys.argv[1], sys.argv[2]
+    renames = load_renames(sys.argv[3] if len(sys.argv) > 3 else None)
+    base_files, new_files = files(base), files(new)
+    problems = [f"only in the base: {f}" for f in sorted(base_files - new_files)]
+    problems += [f"only in the new: {f}" for f in sorted(new_files - base_files)]
+    for rel in sorted(base_files & new_files):
+        b, n = os.path.join(base, rel), os.path.join(new, rel)
+        json_like = rel.endswith((".json", ".jsonl", ".geojson"))
+        read = json_values if json_like else text_lines
+        vb, vn = read(b, renames), read(n, renames)
+        if vb != vn:
+            first = next((i for i, (x, y) in enumerate(zip(vb, vn)) if x != y), min(len(vb), len(vn)))
+            problems.append(f"{rel}: differs from item/line {first + 1} ({len(vb)} vs {len(vn)})")
+    for p in problems:
+        print("compare_example:", p)
+    print(f"compare_example: {len(base_files & new_files)} files compared, {len(problems)} difference(s)")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
