@@ -41,16 +41,13 @@ MethodSample sampleOf(bool available, const Eigen::Vector3d& r_ecef, const Eigen
   return m;
 }
 
-}  // namespace
-
-RunResult runScenario(const Scenario& s, const OrbitSource& orbits, std::uint64_t seed) {
-  const Trajectory trajectory(s.origin, s.waypoints, s.turn_radius_m);
-  SensorSimulator sim(trajectory, orbits, s.start, s.sensors, s.faults, seed);
-  // The filter starts from the truth perturbed within its initial covariance (an initial
-  // alignment and fix), drawn from its own stream so that the sensors' draws do not shift.
+/// \brief The navigator, started from the truth perturbed within its filter's initial
+/// covariance (an initial alignment and fix), drawn from its own stream so that the sensors'
+/// draws do not shift.
+ins::Navigator alignedNavigator(const ins::NavigatorConfig& cfg, const SensorSimulator& sim, std::uint64_t seed) {
   std::mt19937_64 init_rng(seed ^ 0x9E3779B97F4A7C15ULL);
   std::normal_distribution<double> n01(0.0, 1.0);
-  const ins::EkfConfig& ec = s.navigator.ekf;
+  const ins::EkfConfig& ec = cfg.ekf;
   ins::NavState start = sim.truthNav();
   for (int i = 0; i < 3; ++i) {
     start.r_ecef_m[i] += ec.initial_position_m * n01(init_rng);
@@ -59,7 +56,81 @@ RunResult runScenario(const Scenario& s, const OrbitSource& orbits, std::uint64_
   const Eigen::Vector3d tilt(ec.initial_attitude_rad * n01(init_rng), ec.initial_attitude_rad * n01(init_rng),
                              ec.initial_attitude_rad * n01(init_rng));
   start.C_ecef_body = ins::expSo3(tilt) * start.C_ecef_body;
-  ins::Navigator nav(s.navigator, start, sim.clockBias_m() + ec.initial_clock_m * n01(init_rng), 0.0);
+  return ins::Navigator(cfg, start, sim.clockBias_m() + ec.initial_clock_m * n01(init_rng), 0.0);
+}
+
+/// \brief Each method's availability, position error against the truth (local ENU at the
+/// truth, rotation `R`) and protection levels.
+void scoreMethods(const ins::NavigatorEpoch& ep, const Eigen::Vector3d& truth_ecef, const Eigen::Matrix3d& R,
+                  EpochRecord& r) {
+  const bool usable = !ep.outage;
+  r.methods[static_cast<int>(Method::kSeed001)] =
+      sampleOf(usable && ep.seed001_available, ep.r_ecef_m, truth_ecef, R, ep.seed001_hpl_m, ep.seed001_vpl_m);
+  // Seed 000 names no IMU fault detector; it runs inside the same flow as seed 001 (LSR FDE,
+  // innovation test, GNSS alone with RAIM when the IMU is declared faulty), so that the two
+  // differ only in their protection-level formulas.
+  r.methods[static_cast<int>(Method::kSeed000)] =
+      ep.degraded ? sampleOf(usable && ep.raim.available, ep.raim.r_ecef_m, truth_ecef, R, ep.raim.hpl_m,
+                             ep.raim.vpl_m)
+                  : sampleOf(usable && ep.seed000.available, ep.ekf_r_ecef_m, truth_ecef, R, ep.seed000.hpl_m,
+                             ep.seed000.vpl_m);
+  r.methods[static_cast<int>(Method::kRaim)] =
+      sampleOf(usable && ep.raim.available, ep.raim.r_ecef_m, truth_ecef, R, ep.raim.hpl_m, ep.raim.vpl_m);
+  r.methods[static_cast<int>(Method::kAraim)] =
+      sampleOf(usable && ep.araim.available, ep.araim.r_ecef_m, truth_ecef, R, ep.araim.hpl_m, ep.araim.vpl_m);
+}
+
+/// \brief The monitor's side of the epoch: the fault-mode PLs (FF, GS, I, GSI), the satellites
+/// seen, used and excluded, and the GNSS and IMU tests.
+void recordMonitor(const ins::NavigatorEpoch& ep, EpochRecord& r) {
+  const InsFaultMode modes[4] = {InsFaultMode::kFaultFree, InsFaultMode::kGnssSingle, InsFaultMode::kImu,
+                                 InsFaultMode::kGnssSingleImu};
+  for (int i = 0; i < 4; ++i) {
+    r.mode_hpl_m[i] = ep.fault_modes.modes[static_cast<int>(modes[i])].hpl_m;
+    r.mode_vpl_m[i] = ep.fault_modes.modes[static_cast<int>(modes[i])].vpl_m;
+  }
+  r.outage = ep.outage;
+  r.visible = ep.visible;
+  r.used = ep.used;
+  r.excluded = ep.excluded;
+  r.gnss_fault_detected = ep.gnss_fault_detected;
+  r.imu_statistic = ep.imu_statistic;
+  r.imu_threshold = ep.imu_threshold;
+  r.imu_fault_detected = ep.imu_fault_detected;
+  r.degraded = ep.degraded;
+}
+
+/// \brief One GNSS epoch of the navigator scored against the truth.
+EpochRecord scoreEpoch(const ins::NavigatorEpoch& ep, const TruthState& truth, const Trajectory& trajectory,
+                       double t_s) {
+  const Eigen::Matrix3d R = maps::rotationEcefToEnu(truth.geodetic.lat_rad, truth.geodetic.lon_rad);
+  EpochRecord r;
+  r.t_s = t_s;
+  r.truth_enu_m = truth.p_enu_m;
+  r.estimate_enu_m = trajectory.frame().ecefToEnu(ep.r_ecef_m);
+  r.error_enu_m = R * (ep.r_ecef_m - truth.p_ecef_m);
+  scoreMethods(ep, truth.p_ecef_m, R, r);
+  recordMonitor(ep, r);
+  return r;
+}
+
+/// \brief Whether a satellite fault moved a range of this epoch, and whether an IMU fault is on.
+void markActiveFaults(const std::vector<FaultSpec>& faults, const GnssEpoch& g, EpochRecord& r) {
+  for (const FaultSpec& f : faults) {
+    if (f.valueAt(g.t_s) == 0.0) continue;
+    if (f.target == FaultTarget::kSatellite) {
+      for (const Pseudorange& p : g.ranges) r.satellite_fault_active = r.satellite_fault_active || p.injected_m != 0.0;
+    }
+    if (f.target == FaultTarget::kAccelerometer || f.target == FaultTarget::kGyro) r.imu_fault_active = true;
+  }
+}
+
+}  // namespace
+
+RunResult runScenario(const Scenario& s, const OrbitSource& orbits, std::uint64_t seed) {
+  const Trajectory trajectory(s.origin, s.waypoints, s.turn_radius_m);
+  SensorSimulator sim(trajectory, orbits, s.start, s.sensors, s.faults, seed);
+  ins::Navigator nav = alignedNavigator(s.navigator, sim, seed);
 
   RunResult out;
   out.duration_s = trajectory.duration_s();
@@ -75,51 +146,8 @@ RunResult runScenario(const Scenario& s, const OrbitSource& orbits, std::uint64_
     ranges.clear();
     for (const Pseudorange& p : g.ranges) ranges.push_back({p.sat, p.sat_ecef_m, p.pseudorange_m});
     const ins::NavigatorEpoch ep = nav.epoch(g.t_s, ranges, aid.baro_h_m, aid.heading_rad);
-
-    const TruthState& truth = sim.truth();
-    const Eigen::Matrix3d R = maps::rotationEcefToEnu(truth.geodetic.lat_rad, truth.geodetic.lon_rad);
-    EpochRecord r;
-    r.t_s = g.t_s;
-    r.truth_enu_m = truth.p_enu_m;
-    r.estimate_enu_m = trajectory.frame().ecefToEnu(ep.r_ecef_m);
-    r.error_enu_m = R * (ep.r_ecef_m - truth.p_ecef_m);
-    const bool usable = !ep.outage;
-    r.methods[static_cast<int>(Method::kSeed001)] =
-        sampleOf(usable && ep.seed001_available, ep.r_ecef_m, truth.p_ecef_m, R, ep.seed001_hpl_m, ep.seed001_vpl_m);
-    // Seed 000 names no IMU fault detector; it runs inside the same flow as seed 001 (LSR FDE,
-    // innovation test, GNSS alone with RAIM when the IMU is declared faulty), so that the two
-    // differ only in their protection-level formulas.
-    r.methods[static_cast<int>(Method::kSeed000)] =
-        ep.degraded ? sampleOf(usable && ep.raim.available, ep.raim.r_ecef_m, truth.p_ecef_m, R, ep.raim.hpl_m,
-                               ep.raim.vpl_m)
-                    : sampleOf(usable && ep.seed000.available, ep.ekf_r_ecef_m, truth.p_ecef_m, R, ep.seed000.hpl_m,
-                               ep.seed000.vpl_m);
-    r.methods[static_cast<int>(Method::kRaim)] =
-        sampleOf(usable && ep.raim.available, ep.raim.r_ecef_m, truth.p_ecef_m, R, ep.raim.hpl_m, ep.raim.vpl_m);
-    r.methods[static_cast<int>(Method::kAraim)] =
-        sampleOf(usable && ep.araim.available, ep.araim.r_ecef_m, truth.p_ecef_m, R, ep.araim.hpl_m, ep.araim.vpl_m);
-    const InsFaultMode modes[4] = {InsFaultMode::kFaultFree, InsFaultMode::kGnssSingle, InsFaultMode::kImu,
-                                   InsFaultMode::kGnssSingleImu};
-    for (int i = 0; i < 4; ++i) {
-      r.mode_hpl_m[i] = ep.fault_modes.modes[static_cast<int>(modes[i])].hpl_m;
-      r.mode_vpl_m[i] = ep.fault_modes.modes[static_cast<int>(modes[i])].vpl_m;
-    }
-    r.outage = ep.outage;
-    r.visible = ep.visible;
-    r.used = ep.used;
-    r.excluded = ep.excluded;
-    r.gnss_fault_detected = ep.gnss_fault_detected;
-    r.imu_statistic = ep.imu_statistic;
-    r.imu_threshold = ep.imu_threshold;
-    r.imu_fault_detected = ep.imu_fault_detected;
-    r.degraded = ep.degraded;
-    for (const FaultSpec& f : s.faults) {
-      if (f.valueAt(g.t_s) == 0.0) continue;
-      if (f.target == FaultTarget::kSatellite) {
-        for (const Pseudorange& p : g.ranges) r.satellite_fault_active = r.satellite_fault_active || p.injected_m != 0.0;
-      }
-      if (f.target == FaultTarget::kAccelerometer || f.target == FaultTarget::kGyro) r.imu_fault_active = true;
-    }
+    EpochRecord r = scoreEpoch(ep, sim.truth(), trajectory, g.t_s);
+    markActiveFaults(s.faults, g, r);
     out.epochs.push_back(std::move(r));
   }
   return out;

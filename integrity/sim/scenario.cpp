@@ -99,119 +99,176 @@ void matchFilterToSensors(Scenario& s) {
   s.navigator.araim.requirements.val_m = s.val_m;
 }
 
+namespace {
+
+/// \brief `origin`: latitude within ±89°, longitude within ±180°, ellipsoidal height.
+void readOrigin(const JsonNode& root, Scenario& s) {
+  const JsonNode o = root.at("origin");
+  o.requireKnownFields({"lat_deg", "lon_deg", "h_ell_m"});
+  const double lat = o.at("lat_deg").number(), lon = o.at("lon_deg").number();
+  if (std::abs(lat) > 89.0) o.at("lat_deg").fail("a latitude within ±89°");
+  if (std::abs(lon) > 180.0) o.at("lon_deg").fail("a longitude within ±180°");
+  s.origin = {maps::deg2rad(lat), maps::deg2rad(lon), o.at("h_ell_m").number()};
+}
+
+/// \brief `start`: an RFC 3339 UTC time.
+void readStart(const JsonNode& root, Scenario& s) {
+  const JsonNode t = root.at("start");
+  const auto parsed = maps::parseRfc3339(t.str());
+  if (!parsed) t.fail("an RFC 3339 UTC time such as \"2020-01-01T10:00:00Z\"");
+  s.start = *parsed;
+}
+
+/// \brief `orbits`: file names, relative ones resolved against `base_dir`.
+void readOrbits(const JsonNode& root, const std::string& base_dir, Scenario& s) {
+  const JsonNode o = root.at("orbits");
+  if (o.array().empty()) o.fail("a non-empty array of almanac or RINEX navigation file names");
+  for (std::size_t i = 0; i < o.j.size(); ++i) {
+    std::filesystem::path p(o.item(i).str());
+    if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
+    s.orbit_files.push_back(p.lexically_normal().string());
+  }
+}
+
+/// \brief `trajectory.lawnmower`: the lines' waypoints.
+std::vector<Waypoint> readLawnmower(const JsonNode& l) {
+  l.requireKnownFields({"lines", "line_length_m", "spacing_m", "height_m", "speed_mps", "heading_deg"});
+  const double lines = l.at("lines").number();
+  if (!(lines >= 1 && lines <= 1000 && lines == std::floor(lines))) l.at("lines").fail("a whole number 1…1000");
+  return lawnmower(static_cast<int>(lines), positive(l.at("line_length_m")), positive(l.at("spacing_m")),
+                   l.at("height_m").number(), positive(l.at("speed_mps")),
+                   l.has("heading_deg") ? maps::deg2rad(l.at("heading_deg").number()) : 0.0);
+}
+
+/// \brief `trajectory.waypoints`: at least 2; the first one's speed defaults to 1 m/s.
+std::vector<Waypoint> readWaypoints(const JsonNode& w) {
+  std::vector<Waypoint> out;
+  if (w.array().size() < 2) w.fail("an array of at least 2 waypoints");
+  for (std::size_t i = 0; i < w.j.size(); ++i) {
+    const JsonNode p = w.item(i);
+    p.requireKnownFields({"e_m", "n_m", "u_m", "speed_mps"});
+    Waypoint wp;
+    wp.p_enu_m = {p.at("e_m").number(), p.at("n_m").number(), p.at("u_m").number()};
+    wp.speed_mps = i == 0 && !p.has("speed_mps") ? 1.0 : positive(p.at("speed_mps"));
+    out.push_back(wp);
+  }
+  return out;
+}
+
+/// \brief `trajectory`: the turn radius and exactly one of a lawnmower or waypoints.
+void readTrajectory(const JsonNode& root, Scenario& s) {
+  const JsonNode t = root.at("trajectory");
+  t.requireKnownFields({"lawnmower", "waypoints", "turn_radius_m"});
+  if (t.has("turn_radius_m")) s.turn_radius_m = positive(t.at("turn_radius_m"));
+  if (t.has("lawnmower") == t.has("waypoints")) t.fail("an object with exactly one of lawnmower or waypoints");
+  if (t.has("lawnmower")) {
+    s.waypoints = readLawnmower(t.at("lawnmower"));
+  } else {
+    s.waypoints = readWaypoints(t.at("waypoints"));
+  }
+}
+
+/// \brief `imu`, when given: the grade (and its error figures) and the rate.
+void readImu(const JsonNode& root, Scenario& s) {
+  if (!root.has("imu")) return;
+  const JsonNode i = root.at("imu");
+  i.requireKnownFields({"grade", "rate_hz"});
+  if (i.has("grade")) {
+    const auto g = parseImuGrade(i.at("grade").str());
+    if (!g) i.at("grade").fail("\"aviation\", \"tactical\" or \"consumer\"");
+    s.grade = *g;
+  }
+  s.sensors.imu = imuSpec(s.grade);
+  if (i.has("rate_hz")) s.sensors.imu.rate_hz = positive(i.at("rate_hz"));
+}
+
+/// \brief `gnss`, when given: rate, elevation mask and user error model.
+void readGnss(const JsonNode& root, Scenario& s) {
+  if (!root.has("gnss")) return;
+  const JsonNode g = root.at("gnss");
+  g.requireKnownFields({"rate_hz", "elevation_mask_deg", "user_model"});
+  if (g.has("rate_hz")) s.sensors.gnss_rate_hz = positive(g.at("rate_hz"));
+  if (g.has("elevation_mask_deg")) s.sensors.elevation_mask_rad = maps::deg2rad(nonNegative(g.at("elevation_mask_deg")));
+  if (g.has("user_model")) {
+    const std::string m = g.at("user_model").str();
+    if (m == "dual_frequency") s.sensors.model.setUserModel(UserErrorModel::kDualFrequency);
+    else if (m == "single_frequency") s.sensors.model.setUserModel(UserErrorModel::kSingleFrequency);
+    else g.at("user_model").fail("\"dual_frequency\" or \"single_frequency\"");
+  }
+}
+
+/// \brief `baro` and `magnetometer`, when given: whether the filter uses them.
+void readAidingSwitches(const JsonNode& root, Scenario& s) {
+  if (root.has("baro")) s.navigator.use_baro = root.at("baro").boolean();
+  if (root.has("magnetometer")) s.navigator.use_heading = root.at("magnetometer").boolean();
+}
+
+/// \brief `faults`, when given: each one by parseFault.
+void readFaults(const JsonNode& root, Scenario& s) {
+  if (!root.has("faults")) return;
+  const JsonNode f = root.at("faults");
+  for (std::size_t i = 0; i < f.array().size(); ++i) s.faults.push_back(parseFault(f.item(i)));
+}
+
+/// \brief A probability in (0, 1).
+double probability(const JsonNode& p) {
+  const double v = p.number();
+  if (!(v > 0.0 && v < 1.0)) p.fail("a probability in (0, 1)");
+  return v;
+}
+
+/// \brief `integrity`, when given: alert limits, risks, false-alert probabilities, ARAIM on/off.
+void readIntegrity(const JsonNode& root, Scenario& s) {
+  if (!root.has("integrity")) return;
+  const JsonNode n = root.at("integrity");
+  n.requireKnownFields({"hal_m", "val_m", "i_req", "p_sat", "p_imu", "pfa_gnss", "pfa_imu", "araim"});
+  if (n.has("hal_m")) s.hal_m = positive(n.at("hal_m"));
+  if (n.has("val_m")) s.val_m = positive(n.at("val_m"));
+  if (n.has("i_req")) s.navigator.fault_modes.risk.i_req = probability(n.at("i_req"));
+  if (n.has("p_sat")) s.navigator.fault_modes.risk.p_sat = probability(n.at("p_sat"));
+  if (n.has("p_imu")) s.navigator.fault_modes.risk.p_imu = probability(n.at("p_imu"));
+  if (n.has("pfa_gnss")) s.navigator.fault_modes.pfa_gnss = probability(n.at("pfa_gnss"));
+  if (n.has("pfa_imu")) s.navigator.pfa_imu = probability(n.at("pfa_imu"));
+  if (n.has("araim")) s.navigator.compute_araim = n.at("araim").boolean();
+}
+
+/// \brief `seed`, when given: a whole number ≥ 0 that a double holds exactly.
+void readSeed(const JsonNode& root, Scenario& s) {
+  if (!root.has("seed")) return;
+  const JsonNode sd = root.at("seed");
+  const double v = sd.number();
+  if (!(v >= 0 && v < 9.007199254740992e15 && v == std::floor(v))) sd.fail("a whole number ≥ 0");
+  s.seed = static_cast<std::uint64_t>(v);
+}
+
+/// \brief The trajectory builds; checked here so that a bad one is reported against this file.
+void requireFlyableTrajectory(const JsonNode& root, const Scenario& s) {
+  try {
+    (void)Trajectory(s.origin, s.waypoints, s.turn_radius_m);
+  } catch (const std::invalid_argument& e) {
+    root.at("trajectory").fail(std::string("a flyable trajectory (") + e.what() + ")");
+  }
+}
+
+}  // namespace
+
 Scenario parseScenario(const nlohmann::json& doc, const std::string& source, const std::string& base_dir) {
   const JsonNode root{doc, "$", source};
   root.requireKnownFields({"origin", "start", "orbits", "trajectory", "imu", "gnss", "baro", "magnetometer", "faults",
                            "integrity", "seed"});
   Scenario s;
   s.source = source;
-  {
-    const JsonNode o = root.at("origin");
-    o.requireKnownFields({"lat_deg", "lon_deg", "h_ell_m"});
-    const double lat = o.at("lat_deg").number(), lon = o.at("lon_deg").number();
-    if (std::abs(lat) > 89.0) o.at("lat_deg").fail("a latitude within ±89°");
-    if (std::abs(lon) > 180.0) o.at("lon_deg").fail("a longitude within ±180°");
-    s.origin = {maps::deg2rad(lat), maps::deg2rad(lon), o.at("h_ell_m").number()};
-  }
-  {
-    const JsonNode t = root.at("start");
-    const auto parsed = maps::parseRfc3339(t.str());
-    if (!parsed) t.fail("an RFC 3339 UTC time such as \"2020-01-01T10:00:00Z\"");
-    s.start = *parsed;
-  }
-  {
-    const JsonNode o = root.at("orbits");
-    if (o.array().empty()) o.fail("a non-empty array of almanac or RINEX navigation file names");
-    for (std::size_t i = 0; i < o.j.size(); ++i) {
-      std::filesystem::path p(o.item(i).str());
-      if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
-      s.orbit_files.push_back(p.lexically_normal().string());
-    }
-  }
-  {
-    const JsonNode t = root.at("trajectory");
-    t.requireKnownFields({"lawnmower", "waypoints", "turn_radius_m"});
-    if (t.has("turn_radius_m")) s.turn_radius_m = positive(t.at("turn_radius_m"));
-    if (t.has("lawnmower") == t.has("waypoints")) t.fail("an object with exactly one of lawnmower or waypoints");
-    if (t.has("lawnmower")) {
-      const JsonNode l = t.at("lawnmower");
-      l.requireKnownFields({"lines", "line_length_m", "spacing_m", "height_m", "speed_mps", "heading_deg"});
-      const double lines = l.at("lines").number();
-      if (!(lines >= 1 && lines <= 1000 && lines == std::floor(lines))) l.at("lines").fail("a whole number 1…1000");
-      s.waypoints = lawnmower(static_cast<int>(lines), positive(l.at("line_length_m")), positive(l.at("spacing_m")),
-                              l.at("height_m").number(), positive(l.at("speed_mps")),
-                              l.has("heading_deg") ? maps::deg2rad(l.at("heading_deg").number()) : 0.0);
-    } else {
-      const JsonNode w = t.at("waypoints");
-      if (w.array().size() < 2) w.fail("an array of at least 2 waypoints");
-      for (std::size_t i = 0; i < w.j.size(); ++i) {
-        const JsonNode p = w.item(i);
-        p.requireKnownFields({"e_m", "n_m", "u_m", "speed_mps"});
-        Waypoint wp;
-        wp.p_enu_m = {p.at("e_m").number(), p.at("n_m").number(), p.at("u_m").number()};
-        wp.speed_mps = i == 0 && !p.has("speed_mps") ? 1.0 : positive(p.at("speed_mps"));
-        s.waypoints.push_back(wp);
-      }
-    }
-  }
-  if (root.has("imu")) {
-    const JsonNode i = root.at("imu");
-    i.requireKnownFields({"grade", "rate_hz"});
-    if (i.has("grade")) {
-      const auto g = parseImuGrade(i.at("grade").str());
-      if (!g) i.at("grade").fail("\"aviation\", \"tactical\" or \"consumer\"");
-      s.grade = *g;
-    }
-    s.sensors.imu = imuSpec(s.grade);
-    if (i.has("rate_hz")) s.sensors.imu.rate_hz = positive(i.at("rate_hz"));
-  }
-  if (root.has("gnss")) {
-    const JsonNode g = root.at("gnss");
-    g.requireKnownFields({"rate_hz", "elevation_mask_deg", "user_model"});
-    if (g.has("rate_hz")) s.sensors.gnss_rate_hz = positive(g.at("rate_hz"));
-    if (g.has("elevation_mask_deg")) s.sensors.elevation_mask_rad = maps::deg2rad(nonNegative(g.at("elevation_mask_deg")));
-    if (g.has("user_model")) {
-      const std::string m = g.at("user_model").str();
-      if (m == "dual_frequency") s.sensors.model.setUserModel(UserErrorModel::kDualFrequency);
-      else if (m == "single_frequency") s.sensors.model.setUserModel(UserErrorModel::kSingleFrequency);
-      else g.at("user_model").fail("\"dual_frequency\" or \"single_frequency\"");
-    }
-  }
-  if (root.has("baro")) s.navigator.use_baro = root.at("baro").boolean();
-  if (root.has("magnetometer")) s.navigator.use_heading = root.at("magnetometer").boolean();
-  if (root.has("faults")) {
-    const JsonNode f = root.at("faults");
-    for (std::size_t i = 0; i < f.array().size(); ++i) s.faults.push_back(parseFault(f.item(i)));
-  }
-  if (root.has("integrity")) {
-    const JsonNode n = root.at("integrity");
-    n.requireKnownFields({"hal_m", "val_m", "i_req", "p_sat", "p_imu", "pfa_gnss", "pfa_imu", "araim"});
-    if (n.has("hal_m")) s.hal_m = positive(n.at("hal_m"));
-    if (n.has("val_m")) s.val_m = positive(n.at("val_m"));
-    auto prob = [](const JsonNode& p) {
-      const double v = p.number();
-      if (!(v > 0.0 && v < 1.0)) p.fail("a probability in (0, 1)");
-      return v;
-    };
-    if (n.has("i_req")) s.navigator.fault_modes.risk.i_req = prob(n.at("i_req"));
-    if (n.has("p_sat")) s.navigator.fault_modes.risk.p_sat = prob(n.at("p_sat"));
-    if (n.has("p_imu")) s.navigator.fault_modes.risk.p_imu = prob(n.at("p_imu"));
-    if (n.has("pfa_gnss")) s.navigator.fault_modes.pfa_gnss = prob(n.at("pfa_gnss"));
-    if (n.has("pfa_imu")) s.navigator.pfa_imu = prob(n.at("pfa_imu"));
-    if (n.has("araim")) s.navigator.compute_araim = n.at("araim").boolean();
-  }
-  if (root.has("seed")) {
-    const JsonNode sd = root.at("seed");
-    const double v = sd.number();
-    if (!(v >= 0 && v < 9.007199254740992e15 && v == std::floor(v))) sd.fail("a whole number ≥ 0");
-    s.seed = static_cast<std::uint64_t>(v);
-  }
-  // The trajectory is checked here so that a bad one is reported against this file.
-  try {
-    (void)Trajectory(s.origin, s.waypoints, s.turn_radius_m);
-  } catch (const std::invalid_argument& e) {
-    root.at("trajectory").fail(std::string("a flyable trajectory (") + e.what() + ")");
-  }
+  readOrigin(root, s);
+  readStart(root, s);
+  readOrbits(root, base_dir, s);
+  readTrajectory(root, s);
+  readImu(root, s);
+  readGnss(root, s);
+  readAidingSwitches(root, s);
+  readFaults(root, s);
+  readIntegrity(root, s);
+  readSeed(root, s);
+  requireFlyableTrajectory(root, s);
   matchFilterToSensors(s);
   return s;
 }

@@ -17,10 +17,8 @@ constexpr double kStandardGravity_mps2 = 9.80665;
 
 double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
-}  // namespace
-
-Trajectory::Trajectory(const maps::Geodetic& origin, std::vector<Waypoint> waypoints, double turn_radius_m)
-    : frame_(origin) {
+/// \brief At least two waypoints, a positive turn radius, a positive finite speed into each.
+void requireFlyable(const std::vector<Waypoint>& waypoints, double turn_radius_m) {
   const std::size_t n = waypoints.size();
   if (n < 2) throw std::invalid_argument("trajectory: at least two waypoints are needed, got " + std::to_string(n));
   if (!(turn_radius_m > 0.0)) throw std::invalid_argument("trajectory: turn radius must be > 0 m");
@@ -29,14 +27,50 @@ Trajectory::Trajectory(const maps::Geodetic& origin, std::vector<Waypoint> waypo
       throw std::invalid_argument("trajectory: waypoint " + std::to_string(i) + ": speed must be > 0 m/s");
     }
   }
+}
+
+}  // namespace
+
+/// The waypoints' horizontal positions, each leg's length and direction, and each corner's
+/// signed turn, arc radius and tangent distance (0 at the ends and where the path runs straight).
+struct Trajectory::Corners {
+  std::vector<Eigen::Vector2d> p;
+  std::vector<double> leg_len;
+  std::vector<Eigen::Vector2d> leg_dir;
+  std::vector<double> tangent_dist;  // corner i: distance from the waypoint to the arc's ends
+  std::vector<double> radius, turn;
+};
+
+Trajectory::Trajectory(const maps::Geodetic& origin, std::vector<Waypoint> waypoints, double turn_radius_m)
+    : frame_(origin) {
+  requireFlyable(waypoints, turn_radius_m);
   R_ecef_enu_ = maps::rotationEcefToEnu(origin.lat_rad, origin.lon_rad).transpose();
   p_origin_ecef_ = maps::geodeticToEcef(origin);
 
   // Horizontal legs and corner arcs.
-  std::vector<Eigen::Vector2d> p(n);
+  const Corners corners = roundCorners(waypoints, turn_radius_m);
+  const std::vector<double> station_s = layPieces(corners);
+
+  // Vertical profile and speed per leg (between stations).
+  duration_s_ = layLegs(waypoints, station_s);
+}
+
+Trajectory::Corners Trajectory::roundCorners(const std::vector<Waypoint>& waypoints, double turn_radius_m) {
+  const std::size_t n = waypoints.size();
+  Corners corners;
+  corners.p.resize(n);
+  corners.leg_len.resize(n - 1);
+  corners.leg_dir.resize(n - 1);
+  corners.tangent_dist.assign(n, 0.0);
+  corners.radius.assign(n, 0.0);
+  corners.turn.assign(n, 0.0);
+  std::vector<Eigen::Vector2d>& p = corners.p;
+  std::vector<double>& leg_len = corners.leg_len;
+  std::vector<Eigen::Vector2d>& leg_dir = corners.leg_dir;
+  std::vector<double>& tangent_dist = corners.tangent_dist;
+  std::vector<double>& radius = corners.radius;
+  std::vector<double>& turn = corners.turn;
   for (std::size_t i = 0; i < n; ++i) p[i] = waypoints[i].p_enu_m.head<2>();
-  std::vector<double> leg_len(n - 1);
-  std::vector<Eigen::Vector2d> leg_dir(n - 1);
   for (std::size_t i = 0; i + 1 < n; ++i) {
     leg_len[i] = (p[i + 1] - p[i]).norm();
     if (leg_len[i] < 1e-3) {
@@ -45,8 +79,6 @@ Trajectory::Trajectory(const maps::Geodetic& origin, std::vector<Waypoint> waypo
     }
     leg_dir[i] = (p[i + 1] - p[i]) / leg_len[i];
   }
-  std::vector<double> tangent_dist(n, 0.0);  // corner i: distance from the waypoint to the arc's ends
-  std::vector<double> radius(n, 0.0), turn(n, 0.0);
   for (std::size_t i = 1; i + 1 < n; ++i) {
     turn[i] = std::atan2(cross2(leg_dir[i - 1], leg_dir[i]), leg_dir[i - 1].dot(leg_dir[i]));
     if (std::abs(turn[i]) > kMaxCornerTurn_rad) {
@@ -58,6 +90,17 @@ Trajectory::Trajectory(const maps::Geodetic& origin, std::vector<Waypoint> waypo
     radius[i] = std::min(turn_radius_m, 0.5 * std::min(leg_len[i - 1], leg_len[i]) / half_tan);
     tangent_dist[i] = radius[i] * half_tan;
   }
+  return corners;
+}
+
+std::vector<double> Trajectory::layPieces(const Corners& corners) {
+  const std::vector<Eigen::Vector2d>& p = corners.p;
+  const std::vector<double>& leg_len = corners.leg_len;
+  const std::vector<Eigen::Vector2d>& leg_dir = corners.leg_dir;
+  const std::vector<double>& tangent_dist = corners.tangent_dist;
+  const std::vector<double>& radius = corners.radius;
+  const std::vector<double>& turn = corners.turn;
+  const std::size_t n = p.size();
   std::vector<double> station_s(n, 0.0);  // arc length at each waypoint's station
   double s = 0.0;
   for (std::size_t i = 0; i + 1 < n; ++i) {
@@ -94,8 +137,11 @@ Trajectory::Trajectory(const maps::Geodetic& origin, std::vector<Waypoint> waypo
     }
   }
   station_s[n - 1] = s;
+  return station_s;
+}
 
-  // Vertical profile and speed per leg (between stations).
+double Trajectory::layLegs(const std::vector<Waypoint>& waypoints, const std::vector<double>& station_s) {
+  const std::size_t n = waypoints.size();
   legs_.resize(n - 1);
   double t = 0.0;
   for (std::size_t i = 0; i + 1 < n; ++i) {
@@ -117,7 +163,7 @@ Trajectory::Trajectory(const maps::Geodetic& origin, std::vector<Waypoint> waypo
     t += std::abs(k) < 1e-12 ? len / leg.v0 : std::log(leg.v1 / leg.v0) / k;
     leg.t1 = t;
   }
-  duration_s_ = t;
+  return t;
 }
 
 void Trajectory::horizontal(double s, Eigen::Vector2d& p, Eigen::Vector2d& tangent, double& curvature) const {

@@ -75,6 +75,14 @@ class Trajectory {
   struct Leg {  // waypoint i → i+1 in horizontal arc length, with speed ramp and climb
     double s0 = 0.0, s1 = 0.0, h0 = 0.0, h1 = 0.0, v0 = 0.0, v1 = 0.0, t0 = 0.0, t1 = 0.0;
   };
+  struct Corners;  // the constructor's horizontal plan: legs and corner arcs (trajectory.cpp)
+
+  /// The constructor's steps: the horizontal legs and the arc that rounds each corner; the
+  /// lines and arcs laid along them (returns each waypoint's station, its arc length); the legs
+  /// between stations with their climb, speed ramp and times (returns the duration).
+  [[nodiscard]] static Corners roundCorners(const std::vector<Waypoint>& waypoints, double turn_radius_m);
+  [[nodiscard]] std::vector<double> layPieces(const Corners& corners);
+  [[nodiscard]] double layLegs(const std::vector<Waypoint>& waypoints, const std::vector<double>& station_s);
 
   void horizontal(double s, Eigen::Vector2d& p, Eigen::Vector2d& tangent, double& curvature) const;
   /// The mean signed curvature over horizontal arc lengths [a, b] (clipped to the path; `at_s`

@@ -36,13 +36,17 @@ std::pair<double, double> insNominalPl(const InsUncertainty& ins) {
   return {k_h * std::hypot(ins.sigma_n_m, ins.sigma_e_m), k_v * ins.sigma_u_m};
 }
 
-TrackFix parseTrackFixJson(const json& doc, const std::string& source) {
-  const maps::JsonNode root{doc, "$", source};
-  if (!doc.is_object()) root.fail("one JSON object per line {\"time\", \"lat\", \"lon\", \"h_ell_m\", …}");
+namespace {
+
+/// \brief The document is one object with only the schema's fields.
+void requireFixObject(const maps::JsonNode& root) {
+  if (!root.j.is_object()) root.fail("one JSON object per line {\"time\", \"lat\", \"lon\", \"h_ell_m\", …}");
   root.requireKnownFields({"flight", "vehicle", "time", "lat", "lon", "h_ell_m", "hpl_m", "vpl_m", "pseudoranges", "imu",
                           "velocity_enu_mps", "attitude_deg", "baro_h_m", "mag_heading_deg"});
-  TrackFix f;
-  f.source = source;
+}
+
+/// \brief `flight` or `vehicle` (one of them, a non-empty string or an integer).
+void readFlight(const maps::JsonNode& root, TrackFix& f) {
   if (root.has("flight") && root.has("vehicle")) root.at("vehicle").fail("one of \"flight\" and \"vehicle\", not both");
   for (const char* key : {"flight", "vehicle"}) {
     if (!root.has(key)) continue;
@@ -50,6 +54,10 @@ TrackFix parseTrackFixJson(const json& doc, const std::string& source) {
     f.flight = n.j.is_number_integer() ? std::to_string(n.j.get<long long>()) : n.str();
     if (f.flight.empty()) n.fail("a flight or vehicle identifier");
   }
+}
+
+/// \brief `time`, `lat`, `lon` and `h_ell_m`.
+void readTimeAndPosition(const maps::JsonNode& root, TrackFix& f) {
   const maps::JsonNode time = root.at("time");
   const auto t = maps::parseRfc3339(time.str());
   if (!t) time.fail("an RFC 3339 date-time such as 2026-11-23T14:00:00Z");
@@ -61,6 +69,10 @@ TrackFix parseTrackFixJson(const json& doc, const std::string& source) {
   f.lon_rad = maps::deg2rad(lon.number());
   f.h_ell_m = root.at("h_ell_m").number();
   if (std::abs(f.h_ell_m) > 1e5) root.at("h_ell_m").fail("an ellipsoidal height within ±100 km");
+}
+
+/// \brief The onboard `hpl_m` and `vpl_m`: both or neither.
+void readOnboardPls(const maps::JsonNode& root, TrackFix& f) {
   if (root.has("hpl_m") != root.has("vpl_m")) {
     root.orNull(root.has("hpl_m") ? "vpl_m" : "hpl_m").fail("both hpl_m and vpl_m, or neither");
   }
@@ -72,76 +84,101 @@ TrackFix parseTrackFixJson(const json& doc, const std::string& source) {
     f.hpl_m = root.at("hpl_m").number();
     f.vpl_m = root.at("vpl_m").number();
   }
-  if (root.has("pseudoranges")) {
-    const maps::JsonNode list = root.at("pseudoranges");
-    for (std::size_t i = 0; i < list.array().size(); ++i) {
-      const maps::JsonNode r = list.item(i);
-      r.requireKnownFields({"sat", "pr_m", "ecef_m"});
-      integrity::RawRange raw;
-      const maps::JsonNode sat = r.at("sat");
-      const auto id = integrity::parseSatId(sat.str());
-      if (!id) sat.fail("a satellite such as G05 or E11");
-      raw.sat = *id;
-      for (const integrity::RawRange& e : f.ranges) {
-        if (e.sat == raw.sat) sat.fail("each satellite once");
-      }
-      raw.pr_m = r.at("pr_m").number();
-      if (!(raw.pr_m > 1e6 && raw.pr_m < 1e8)) r.at("pr_m").fail("a pseudorange between 1,000 and 100,000 km");
-      if (r.has("ecef_m")) {
-        const maps::JsonNode e = r.at("ecef_m");
-        if (e.array().size() != 3) e.fail("[x, y, z] in metres");
-        Eigen::Vector3d p;
-        for (int k = 0; k < 3; ++k) p[k] = e.item(static_cast<std::size_t>(k)).number();
-        if (!(p.norm() > 1e7 && p.norm() < 1e8)) e.fail("a satellite position 10,000–100,000 km from the Earth's centre");
-        raw.sat_ecef_m = p;
-      }
-      f.ranges.push_back(raw);
-    }
+}
+
+/// \brief One element of `pseudoranges`; its satellite must not be among `earlier`.
+integrity::RawRange readPseudorange(const maps::JsonNode& r, const std::vector<integrity::RawRange>& earlier) {
+  r.requireKnownFields({"sat", "pr_m", "ecef_m"});
+  integrity::RawRange raw;
+  const maps::JsonNode sat = r.at("sat");
+  const auto id = integrity::parseSatId(sat.str());
+  if (!id) sat.fail("a satellite such as G05 or E11");
+  raw.sat = *id;
+  for (const integrity::RawRange& e : earlier) {
+    if (e.sat == raw.sat) sat.fail("each satellite once");
   }
-  if (root.has("imu")) {
-    const maps::JsonNode imu = root.at("imu");
-    imu.requireKnownFields({"grade", "sigma_n_m", "sigma_e_m", "sigma_u_m", "increments"});
-    const auto parsed = integrity::ins::parseImuGrade(imu.at("grade").str());
-    if (!parsed) imu.at("grade").fail("aviation, tactical or consumer (seed 000 Table 1)");
-    const int grade = static_cast<int>(*parsed);
-    if (imu.has("increments")) {
-      for (const char* key : {"sigma_n_m", "sigma_e_m", "sigma_u_m"}) {
-        if (imu.has(key)) imu.at(key).fail("either the INS σ's or the IMU increments, not both");
-      }
-      ImuRecord rec;
-      rec.grade = grade;
-      const maps::JsonNode list = imu.at("increments");
-      const std::size_t n = list.array().size();
-      if (n == 0 || n > 10000) list.fail("1 to 10,000 increments [dt_s, dθx, dθy, dθz, dvx, dvy, dvz]");
-      rec.increments.reserve(n);
-      for (std::size_t i = 0; i < n; ++i) {
-        const maps::JsonNode row = list.item(i);
-        if (row.array().size() != 7) row.fail("[dt_s, dθx, dθy, dθz (rad), dvx, dvy, dvz (m/s)]");
-        double v[7];
-        for (std::size_t k = 0; k < 7; ++k) v[k] = row.item(k).number();
-        ImuIncrement inc;
-        inc.dt_s = v[0];
-        if (!(inc.dt_s > 0.0 && inc.dt_s <= 1.0)) row.item(0).fail("an interval in (0, 1] s");
-        inc.dtheta_rad = Eigen::Vector3d(v[1], v[2], v[3]);
-        inc.dv_mps = Eigen::Vector3d(v[4], v[5], v[6]);
-        // Bounds: 2000 °/s and 50 g over the interval, far beyond any airframe's.
-        if (inc.dtheta_rad.norm() > 35.0 * inc.dt_s) row.fail("an angle increment below 35 rad/s × dt_s");
-        if (inc.dv_mps.norm() > 500.0 * inc.dt_s) row.fail("a velocity increment below 500 m/s² × dt_s");
-        rec.increments.push_back(inc);
-      }
-      if (rec.span_s() > 60.0) list.fail("increments spanning at most 60 s");
-      f.imu = std::move(rec);
-    } else {
-      InsUncertainty u;
-      u.grade = grade;
-      for (auto [key, dst] : {std::pair{"sigma_n_m", &u.sigma_n_m}, {"sigma_e_m", &u.sigma_e_m}, {"sigma_u_m", &u.sigma_u_m}}) {
-        const maps::JsonNode n = imu.at(key);
-        if (n.number() < 0.0) n.fail("a standard deviation ≥ 0 m");
-        *dst = n.number();
-      }
-      f.ins = u;
-    }
+  raw.pr_m = r.at("pr_m").number();
+  if (!(raw.pr_m > 1e6 && raw.pr_m < 1e8)) r.at("pr_m").fail("a pseudorange between 1,000 and 100,000 km");
+  if (r.has("ecef_m")) {
+    const maps::JsonNode e = r.at("ecef_m");
+    if (e.array().size() != 3) e.fail("[x, y, z] in metres");
+    Eigen::Vector3d p;
+    for (int k = 0; k < 3; ++k) p[k] = e.item(static_cast<std::size_t>(k)).number();
+    if (!(p.norm() > 1e7 && p.norm() < 1e8)) e.fail("a satellite position 10,000–100,000 km from the Earth's centre");
+    raw.sat_ecef_m = p;
   }
+  return raw;
+}
+
+/// \brief `pseudoranges`, when given.
+void readPseudoranges(const maps::JsonNode& root, TrackFix& f) {
+  if (!root.has("pseudoranges")) return;
+  const maps::JsonNode list = root.at("pseudoranges");
+  for (std::size_t i = 0; i < list.array().size(); ++i) f.ranges.push_back(readPseudorange(list.item(i), f.ranges));
+}
+
+/// \brief One row of `imu.increments`: [dt_s, dθx, dθy, dθz, dvx, dvy, dvz].
+ImuIncrement readImuIncrement(const maps::JsonNode& row) {
+  if (row.array().size() != 7) row.fail("[dt_s, dθx, dθy, dθz (rad), dvx, dvy, dvz (m/s)]");
+  double v[7];
+  for (std::size_t k = 0; k < 7; ++k) v[k] = row.item(k).number();
+  ImuIncrement inc;
+  inc.dt_s = v[0];
+  if (!(inc.dt_s > 0.0 && inc.dt_s <= 1.0)) row.item(0).fail("an interval in (0, 1] s");
+  inc.dtheta_rad = Eigen::Vector3d(v[1], v[2], v[3]);
+  inc.dv_mps = Eigen::Vector3d(v[4], v[5], v[6]);
+  // Bounds: 2000 °/s and 50 g over the interval, far beyond any airframe's.
+  if (inc.dtheta_rad.norm() > 35.0 * inc.dt_s) row.fail("an angle increment below 35 rad/s × dt_s");
+  if (inc.dv_mps.norm() > 500.0 * inc.dt_s) row.fail("a velocity increment below 500 m/s² × dt_s");
+  return inc;
+}
+
+/// \brief `imu.increments` (and no INS σ's beside them).
+ImuRecord readImuIncrements(const maps::JsonNode& imu, int grade) {
+  for (const char* key : {"sigma_n_m", "sigma_e_m", "sigma_u_m"}) {
+    if (imu.has(key)) imu.at(key).fail("either the INS σ's or the IMU increments, not both");
+  }
+  ImuRecord rec;
+  rec.grade = grade;
+  const maps::JsonNode list = imu.at("increments");
+  const std::size_t n = list.array().size();
+  if (n == 0 || n > 10000) list.fail("1 to 10,000 increments [dt_s, dθx, dθy, dθz, dvx, dvy, dvz]");
+  rec.increments.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) rec.increments.push_back(readImuIncrement(list.item(i)));
+  if (rec.span_s() > 60.0) list.fail("increments spanning at most 60 s");
+  return rec;
+}
+
+/// \brief The INS σ's `imu.sigma_n_m`, `sigma_e_m` and `sigma_u_m`.
+InsUncertainty readInsSigmas(const maps::JsonNode& imu, int grade) {
+  InsUncertainty u;
+  u.grade = grade;
+  for (auto [key, dst] : {std::pair{"sigma_n_m", &u.sigma_n_m}, {"sigma_e_m", &u.sigma_e_m}, {"sigma_u_m", &u.sigma_u_m}}) {
+    const maps::JsonNode n = imu.at(key);
+    if (n.number() < 0.0) n.fail("a standard deviation ≥ 0 m");
+    *dst = n.number();
+  }
+  return u;
+}
+
+/// \brief The `imu` block, when given: its grade and either the increments or the INS σ's.
+void readImu(const maps::JsonNode& root, TrackFix& f) {
+  if (!root.has("imu")) return;
+  const maps::JsonNode imu = root.at("imu");
+  imu.requireKnownFields({"grade", "sigma_n_m", "sigma_e_m", "sigma_u_m", "increments"});
+  const auto parsed = integrity::ins::parseImuGrade(imu.at("grade").str());
+  if (!parsed) imu.at("grade").fail("aviation, tactical or consumer (seed 000 Table 1)");
+  const int grade = static_cast<int>(*parsed);
+  if (imu.has("increments")) {
+    f.imu = readImuIncrements(imu, grade);
+  } else {
+    f.ins = readInsSigmas(imu, grade);
+  }
+}
+
+/// \brief The onboard navigation that aligns and aids the filter: `velocity_enu_mps`,
+/// `attitude_deg`, `baro_h_m` and `mag_heading_deg`, each when given.
+void readNavigationAids(const maps::JsonNode& root, TrackFix& f) {
   if (root.has("velocity_enu_mps")) {
     const maps::JsonNode v = root.at("velocity_enu_mps");
     if (v.array().size() != 3) v.fail("[ve, vn, vu] in m/s");
@@ -169,12 +206,33 @@ TrackFix parseTrackFixJson(const json& doc, const std::string& source) {
     if (m.number() < -360.0 || m.number() > 360.0) m.fail("a heading in [-360, 360] degrees");
     f.mag_heading_rad = maps::deg2rad(m.number());
   }
+}
+
+/// \brief A fix needs a protection level: onboard PLs, pseudoranges or the INS σ's; IMU
+/// increments need pseudoranges or onboard PLs beside them.
+void requireProtectionLevelSource(const maps::JsonNode& root, const TrackFix& f) {
   if (f.imu && f.ranges.empty() && !f.hpl_m) {
     root.at("imu").fail("pseudoranges with the IMU increments (GNSS/INS), or hpl_m and vpl_m");
   }
   if (!f.hpl_m && f.ranges.empty() && !f.ins) {
     root.fail("a protection level: hpl_m and vpl_m, pseudoranges, or an imu block");
   }
+}
+
+}  // namespace
+
+TrackFix parseTrackFixJson(const json& doc, const std::string& source) {
+  const maps::JsonNode root{doc, "$", source};
+  requireFixObject(root);
+  TrackFix f;
+  f.source = source;
+  readFlight(root, f);
+  readTimeAndPosition(root, f);
+  readOnboardPls(root, f);
+  readPseudoranges(root, f);
+  readImu(root, f);
+  readNavigationAids(root, f);
+  requireProtectionLevelSource(root, f);
   if (!f.ranges.empty()) f.pl_source = PlSource::kRaw;
   return f;
 }
