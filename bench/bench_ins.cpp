@@ -47,14 +47,14 @@ void BM_NavigatorEpoch20Sats(benchmark::State& state) {
     nav.propagate(Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 9.81), 1e-3);  // keeps P from collapsing
     benchmark::DoNotOptimize(nav.epoch(0.0, s.ranges, 520.0, 0.0));
   }
-  state.SetLabel(cfg.compute_araim ? "with snapshot RAIM + ARAIM FDE" : "filter, FDE, seed 001 + 000 PLs, RAIM");
+  state.SetLabel(cfg.compute_araim ? "with snapshot RAIM + ARAIM FDE" : "filter, FDE, fault-mode + three-hypothesis INS PLs, RAIM");
 }
 BENCHMARK(BM_NavigatorEpoch20Sats)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly(true);
 
-/// Seed 001's 750 s survey (the bundled example): simulation + navigation + every method.
+/// Zhao & Song's 750 s survey (the bundled example): simulation + navigation + every method.
 void BM_SimulateSurvey(benchmark::State& state) {
   const sim::Scenario sc =
-      sim::loadScenario(std::string(SKYLANE_TEST_DATA) + "/../../examples/simulate/seed001_combined.json");
+      sim::loadScenario(std::string(SKYLANE_TEST_DATA) + "/../../examples/simulate/gnss_ins_combined.json");
   const OrbitSource orbits = sim::loadOrbits(sc);
   double flown = 0, spent = 0;
   for (auto _ : state) {

@@ -62,7 +62,7 @@ BENCHMARK(BM_RaimFdeWithFault)->Repetitions(5)->ReportAggregatesOnly(true);
 
 namespace {
 
-/// Skies with 18 … 22 satellites above 5° over a grid of places and a day (the case).
+/// Skies with 18 … 22 satellites above 5° over a grid of places and a day (the ARAIM benchmark case of the README).
 std::vector<Geometry> almanacSkies() {
   OrbitSource orbits;
   orbits.addAlmanac(loadAlmanac(SKYLANE_TEST_DATA "/gnss/alm_gps_ed259.txt"));

@@ -354,7 +354,7 @@ void BM_TrackRawFixes(benchmark::State& state) {
 BENCHMARK(BM_TrackRawFixes)->Unit(benchmark::kMicrosecond)->MinTime(1.0);
 
 /// The same flight with a tactical IMU's increments (100 per fix), barometer and magnetometer:
-/// seed 001's GNSS/INS flow per fix (strapdown, EKF, FDE, IMU test, fault-mode PLs). Vehicle of
+/// the fault-mode GNSS/INS flow per fix (docs/method.md §5.2) (strapdown, EKF, FDE, IMU test, fault-mode PLs). Vehicle of
 /// 40 m span: the fault-mode PLs fit level 1.
 void BM_TrackGnssInsFixes(benchmark::State& state) {
   RawScene scene;

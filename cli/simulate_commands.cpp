@@ -102,14 +102,14 @@ json countsJson(const integrity::sim::MonteCarloResult& r) {
 
 void printCounts(const integrity::sim::MonteCarloResult& r, std::ostream& os) {
   char b[256];
-  std::snprintf(b, sizeof b, "%-8s %-4s %10s %9s %9s %6s %11s %12s %12s\n", "method", "dir", "with PL", "unavail",
+  std::snprintf(b, sizeof b, "%-20s %-4s %10s %9s %9s %6s %11s %12s %12s\n", "method", "dir", "with PL", "unavail",
                 "error>PL", "HMI", "MI rate", "MI rate 95%", "HMI rate 95%");
   os << b;
   for (int m = 0; m < kNumMethods; ++m) {
     for (int dir = 0; dir < 2; ++dir) {
       const auto& h = dir == 0 ? r.methods[m].horizontal : r.methods[m].vertical;
       const std::uint64_t with_pl = h.total - h.no_pl;
-      std::snprintf(b, sizeof b, "%-8s %-4s %10llu %9llu %9llu %6llu %11.3g %12.3g %12.3g\n",
+      std::snprintf(b, sizeof b, "%-20s %-4s %10llu %9llu %9llu %6llu %11.3g %12.3g %12.3g\n",
                     std::string(integrity::sim::methodName(static_cast<Method>(m))).c_str(), dir == 0 ? "H" : "V",
                     static_cast<unsigned long long>(with_pl), static_cast<unsigned long long>(h.unavailable),
                     static_cast<unsigned long long>(h.misleading), static_cast<unsigned long long>(h.hmi),
@@ -128,8 +128,8 @@ std::string curvesSvg(const integrity::sim::RunResult& run, const integrity::sim
     const char* colour;
     Method method;
   };
-  const Line lines[] = {{"seed001 PL", "#d62728", Method::kSeed001},
-                        {"seed000 PL", "#ff7f0e", Method::kSeed000},
+  const Line lines[] = {{"fault-mode PL", "#d62728", Method::kFaultMode},
+                        {"three-hypothesis INS PL", "#ff7f0e", Method::kThreeHypothesisIns},
                         {"RAIM PL", "#2ca02c", Method::kRaim},
                         {"ARAIM PL", "#9467bd", Method::kAraim}};
   std::vector<Panel> panels(2);
@@ -144,9 +144,9 @@ std::string curvesSvg(const integrity::sim::RunResult& run, const integrity::sim
     Series raim_err{"error (snapshot)", "#2ca02c", {}, true, false};
     for (const auto& e : run.epochs) {
       if (dir == 0) t.push_back(e.t_s);
-      const auto& sys = e.methods[static_cast<int>(Method::kSeed001)];
+      const auto& sys = e.methods[static_cast<int>(Method::kFaultMode)];
       err.y.push_back(dir == 0 ? sys.hpe_m : sys.vpe_m);
-      const auto& f = e.methods[static_cast<int>(Method::kSeed000)];
+      const auto& f = e.methods[static_cast<int>(Method::kThreeHypothesisIns)];
       ekf_err.y.push_back(dir == 0 ? f.hpe_m : f.vpe_m);
       const auto& sn = e.methods[static_cast<int>(Method::kRaim)];
       raim_err.y.push_back(dir == 0 ? sn.hpe_m : sn.vpe_m);
@@ -162,18 +162,18 @@ std::string curvesSvg(const integrity::sim::RunResult& run, const integrity::sim
     for (Series& se : pls) p.series.push_back(std::move(se));
     p.series.push_back(al);
   }
-  // Seed 001's fault modes (its Figs. 6–11): each mode's PL against the system error.
+  // The fault modes (Zhao & Song 2024 Figs. 6–11): each mode's PL against the system error.
   const char* const mode_names[4] = {"FF", "GS", "I", "GSI"};
   const char* const mode_colours[4] = {"#2ca02c", "#d62728", "#1f77b4", "#9467bd"};
   for (int dir = 0; dir < 2; ++dir) {
     Panel p;
-    p.y_label = dir == 0 ? "seed 001 modes, H [m]" : "seed 001 modes, V [m]";
+    p.y_label = dir == 0 ? "fault-mode PLs, H [m]" : "fault-mode PLs, V [m]";
     p.height_px = 200;
     Series err{"error (system)", "#000000", {}, false, false};
     std::vector<Series> modes;
     for (int k = 0; k < 4; ++k) modes.push_back({std::string(mode_names[k]) + (dir == 0 ? " HPL" : " VPL"), mode_colours[k], {}, k == 0, false});
     for (const auto& e : run.epochs) {
-      const auto& sys = e.methods[static_cast<int>(Method::kSeed001)];
+      const auto& sys = e.methods[static_cast<int>(Method::kFaultMode)];
       err.y.push_back(dir == 0 ? sys.hpe_m : sys.vpe_m);
       for (int k = 0; k < 4; ++k) {
         const double v = dir == 0 ? e.mode_hpl_m[static_cast<std::size_t>(k)] : e.mode_vpl_m[static_cast<std::size_t>(k)];
@@ -257,7 +257,7 @@ void runSimulate(const SimulateOptions& o) {
     }
     const auto& h = single.methods[m].horizontal;
     const auto& v = single.methods[m].vertical;
-    std::printf("  %-8s H: %s (max error/PL %.2f, %llu epochs without PL)  V: %s (max error/PL %.2f)\n",
+    std::printf("  %-20s H: %s (max error/PL %.2f, %llu epochs without PL)  V: %s (max error/PL %.2f)\n",
                 std::string(integrity::sim::methodName(static_cast<Method>(m))).c_str(),
                 h.misleading == 0 ? "bounded" : "NOT bounded", worst_h, static_cast<unsigned long long>(h.no_pl),
                 v.misleading == 0 ? "bounded" : "NOT bounded", worst_v);

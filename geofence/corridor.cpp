@@ -39,7 +39,7 @@ void checkFactor(const char* name, double k, double lo, double hi, bool override
   }
   if (k >= lo && k <= hi) return;
   std::ostringstream s;
-  s << name << " = " << k << " is outside seed 000's range [" << lo << ", " << hi << "]";
+  s << name << " = " << k << " is outside the box levels' range [" << lo << ", " << hi << "]";
   if (!override_ranges) throw std::invalid_argument(s.str() + " (pass the override to accept it)");
   warnings.push_back(s.str() + ": accepted by override");
 }

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief The two box levels of seed 000 (claims 8 and 9; DESIGN.md "The two box levels"):
+/// \brief The two box levels (docs/method.md §6; US 10,466,362 claims 8 and 9):
 /// alert limits from the vehicle's size, first-level corridor and second-level airspace boxes
 /// along a path, and whether a protection volume lies inside them, with margins.
 ///
@@ -29,7 +29,7 @@ struct Vehicle {
   double height_m = 0.0;
 };
 
-/// \brief Which dimension each alert limit scales. Seed 000's mapping is the default: the
+/// \brief Which dimension each alert limit scales. The patent's mapping (US 10,466,362) is the default: the
 /// horizontal limit from the lateral size, the vertical one from the longitudinal size.
 struct AlertMapping {
   Dimension horizontal = Dimension::kLateral;

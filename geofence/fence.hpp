@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief The fence check of seed 000 (claims 8–9; DESIGN.md "The two box levels"): a
+/// \brief The fence check (docs/method.md §6; US 10,466,362 claims 8–9): a
 /// protection volume is trusted only when it lies inside its first-level corridor, inside its
 /// second-level airspace box, and clear of every zone active at the time and every obstacle.
 /// One verdict type serves every level; the same checker serves a predicted trajectory and a

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Buildings and obstacles: GeoJSON footprints with a height, extruded to prisms and
-/// closed triangle meshes in a local ENU frame (DESIGN.md, maps/).
+/// closed triangle meshes in a local ENU frame (docs/method.md §1.1).
 ///
 /// **Input** (README "Buildings and obstacles"): an RFC 7946 FeatureCollection (or a single
 /// Feature) whose geometries are Polygon, MultiPolygon or Point (a mast, a chimney: a vertical

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Sky mask at a point: the elevation angle blocked by buildings and terrain in every
-/// azimuth bin, for the integrity prediction to drop satellites behind them (DESIGN.md, maps/).
+/// azimuth bin, for the integrity prediction to drop satellites behind them (docs/method.md §7.1 step 3).
 ///
 /// **Geometry.** Seen from an observer at ellipsoidal height h_obs, a point at horizontal
 /// distance d whose ellipsoidal height is h appears at elevation

@@ -2,7 +2,7 @@
 /// \file
 /// \brief Terrain elevation: a flat plane or a digital elevation model raster read with GDAL.
 ///
-/// Zones whose limits are "above ground level" are resolved with this model (DESIGN.md,
+/// Zones whose limits are "above ground level" are resolved with this model (docs/method.md §1.2
 /// Frames, units, time). Heights above mean sea level mean above the EGM96 geoid (maps/geoid.hpp).
 /// SRTM heights are EGM96 heights, so kAmslEgm96 is the default datum; other "sea level" DEMs
 /// (Copernicus GLO-30 on EGM2008, national DEMs on their own geoids) are read the same way and

@@ -2,7 +2,7 @@
 /// \file
 /// \brief The approval in exchange formats: GeoJSON (RFC 7946) for any GIS, and ASTM F3548-21
 /// operational-intent `Volume4D` objects for a UTM / U-space service (field names as in
-/// DESIGN.md: volume.outline_polygon.vertices[{lat, lng}], altitude_lower/upper {value,
+/// ASTM F3548-21 Volume4D: volume.outline_polygon.vertices[{lat, lng}], altitude_lower/upper {value,
 /// reference "W84", units "M"}, time_start/time_end {value, format "RFC3339"}).
 
 #include "planner/approval.hpp"

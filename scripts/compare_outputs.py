@@ -22,13 +22,19 @@ def load_renames(path):
     return renames
 
 
+def renamed(text, renames):
+    for old, new in renames.items():
+        text = text.replace(old, new)
+    return text
+
+
 def normalise(value, renames):
     if isinstance(value, dict):
-        return {renames.get(k, k): normalise(v, renames) for k, v in value.items() if k not in WALL_CLOCK_KEYS}
+        return {renamed(k, renames): normalise(v, renames) for k, v in value.items() if k not in WALL_CLOCK_KEYS}
     if isinstance(value, list):
         return [normalise(v, renames) for v in value]
     if isinstance(value, str):
-        return renames.get(value, value)
+        return renamed(value, renames)
     return value
 
 
@@ -43,9 +49,7 @@ def json_values(path, renames):
 def text_lines(path, renames):
     lines = []
     for line in open(path, encoding="utf-8", errors="replace").read().splitlines():
-        for old, new in renames.items():
-            line = line.replace(old, new)
-        lines.append(WALL_CLOCK_TEXT.sub("<t>", line))
+        lines.append(WALL_CLOCK_TEXT.sub("<t>", renamed(line, renames)))
     return lines
 
 

@@ -46,10 +46,10 @@ python3 -c 'import json, os
 for l in open(os.environ["OUT"] + "/fence.jsonl"):
     j = json.loads(l)
     print(j.get("id", "line %d" % j["line"]), j.get("verdict", j.get("event")), j.get("violated") or "")'
-echo "--- GNSS/INS simulation, seed 001's experiments ("$OUT"/simulate/<scenario>/: epochs.csv,"
+echo "--- GNSS/INS simulation, the fault-mode experiments of Zhao & Song 2024 ("$OUT"/simulate/<scenario>/: epochs.csv,"
 echo "    errors_and_pls.svg, stanford_horizontal.svg, stanford_vertical.svg):"
 for s in no_fault accel_fault sat_10sigma sat_20sigma combined; do
-  "$SKYLANE" simulate examples/simulate/seed001_$s.json --out "$OUT"/simulate/$s | grep -v '^skylane: simulate: wrote'
+  "$SKYLANE" simulate examples/simulate/gnss_ins_$s.json --out "$OUT"/simulate/$s | grep -v '^skylane: simulate: wrote'
 done
 echo "--- preflight approval ("$OUT"/approve/: report.json, route.geojson, operational_intent.json, map.svg, pl.svg):"
 "$SKYLANE" approve examples/approve/mission.json --out "$OUT"/approve > /dev/null

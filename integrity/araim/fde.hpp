@@ -9,7 +9,7 @@
 /// the one whose solution has the smallest weighted residual sum of squares is excluded and the
 /// protection levels are those of the remaining geometry. (The ADD's pre-allocation of the
 /// integrity budget to exclusion outcomes — Blanch, Walter & Enge, NAVIGATION 64(4), 2017 — is
-/// not applied yet: see the issue note.)
+/// not applied yet: see docs/method.md §4.3.)
 
 #include "integrity/araim/mhss.hpp"
 

@@ -1,12 +1,12 @@
 #pragma once
 /// \file
 /// \brief ARAIM multiple-hypothesis solution separation (MHSS): subset solutions, thresholds,
-/// the optimised protection level of seed 003, the equal-allocation bound, EMT, σ_acc and
+/// the optimised protection level (docs/method.md §4.5; CN 110687557 A), the equal-allocation bound, EMT, σ_acc and
 /// availability.
 ///
 /// References: WG-C ARAIM Technical Subgroup, "Reference Airborne Algorithm Description Document"
 /// v3.0 (2017) — ADD; J. Blanch et al., "Baseline Advanced RAIM User Algorithm and Possible
-/// Improvements", IEEE TAES 51(1) 713–732, 2015 — TAES; seed 003 (ARAIM PL optimisation patent):
+/// Improvements", IEEE TAES 51(1) 713–732, 2015 — TAES; R. Xue & Y. Zhao, CN 110687557 A (ARAIM PL optimisation patent, Beihang University, 2020):
 /// the PL is the root of the integrity-risk equation over all monitored subsets, which is the
 /// optimal allocation of PHMI among them and never larger than the equal-allocation bound.
 ///

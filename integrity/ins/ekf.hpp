@@ -2,7 +2,7 @@
 /// \file
 /// \brief Error-state extended Kalman filter for a single IMU tightly coupled with GNSS
 /// pseudoranges, with barometric-height and magnetometer-heading updates and closed-loop
-/// correction of the strapdown solution (seed 002: INS error states reset to zero after each
+/// correction of the strapdown solution (as in "Estimation algorithm of the computer-integrated navigation complex of an unmanned aerial vehicle", Electronics and Control Systems 2012 No. 4(34); docs/method.md §5.1: INS error states reset to zero after each
 /// feedback; Groves 2013 §14.2 (ECEF error model) and §14.3.3 (tightly coupled measurement model)).
 ///
 /// Error state δx = truth − estimate (18 states): δr (0–2), δv (3–5) in ECEF; attitude error φ

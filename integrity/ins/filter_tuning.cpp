@@ -17,9 +17,9 @@ void tuneFilterToSensors(NavigatorConfig& nav, const SensorErrorSpec& sensors, I
   e.baro_bias_m = sensors.baro_bias_m;
   e.baro_bias_rw_m_rts = sensors.baro_bias_rw_m_rts;
   e.heading_noise_rad = sensors.heading_noise_rad;
-  nav.seed000.lambda = seed000Lambda(static_cast<int>(grade));
-  nav.seed000.phmi_h = nav.fault_modes.risk.i_req * (1.0 - nav.fault_modes.risk.vertical_share);
-  nav.seed000.phmi_v = nav.fault_modes.risk.i_req * nav.fault_modes.risk.vertical_share;
+  nav.three_hypothesis_ins.lambda = imuErrorWeightRatio(static_cast<int>(grade));
+  nav.three_hypothesis_ins.phmi_h = nav.fault_modes.risk.i_req * (1.0 - nav.fault_modes.risk.vertical_share);
+  nav.three_hypothesis_ins.phmi_v = nav.fault_modes.risk.i_req * nav.fault_modes.risk.vertical_share;
 }
 
 NavigatorConfig trackingNavigatorConfig(ImuGrade grade, const ErrorModel& model, double elevation_mask_rad,

@@ -133,21 +133,21 @@ void updateGnssAloneMode(bool imu_fault_detected, double t_s, double recover_s, 
 void selectSystemOutput(bool degraded, NavigatorEpoch& out) {
   if (degraded) {
     out.r_ecef_m = out.raim.r_ecef_m;
-    out.seed001_available = out.raim.available;
-    out.seed001_hpl_m = out.raim.hpl_m;
-    out.seed001_vpl_m = out.raim.vpl_m;
+    out.fault_mode_available = out.raim.available;
+    out.fault_mode_hpl_m = out.raim.hpl_m;
+    out.fault_mode_vpl_m = out.raim.vpl_m;
   } else {
     out.r_ecef_m = out.ekf_r_ecef_m;
-    out.seed001_available = out.fault_modes.available;
-    out.seed001_hpl_m = out.fault_modes.hpl_m;
-    out.seed001_vpl_m = out.fault_modes.vpl_m;
+    out.fault_mode_available = out.fault_modes.available;
+    out.fault_mode_hpl_m = out.fault_modes.hpl_m;
+    out.fault_mode_vpl_m = out.fault_modes.vpl_m;
   }
 }
 
 }  // namespace
 
 Navigator::Navigator(const NavigatorConfig& cfg, const NavState& initial, double clock_m, double drift_mps)
-    : cfg_(cfg), ekf_(cfg.ekf, initial, clock_m, drift_mps), seed000_(cfg.seed000) {}
+    : cfg_(cfg), ekf_(cfg.ekf, initial, clock_m, drift_mps), three_hypothesis_ins_(cfg.three_hypothesis_ins) {}
 
 NavigatorEpoch Navigator::epoch(double t_s, const std::vector<PseudorangeInput>& ranges, std::optional<double> baro_h_m,
                                 std::optional<double> heading_rad) {
@@ -178,7 +178,7 @@ NavigatorEpoch Navigator::epoch(double t_s, const std::vector<PseudorangeInput>&
   // 4. Protection levels.
   if (rec.ok) {
     out.fault_modes = faultModeProtectionLevels(rec, cfg_.fault_modes);
-    out.seed000 = seed000_.push(rec, fde.pl);
+    out.three_hypothesis_ins = three_hypothesis_ins_.push(rec, fde.pl);
   }
   selectSystemOutput(degraded_, out);
   return out;

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// \brief Seed 001's integrity monitoring flow around the GNSS/INS filter (Zhao & Song 2024,
-/// §1.1, Fig. 1), with seed 000's protection levels and snapshot RAIM/ARAIM beside it:
+/// \brief The fault-mode integrity monitoring flow around the GNSS/INS filter (docs/method.md §5.2; Zhao & Song 2024,
+/// §1.1, Fig. 1), with the three-hypothesis INS PL (US 10,466,362) and snapshot RAIM/ARAIM beside it:
 /// 1. before fusion, LSR fault detection and w-test exclusion on the epoch's pseudoranges;
 /// 2. the kept pseudoranges update the filter; the innovations test the IMU (a windowed χ² of the
 ///    position/clock bias they reveal, see imuInnovationStatistic);
@@ -33,7 +33,7 @@ struct NavigatorConfig {
   ErrorModel model;
   double elevation_mask_rad = 5.0 * M_PI / 180.0;
   FaultModeConfig fault_modes;
-  Seed000Config seed000;
+  ThreeHypothesisInsConfig three_hypothesis_ins;
   AraimConfig araim;
   int max_exclusions = 1;
   int imu_test_window = 10;    ///< epochs summed in the IMU innovation test
@@ -70,14 +70,14 @@ struct NavigatorEpoch {
   double imu_statistic = 0.0;  ///< windowed χ² of the IMU innovation test
   double imu_threshold = 0.0;
   bool imu_fault_detected = false;
-  bool degraded = false;       ///< GNSS alone (seed 001 class 1)
-  /// \brief The system's output: the filter (or the snapshot when degraded) and seed 001's PLs.
+  bool degraded = false;       ///< GNSS alone (fault-mode class 1, docs/method.md §5.3)
+  /// \brief The system's output: the filter (or the snapshot when degraded) and its fault-mode PLs.
   Eigen::Vector3d r_ecef_m = Eigen::Vector3d::Zero();
-  bool seed001_available = false;
-  double seed001_hpl_m = 0.0, seed001_vpl_m = 0.0;
+  bool fault_mode_available = false;
+  double fault_mode_hpl_m = 0.0, fault_mode_vpl_m = 0.0;
   FaultModePls fault_modes;    ///< class-2 details (also computed while degraded)
   Eigen::Vector3d ekf_r_ecef_m = Eigen::Vector3d::Zero();
-  Seed000Pl seed000;           ///< bounds the filter position
+  ThreeHypothesisInsPl three_hypothesis_ins;           ///< bounds the filter position
   SnapshotSolution raim;       ///< after FDE
   SnapshotSolution araim;      ///< after ARAIM solution-separation FDE
 };
@@ -99,13 +99,13 @@ class Navigator {
   [[nodiscard]] const NavigatorConfig& config() const { return cfg_; }
   /// \brief How many satellites step 1 may exclude from the next epochs on (a deeper FDE rerun).
   void setMaxExclusions(int n) { cfg_.max_exclusions = n; }
-  /// \brief Whether the flow is in seed 001's GNSS-alone mode after an IMU fault.
+  /// \brief Whether the flow is in the fault-mode flow's GNSS-alone mode after an IMU fault.
   [[nodiscard]] bool degraded() const { return degraded_; }
 
  private:
   NavigatorConfig cfg_;
   InsEkf ekf_;
-  Seed000Monitor seed000_;
+  ThreeHypothesisInsMonitor three_hypothesis_ins_;
   std::deque<double> imu_stats_;
   std::map<int, double> imu_thresholds_;  ///< χ² thresholds by degrees of freedom
   bool degraded_ = false;

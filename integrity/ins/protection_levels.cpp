@@ -161,22 +161,22 @@ FaultModePls faultModeProtectionLevels(const GnssUpdateRecord& rec, const FaultM
   return out;
 }
 
-double seed000Lambda(int grade_index) {
+double imuErrorWeightRatio(int grade_index) {
   switch (grade_index) {
     case 0: return 1.0 / 12.0;
     case 1: return 5.0 / 12.0;
     case 2: return 9.0 / 12.0;
-    default: throw std::invalid_argument("seed 000: IMU grade index must be 0, 1 or 2");
+    default: throw std::invalid_argument("IMU grade index must be 0 (aviation), 1 (tactical) or 2 (consumer)");
   }
 }
 
-Seed000Monitor::Seed000Monitor(const Seed000Config& cfg) : cfg_(cfg) {
-  if (cfg_.window < 1) throw std::invalid_argument("seed 000: the averaging window must be ≥ 1 epoch");
-  if (!(cfg_.lambda > 0.0 && cfg_.lambda < 1.0)) throw std::invalid_argument("seed 000: λ must lie in (0, 1)");
+ThreeHypothesisInsMonitor::ThreeHypothesisInsMonitor(const ThreeHypothesisInsConfig& cfg) : cfg_(cfg) {
+  if (cfg_.window < 1) throw std::invalid_argument("three-hypothesis INS PL: the averaging window must be ≥ 1 epoch");
+  if (!(cfg_.lambda > 0.0 && cfg_.lambda < 1.0)) throw std::invalid_argument("three-hypothesis INS PL: λ must lie in (0, 1)");
 }
 
-Seed000Pl Seed000Monitor::push(const GnssUpdateRecord& rec, const RaimPl& raim) {
-  Seed000Pl out;
+ThreeHypothesisInsPl ThreeHypothesisInsMonitor::push(const GnssUpdateRecord& rec, const RaimPl& raim) {
+  ThreeHypothesisInsPl out;
   if (!rec.ok) return out;
   const Eigen::Vector3d& c = rec.correction_enu;
   corrections_.emplace_back(std::hypot(c.x(), c.y()), std::abs(c.z()), 0.0);

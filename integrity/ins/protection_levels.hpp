@@ -1,9 +1,9 @@
 #pragma once
 /// \file
-/// \brief Protection levels of the GNSS/INS filter: seed 001's fault modes (Zhao & Song 2024,
-/// §3) and seed 000's three hypotheses (patent, claims 1–7).
+/// \brief Protection levels of the GNSS/INS filter: the fault-mode PLs (docs/method.md §5.4; Zhao & Song 2024,
+/// §3) and the three-hypothesis INS PL (docs/method.md §5.5; US 10,466,362 claims 1–7).
 ///
-/// **Seed 001, as skylane reads it.** The paper's Eqs. (18)–(35) are lost in the OCR; the text
+/// **The fault-mode PL (Zhao & Song 2024), as skylane reads it.** The paper's Eqs. (18)–(35) are lost in the OCR; the text
 /// keeps their structure: the fault-free error is N(0, σ_q²) with σ_q from the filter covariance
 /// (Eq. 18); for the GS mode the estimate error is written through the filter innovation, which
 /// carries the effect of past-epoch faults, plus (B_k + K'_k)·f_k for the current epoch's fault
@@ -31,7 +31,7 @@
 /// horizontal conditional risk, so the union bound keeps the horizontal total (the paper does not
 /// say how it splits it). Final PL = max over the modes that need one (Eq. 38).
 ///
-/// **Seed 000, as read** (see also the notes in DESIGN.md): HPL = max{HPL_GNSS,fault,
+/// **The three-hypothesis INS PL (US 10,466,362), as read** (docs/method.md §5.5): HPL = max{HPL_GNSS,fault,
 /// HPL_IMU,fault, HPL_IMU,nominal}, VPL alike, with
 ///   HPL_IMU,nominal = Q⁻¹(λ·P_nom)·σ_h, σ_h = √(σ_E² + σ_N²) from the filter covariance;
 ///   HPL_IMU,fault = Q⁻¹(λ·P_ins)·σ_fault,h + mean over the last N epochs of |(K ν)_h| — the
@@ -62,7 +62,7 @@ struct ModePl {
   double vpl_m = 0.0;
 };
 
-/// \brief Seed 001's protection levels at one epoch.
+/// \brief The fault-mode protection levels at one epoch.
 struct FaultModePls {
   bool available = false;
   std::string reason;
@@ -74,13 +74,13 @@ struct FaultModePls {
   double bias_estimate_up_m = 0.0;  ///< (A ν)_U
 };
 
-/// \brief Seed 001 settings.
+/// \brief Fault-mode PL settings.
 struct FaultModeConfig {
   RiskAllocationConfig risk;
   double pfa_gnss = 1e-5;  ///< false-alert probability of the LSR test (also used by the FDE)
 };
 
-/// \brief Seed 001's fault-mode protection levels (class 2: no IMU fault detected) from a GNSS update.
+/// \brief The fault-mode protection levels (class 2: no IMU fault detected) from a GNSS update.
 [[nodiscard]] FaultModePls faultModeProtectionLevels(const GnssUpdateRecord& rec, const FaultModeConfig& cfg);
 
 /// \brief The innovation test statistic for IMU faults: the prior position/clock bias estimated
@@ -88,8 +88,8 @@ struct FaultModeConfig {
 /// per fault-free epoch (one clock). Returns a negative number when fewer than 4 satellites.
 [[nodiscard]] double imuInnovationStatistic(const GnssUpdateRecord& rec);
 
-/// \brief Seed 000 settings.
-struct Seed000Config {
+/// \brief Three-hypothesis INS PL settings.
+struct ThreeHypothesisInsConfig {
   double phmi_h = 0.5e-7;
   double phmi_v = 0.5e-7;
   std::array<double, 3> share{1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0};  ///< nominal, INS fault, GNSS fault
@@ -97,29 +97,29 @@ struct Seed000Config {
   int window = 10;             ///< N epochs of the means
 };
 
-/// \brief Seed 000's HPL/VPL with the three hypotheses' parts.
-struct Seed000Pl {
+/// \brief The three-hypothesis INS HPL/VPL with each hypothesis' part.
+struct ThreeHypothesisInsPl {
   bool available = false;
   double hpl_m = 0.0, vpl_m = 0.0;
   double hpl_nominal_m = 0.0, hpl_imu_fault_m = 0.0, hpl_gnss_fault_m = 0.0;
   double vpl_nominal_m = 0.0, vpl_imu_fault_m = 0.0, vpl_gnss_fault_m = 0.0;
 };
 
-/// \brief Seed 000's monitor: keeps the last N corrections and RAIM biases.
-class Seed000Monitor {
+/// \brief The three-hypothesis INS PL monitor: keeps the last N corrections and RAIM biases.
+class ThreeHypothesisInsMonitor {
  public:
-  explicit Seed000Monitor(const Seed000Config& cfg);
+  explicit ThreeHypothesisInsMonitor(const ThreeHypothesisInsConfig& cfg);
   /// \brief Adds an epoch and returns its protection levels. `raim` is the snapshot RAIM of the
   /// satellites the filter used (for μ); an unavailable RAIM makes the epoch unavailable.
-  Seed000Pl push(const GnssUpdateRecord& rec, const RaimPl& raim);
+  ThreeHypothesisInsPl push(const GnssUpdateRecord& rec, const RaimPl& raim);
 
  private:
-  Seed000Config cfg_;
+  ThreeHypothesisInsConfig cfg_;
   std::deque<Eigen::Vector3d> corrections_;  ///< |K ν| parts: (horizontal, up, –)
   std::deque<Eigen::Vector2d> mu_;            ///< (μ_h, μ_v)
 };
 
-/// \brief Seed 000's error weight ratio λ for an IMU grade index (0 aviation, 1 tactical, 2 consumer).
-[[nodiscard]] double seed000Lambda(int grade_index);
+/// \brief The patent's error weight ratio λ for an IMU grade index (0 aviation, 1 tactical, 2 consumer).
+[[nodiscard]] double imuErrorWeightRatio(int grade_index);
 
 }  // namespace skylane::integrity::ins

@@ -3,7 +3,7 @@
 /// \brief Fault modes of a GNSS/IMU integrated navigation system with one IMU, their prior
 /// probabilities and the split of the integrity requirement among them (J. Zhao & D. Song,
 /// "Integrity monitoring method for UAV GNSS/IMU integrated navigation system", Acta
-/// Aeronautica et Astronautica Sinica 45(7), 2024 — seed 001, §§1.3, 2.1, 2.2).
+/// Aeronautica et Astronautica Sinica 45(7), 2024 §§1.3, 2.1, 2.2; docs/method.md §5.3).
 ///
 /// Reading of the damaged equations (the OCR lost every formula; the printed numbers fix them):
 /// - Eq. (4) (class 1, IMU fault detected, GNSS alone): P(FF) = (1−P_sat)^K,
@@ -16,7 +16,7 @@
 ///   I_req = 1e-7 (so ≤ 5e-9; GM's 4.4998e-9 passes only against the total, not against the
 ///   per-direction 5e-8) gets its prior as its budget and needs no protection level; the rest
 ///   of the direction's budget is split evenly among the remaining modes. The paper prints
-///   1.1376e-9 for class 2, but (5e-8 − 4.4953e-9)/4 = 1.1376e-8: a misprint (DESIGN.md).
+///   1.1376e-9 for class 2, but (5e-8 − 4.4953e-9)/4 = 1.1376e-8: a misprint (docs/method.md §5.3).
 /// - The paper's class 2 leaves out "multi-satellite and IMU" (GMI), prior
 ///   P(GM)·P_IMU/(1−P_IMU) ≈ 4.5e-12 for K = 10. Left out, the requirement is not fully
 ///   accounted for, so skylane adds it as a prior-budgeted mode by default
@@ -27,7 +27,7 @@
 
 namespace skylane::integrity {
 
-/// \brief The fault modes of seed 001 (plus GMI, see the file comment).
+/// \brief The fault modes of Zhao & Song 2024 (plus GMI, see the file comment).
 enum class InsFaultMode {
   kFaultFree,      ///< no GNSS and no IMU fault
   kGnssSingle,     ///< GS: one satellite faulty, IMU healthy
@@ -41,7 +41,7 @@ inline constexpr int kNumInsFaultModes = 6;
 /// \brief Short name as in the paper: "FF", "GS", "GM", "I", "GSI", "GMI".
 [[nodiscard]] std::string_view faultModeName(InsFaultMode m);
 
-/// \brief Which detection outcome the budget is for (seed 001 Fig. 3).
+/// \brief Which detection outcome the budget is for (Zhao & Song 2024 Fig. 3).
 enum class DetectionClass {
   kGnssAlone,   ///< class 1: IMU fault detected, the system degrades to GNSS (modes FF, GS, GM)
   kIntegrated,  ///< class 2: no IMU fault detected (FF, GS, GM, I, GSI, GMI)
@@ -76,7 +76,7 @@ struct RiskAllocation {
   [[nodiscard]] const ModeBudget& of(InsFaultMode m) const { return modes[static_cast<int>(m)]; }
 };
 
-/// \brief Priors of every mode (seed 001 Eqs. (4), (7)) for K satellites in view.
+/// \brief Priors of every mode (Zhao & Song 2024 Eqs. (4), (7); docs/method.md Eqs. (5.7)–(5.8)) for K satellites in view.
 /// \throws std::invalid_argument for K < 1 or probabilities outside [0, 1).
 [[nodiscard]] std::array<double, kNumInsFaultModes> faultModePriors(int num_sats, DetectionClass detection,
                                                                     const RiskAllocationConfig& cfg);

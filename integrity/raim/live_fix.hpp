@@ -17,7 +17,7 @@
 ///   PL_det = PL + max_i |Δx_i| (horizontal: the horizontal norm, vertical: |Δx_U|), Δx_i the
 ///   shift of the solution when satellite i (ARAIM: each monitored subset) is left out — the
 ///   displacement the data themselves show a fault could have caused. (skylane's reading: the
-///   seeds give no PL for a detected, not yet excluded fault; this one grows with the fault and
+///   source documents give no PL for a detected, not yet excluded fault (docs/method.md §3.4); this one grows with the fault and
 ///   falls back to the fault-free PL once the fault is excluded.)
 /// - **monitoring rerun** (`exclude = true`): the method's FDE (RAIM w-test, ARAIM
 ///   solution-separation exclusion), the position and PLs of the remaining geometry.

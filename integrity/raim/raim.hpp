@@ -34,7 +34,7 @@ struct RaimThresholds {
 
 /// \brief How the slope-based protection level is formed.
 enum class RaimPlFormula {
-  /// DESIGN.md's "max slope × p_bias plus the fault-free term": PL_V = max_i VSlope_i·p_bias
+  /// "max slope × p_bias plus the fault-free term" (docs/method.md Eq. (3.5)): PL_V = max_i VSlope_i·p_bias
   /// + Q⁻¹(P_md/2)·σ_V, PL_H = max_i HSlope_i·p_bias + √(−2 ln P_md)·σ_H,major. Rigorous: the
   /// position noise is independent of the residuals in WLS, so for a bias whose non-centrality
   /// is below p_bias² the exceedance is ≤ P_md by the noise term, and above it the miss

@@ -17,8 +17,8 @@ namespace skylane::integrity::sim {
 
 std::string_view methodName(Method m) {
   switch (m) {
-    case Method::kSeed001: return "seed001";
-    case Method::kSeed000: return "seed000";
+    case Method::kFaultMode: return "fault_mode";
+    case Method::kThreeHypothesisIns: return "three_hypothesis_ins";
     case Method::kRaim: return "raim";
     case Method::kAraim: return "araim";
   }
@@ -64,16 +64,16 @@ ins::Navigator alignedNavigator(const ins::NavigatorConfig& cfg, const SensorSim
 void scoreMethods(const ins::NavigatorEpoch& ep, const Eigen::Vector3d& truth_ecef, const Eigen::Matrix3d& R,
                   EpochRecord& r) {
   const bool usable = !ep.outage;
-  r.methods[static_cast<int>(Method::kSeed001)] =
-      sampleOf(usable && ep.seed001_available, ep.r_ecef_m, truth_ecef, R, ep.seed001_hpl_m, ep.seed001_vpl_m);
-  // Seed 000 names no IMU fault detector; it runs inside the same flow as seed 001 (LSR FDE,
+  r.methods[static_cast<int>(Method::kFaultMode)] =
+      sampleOf(usable && ep.fault_mode_available, ep.r_ecef_m, truth_ecef, R, ep.fault_mode_hpl_m, ep.fault_mode_vpl_m);
+  // The patent (US 10,466,362) names no IMU fault detector; the three-hypothesis INS PL runs inside the fault-mode flow (LSR FDE,
   // innovation test, GNSS alone with RAIM when the IMU is declared faulty), so that the two
   // differ only in their protection-level formulas.
-  r.methods[static_cast<int>(Method::kSeed000)] =
+  r.methods[static_cast<int>(Method::kThreeHypothesisIns)] =
       ep.degraded ? sampleOf(usable && ep.raim.available, ep.raim.r_ecef_m, truth_ecef, R, ep.raim.hpl_m,
                              ep.raim.vpl_m)
-                  : sampleOf(usable && ep.seed000.available, ep.ekf_r_ecef_m, truth_ecef, R, ep.seed000.hpl_m,
-                             ep.seed000.vpl_m);
+                  : sampleOf(usable && ep.three_hypothesis_ins.available, ep.ekf_r_ecef_m, truth_ecef, R, ep.three_hypothesis_ins.hpl_m,
+                             ep.three_hypothesis_ins.vpl_m);
   r.methods[static_cast<int>(Method::kRaim)] =
       sampleOf(usable && ep.raim.available, ep.raim.r_ecef_m, truth_ecef, R, ep.raim.hpl_m, ep.raim.vpl_m);
   r.methods[static_cast<int>(Method::kAraim)] =
@@ -263,7 +263,7 @@ Scenario monteCarloVariant(const Scenario& base, std::uint64_t run_index) {
   //   fault, one of (probabilities): none (0.15); satellite step 3–12 σ (0.25, the LSR detects
   //   ~5–7 σ); satellite ramp 0.02–0.5 m/s (0.10); accelerometer step 0.005–0.1 m/s² on a random
   //   axis (0.15); accelerometer ramp 2e-4–5e-3 m/s³ (0.10); gyro step 2e-3–3e-2 rad/s (0.10);
-  //   satellite step and accelerometer step together (0.10, seed 001's GSI); GNSS outage of
+  //   satellite step and accelerometer step together (0.10, the GSI fault mode); GNSS outage of
   //   10–60 s (0.05). Windows start in [60 s, T − 90 s] and last 30–200 s.
   //   The faulted satellite is picked when the fault starts (FaultSpec::sats empty = "one of the
   //   satellites in view, chosen by `pick`").

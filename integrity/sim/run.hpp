@@ -18,13 +18,13 @@ namespace skylane::integrity::sim {
 
 /// \brief The methods compared.
 enum class Method {
-  kSeed001,  ///< seed 001 fault-mode PLs on the system output (filter, or GNSS alone when degraded)
-  kSeed000,  ///< seed 000's three hypotheses on the filter position (GNSS alone with RAIM when degraded)
+  kFaultMode,  ///< fault-mode PLs (Zhao & Song 2024) on the system output (filter, or GNSS alone when degraded)
+  kThreeHypothesisIns,  ///< three-hypothesis INS PL (US 10,466,362) on the filter position (GNSS alone with RAIM when degraded)
   kRaim,     ///< snapshot RAIM after FDE on its own position
   kAraim,    ///< snapshot ARAIM (MHSS) after solution-separation FDE on its own position
 };
 inline constexpr int kNumMethods = 4;
-/// \brief "seed001", "seed000", "raim", "araim".
+/// \brief "fault_mode", "three_hypothesis_ins", "raim", "araim".
 [[nodiscard]] std::string_view methodName(Method m);
 
 /// \brief One method at one epoch.
@@ -41,7 +41,7 @@ struct EpochRecord {
   Eigen::Vector3d estimate_enu_m = Eigen::Vector3d::Zero();  ///< the system output
   Eigen::Vector3d error_enu_m = Eigen::Vector3d::Zero();   ///< estimate − truth, local ENU at the truth
   std::array<MethodSample, kNumMethods> methods{};
-  std::array<double, 4> mode_hpl_m{}, mode_vpl_m{};  ///< seed 001 FF, GS, I, GSI
+  std::array<double, 4> mode_hpl_m{}, mode_vpl_m{};  ///< fault-mode FF, GS, I, GSI
   bool outage = false;
   int visible = 0, used = 0;
   std::vector<SatId> excluded;
@@ -79,7 +79,7 @@ struct StanfordHistogram {
   int bins = 0;
   std::vector<std::uint64_t> counts;  ///< bins × bins, row = PL bin, column = error bin
   std::uint64_t total = 0, normal = 0, mi = 0, hmi = 0, unavailable = 0, unavailable_mi = 0, no_pl = 0;
-  std::uint64_t misleading = 0;  ///< error > PL, whatever the region (the issue's "MI" count)
+  std::uint64_t misleading = 0;  ///< error > PL, whatever the region (the "misleading" count of docs/method.md §5.6)
 
   StanfordHistogram() = default;
   StanfordHistogram(double alert_limit, double max, int num_bins);

@@ -31,16 +31,16 @@ struct Scenario {
   SensorSpec sensors;
   std::vector<FaultSpec> faults;
   ins::NavigatorConfig navigator;
-  double hal_m = 40.0;  ///< seed 001 Table 2 (LPV): HAL 40 m, VAL 50 m
+  double hal_m = 40.0;  ///< Zhao & Song 2024 Table 2 (LPV): HAL 40 m, VAL 50 m
   double val_m = 50.0;
   std::uint64_t seed = 1;
 };
 
-/// \brief The navigator's filter and seed-000 settings that match an IMU grade and the sensors
-/// (the filter assumes the simulator's noise figures; seed 000's λ from the grade).
+/// \brief The navigator's filter and three-hypothesis INS PL settings that match an IMU grade and the sensors
+/// (the filter assumes the simulator's noise figures; the three-hypothesis λ from the grade).
 void matchFilterToSensors(Scenario& s);
 /// \brief The same for any navigator: its filter noise from `sensors` (IMU, clock, baro,
-/// magnetometer), its error model and mask, seed 000's λ from `grade`.
+/// magnetometer), its error model and mask, the three-hypothesis λ from `grade`.
 void matchFilterToSensors(ins::NavigatorConfig& nav, const SensorSpec& sensors, ImuGrade grade);
 
 /// \brief Parses a scenario document; relative file names are resolved against `base_dir`.

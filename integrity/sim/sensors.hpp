@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief Sensor simulation for the GNSS/INS proof: IMU increments per grade, GNSS pseudoranges
-/// from real orbits with the error model of DESIGN.md, barometric height, magnetometer heading,
+/// from real orbits with the error model of docs/method.md §2, barometric height, magnetometer heading,
 /// and fault injection. Every random draw comes from one seeded generator.
 ///
 /// IMU grades and their figures: integrity/ins/imu_grade.hpp.
@@ -54,7 +54,7 @@ struct FaultSpec {
   double t_end_s = 0.0;
   bool ramp = false;         ///< false: step of `magnitude`; true: grows by `magnitude` per second
   double magnitude = 0.0;    ///< m (satellite), m/s² (accelerometer), rad/s (gyro)
-  bool in_sigma = false;     ///< satellite: magnitude in units of the satellite's σ_int (seed 001's σ₀)
+  bool in_sigma = false;     ///< satellite: magnitude in units of the satellite's σ_int (Zhao & Song's σ₀)
   /// \brief Satellite fault with no `sats`: when the fault starts, the satellite at position
   /// ⌊pick·n⌋ of the n in view (in id order) is chosen and kept.
   double pick = -1.0;

@@ -2,7 +2,7 @@
 /// \file
 /// \brief Truth trajectories for the GNSS/INS simulation: a polyline of waypoints flown at set
 /// ground speeds, corners rounded into circular arcs, with attitude from the velocity (heading,
-/// flight-path angle) and a coordinated-turn bank angle; and seed 001's survey ("lawnmower")
+/// flight-path angle) and a coordinated-turn bank angle; and the survey ("lawnmower") of Zhao & Song 2024's simulation
 /// pattern.
 ///
 /// Frames: positions are in the local ENU frame of the trajectory's origin (a Cartesian frame:
@@ -98,7 +98,7 @@ class Trajectory {
   double duration_s_ = 0.0;
 };
 
-/// \brief Seed 001's survey pattern: `lines` parallel lines of length `line_length_m`, spaced
+/// \brief The survey pattern of Zhao & Song 2024: `lines` parallel lines of length `line_length_m`, spaced
 /// `spacing_m`, flown back and forth at `height_m` above the origin and `speed_mps`, starting at
 /// the origin heading along `heading_rad`.
 [[nodiscard]] std::vector<Waypoint> lawnmower(int lines, double line_length_m, double spacing_m, double height_m,

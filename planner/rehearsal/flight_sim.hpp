@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// \brief A rehearsal flight for `skylane track` (`skylane fly`): an approved route flown by seed
-/// 001's sensor simulator (integrity/sim: real orbits, the ARAIM error model, fault injection),
+/// \brief A rehearsal flight for `skylane track` (`skylane fly`): an approved route flown by skylane's GNSS/INS sensor
+/// simulator (docs/method.md §5.6) (integrity/sim: real orbits, the ARAIM error model, fault injection),
 /// one tracker fix per GNSS epoch with raw pseudoranges and, optionally, the IMU's increments,
 /// the onboard velocity and attitude and the barometer and magnetometer — what a vehicle's
 /// receiver and IMU would stream.

@@ -158,21 +158,21 @@ void runGnssInsEpoch(TrackedFlight& f, FixWork& w) {
     w.ins_before.reset();
     w.note = std::string("GNSS/INS filter failed (") + err.what() + "); the filter aligns again";
   }
-  if (w.ins_epoch && !w.ins_epoch->seed001_available && w.ins_epoch->gnss_fault_detected && w.ins_before) {
+  if (w.ins_epoch && !w.ins_epoch->fault_mode_available && w.ins_epoch->gnss_fault_detected && w.ins_before) {
     // A fault detected and not excluded: the monitoring rerun at once, one more exclusion allowed.
     if (auto again = f.deeperEpoch(*w.ins_before, fix)) {
       RerunReport r;
       r.detected = true;
       r.excluded = again->excluded;
-      r.hpl_after_m = again->seed001_hpl_m;
-      r.vpl_after_m = again->seed001_vpl_m;
+      r.hpl_after_m = again->fault_mode_hpl_m;
+      r.vpl_after_m = again->fault_mode_vpl_m;
       r.note = "GNSS/INS: a fault detected and not excluded; the epoch again with one more exclusion";
       w.pre_events.push_back(monitoringRerunEvent(f.id, fix, r));
       w.ins_epoch = again;
       w.early_rerun = true;
     }
   }
-  if (w.ins_epoch && !w.ins_epoch->seed001_available) {
+  if (w.ins_epoch && !w.ins_epoch->fault_mode_available) {
     const bool unresolved = w.ins_epoch->gnss_fault_detected && w.ins_epoch->excluded.empty();
     w.note = w.ins_epoch->outage
                  ? "GNSS/INS: no pseudorange above the mask (dead reckoning, no integrity); the snapshot is used"
@@ -193,8 +193,8 @@ void solveSnapshot(TrackedFlight& f, FixWork& w) {
                " reading (its innovation failed the gate)";
     }
     w.pos = maps::ecefToGeodetic(ep.r_ecef_m);
-    w.hpl_m = ep.seed001_hpl_m;
-    w.vpl_m = ep.seed001_vpl_m;
+    w.hpl_m = ep.fault_mode_hpl_m;
+    w.vpl_m = ep.fault_mode_vpl_m;
     w.source = PlSource::kGnssIns;
     return;
   }
@@ -255,7 +255,7 @@ RerunSolution rerunSolution(TrackedFlight& f, FixWork& w, bool detected) {
     RerunSolution again{true, w.pos, *w.hpl_m, *w.vpl_m, w.ins_epoch->excluded, ""};
     if (detected && w.ins_before) {
       if (auto ep2 = f.deeperEpoch(*w.ins_before, fix)) {
-        again = {true, maps::ecefToGeodetic(ep2->r_ecef_m), ep2->seed001_hpl_m, ep2->seed001_vpl_m, ep2->excluded, ""};
+        again = {true, maps::ecefToGeodetic(ep2->r_ecef_m), ep2->fault_mode_hpl_m, ep2->fault_mode_vpl_m, ep2->excluded, ""};
         w.ins_epoch = ep2;
       } else {
         again.note = "the epoch with one more exclusion gave no PL; the first pass stands";

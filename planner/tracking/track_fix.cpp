@@ -29,8 +29,8 @@ const char* plSourceName(PlSource s) {
 }
 
 std::pair<double, double> insNominalPl(const InsUncertainty& ins) {
-  const integrity::ins::Seed000Config cfg;
-  const double lambda = integrity::ins::seed000Lambda(ins.grade);
+  const integrity::ins::ThreeHypothesisInsConfig cfg;
+  const double lambda = integrity::ins::imuErrorWeightRatio(ins.grade);
   const double k_h = integrity::normalTailInverse(lambda * cfg.phmi_h * cfg.share[0]);
   const double k_v = integrity::normalTailInverse(lambda * cfg.phmi_v * cfg.share[0]);
   return {k_h * std::hypot(ins.sigma_n_m, ins.sigma_e_m), k_v * ins.sigma_u_m};
@@ -167,7 +167,7 @@ void readImu(const maps::JsonNode& root, TrackFix& f) {
   const maps::JsonNode imu = root.at("imu");
   imu.requireKnownFields({"grade", "sigma_n_m", "sigma_e_m", "sigma_u_m", "increments"});
   const auto parsed = integrity::ins::parseImuGrade(imu.at("grade").str());
-  if (!parsed) imu.at("grade").fail("aviation, tactical or consumer (seed 000 Table 1)");
+  if (!parsed) imu.at("grade").fail("aviation, tactical or consumer (the IMU grades of docs/method.md §5.1)");
   const int grade = static_cast<int>(*parsed);
   if (imu.has("increments")) {
     f.imu = readImuIncrements(imu, grade);

@@ -18,12 +18,12 @@
 ///   satellite's ECEF position at transmit time or, without it, from the mission's orbit files;
 ///   with them skylane computes its own position and PLs with the mission's method;
 /// - `imu`: the onboard INS's position σ's (north, east, up) and grade; the PL is then
-///   max(GNSS PL, seed 000's nominal-INS PL) — HPL_IMU,nominal = Q⁻¹(λ·P_nom,H)·√(σ_N² + σ_E²),
-///   VPL alike with σ_U (seed 000; λ by grade, P_nom = ⅓ of 0.5e-7 as Seed000Config).
+///   max(GNSS PL, the three-hypothesis nominal-INS PL) — HPL_IMU,nominal = Q⁻¹(λ·P_nom,H)·√(σ_N² + σ_E²),
+///   VPL alike with σ_U (docs/method.md Eq. (7.3); λ by grade, P_nom = ⅓ of 0.5e-7 as ThreeHypothesisInsConfig).
 /// - `imu.increments`: the IMU's body-frame increments (Δθ in rad, Δv in m/s, axes forward-left-
 ///   up, each over dt_s ≤ 1 s) from the previous fix to this one. With pseudoranges, skylane runs
-///   seed 001's GNSS/INS flow (integrity/ins/navigator.hpp: LSR FDE, tightly coupled EKF, the IMU
-///   innovation test, seed 001's fault-mode PLs; the filter's noise model is the grade's). The
+///   the fault-mode GNSS/INS flow (integrity/ins/navigator.hpp: LSR FDE, tightly coupled EKF, the IMU
+///   innovation test, its fault-mode PLs; the filter's noise model is the grade's). The
 ///   filter is aligned at a fix that gives `velocity_enu_mps` and `attitude_deg` (heading
 ///   clockwise from north, pitch nose up, roll right wing down) — the onboard navigation's —
 ///   and skylane's snapshot position; until then, and at that fix, the snapshot PLs are used;
@@ -71,7 +71,7 @@ struct ImuRecord {
 /// \brief Where a fix's protection levels came from.
 enum class PlSource { kOnboard, kRaw, kNmeaGst, kIns, kGnssIns };
 
-/// \brief "onboard", "raw", "nmea_gst", "ins" (the INS σ block alone), "gnss_ins" (seed 001's
+/// \brief "onboard", "raw", "nmea_gst", "ins" (the INS σ block alone), "gnss_ins" (the fault-mode
 /// flow over the fix's pseudoranges and IMU increments).
 [[nodiscard]] const char* plSourceName(PlSource s);
 
@@ -114,7 +114,7 @@ struct NmeaPlRisk {
 /// fields) or no GST.
 [[nodiscard]] TrackFix trackFixFromNmea(const integrity::NmeaFix& fix, const std::string& source, const NmeaPlRisk& risk = {});
 
-/// \brief The PLs of an INS uncertainty (seed 000 nominal-INS hypothesis; see the file comment).
+/// \brief The PLs of an INS uncertainty (the three-hypothesis INS PL's nominal hypothesis, docs/method.md Eq. (7.3); see the file comment).
 [[nodiscard]] std::pair<double, double> insNominalPl(const InsUncertainty& ins);
 
 }  // namespace skylane::planner

@@ -55,7 +55,7 @@ std::optional<integrity::ins::NavigatorEpoch> TrackedFlight::deeperEpoch(const i
   const int max_exclusions = deeper->config().max_exclusions;
   deeper->setMaxExclusions(max_exclusions + 1);
   integrity::ins::NavigatorEpoch ep = runInsEpoch(*deeper, fix);
-  if (!ep.seed001_available) return std::nullopt;
+  if (!ep.fault_mode_available) return std::nullopt;
   deeper->setMaxExclusions(max_exclusions);
   nav = std::move(deeper);
   return ep;

@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief Live corridor tracking (`skylane track`; DESIGN.md question 3): every fix of every
+/// \brief Live corridor tracking (`skylane track`; docs/method.md §7.2): every fix of every
 /// approved flight, with its live protection volume, is checked against its corridor (level 1),
 /// its airspace (level 2), the active zones and the obstacles; a level-1 violation reruns the
 /// integrity monitoring (FDE over the raw pseudoranges, when the fix has them); a persistent
@@ -11,10 +11,10 @@
 ///    than `max_time_jump_s` from it, is rejected (`rejected_input`), as is an unknown flight;
 ///    after a jump, `jump_confirm` fixes in order on the new timeline make it the flight's.
 /// 2. Protection levels: raw pseudoranges with IMU increments, once the filter is aligned →
-///    seed 001's GNSS/INS flow (its FDE, filter and fault-mode PLs; track_fix.hpp); raw
+///    the fault-mode GNSS/INS flow (its FDE, filter and fault-mode PLs; track_fix.hpp); raw
 ///    pseudoranges → skylane's own position and PLs with the mission's method, first pass
 ///    detection only (integrity/raim/live_fix.hpp); else the onboard (or NMEA GST) PLs; an INS
-///    σ block raises them to seed 000's nominal-INS PL when that is larger.
+///    σ block raises them to the three-hypothesis nominal-INS PL when that is larger.
 /// 3. The fence check of the volume at the fix time (geofence::checkVolume).
 /// 4. Level 1 not inside and raw pseudoranges → **monitoring rerun**: FDE, the PLs of the
 ///    remaining geometry, the check again; the fix's verdict is the rerun's. GNSS/INS: after a

@@ -357,10 +357,10 @@ TEST(Cli, FenceCheckRefusesABadCorridorFileWithExitTwo) {
 TEST(Cli, SimulateWritesTheEpochsCurvesAndStanfordDiagrams) {
   const std::string out = test::scratchPath("sim_out");
   const RunResult r = run("simulate " + std::string(SKYLANE_TEST_DATA) +
-                          "/../../examples/simulate/seed001_sat_20sigma.json --out " + out);
+                          "/../../examples/simulate/gnss_ins_sat_20sigma.json --out " + out);
   ASSERT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("752 s of flight, 751 GNSS epochs"), std::string::npos) << r.out;
-  for (const char* m : {"seed001", "seed000", "raim", "araim"}) {
+  for (const char* m : {"fault_mode", "three_hypothesis_ins", "raim", "araim"}) {
     EXPECT_NE(r.out.find(std::string("  ") + m), std::string::npos) << m;
   }
   EXPECT_EQ(r.out.find("NOT bounded"), std::string::npos) << r.out;

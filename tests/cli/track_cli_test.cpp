@@ -309,7 +309,7 @@ TEST_F(TrackCli, FlyWritesFixesThatTrackReadsAndBadOptionsExitTwo) {
   std::ifstream svg(*dir_ + "/fly.svg");
   const std::string map((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
   EXPECT_NE(map.find("excluded G20"), std::string::npos);  // the map marks the exclusion
-  // THEN every fix is accepted, from the first aligned on seed 001's GNSS/INS flow
+  // THEN every fix is accepted, from the first aligned on the fault-mode GNSS/INS flow
   const auto ev = readEvents(*dir_ + "/fly_events.jsonl");
   const auto fx = ofType(ev, "fix");
   EXPECT_TRUE(ofType(ev, "rejected_input").empty());

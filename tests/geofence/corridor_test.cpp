@@ -20,7 +20,7 @@ constexpr double kPi = 3.141592653589793;
 // --- alert limits ------------------------------------------------------------------------------
 
 TEST(BoxLevels, AlertLimitsScaleTheMappedDimensions) {
-  // GIVEN a 1.0 m span, 0.8 m long, 0.3 m high vehicle with seed 000's mapping
+  // GIVEN a 1.0 m span, 0.8 m long, 0.3 m high vehicle with the patent's mapping
   const Vehicle v{1.0, 0.8, 0.3};
   const LevelLimits l = alertLimits(v, BoxLevels{});
   // THEN HAL = k·lateral and VAL = k·longitudinal at k₁ = 1.2 and k₂ = 300
@@ -35,12 +35,12 @@ TEST(BoxLevels, AlertLimitsScaleTheMappedDimensions) {
   EXPECT_DOUBLE_EQ(alertLimits(v, by_height).level1.val_m, 1.2 * 0.3);
 }
 
-TEST(BoxLevels, FactorsOutsideTheSeedRangesNeedAnOverride) {
+TEST(BoxLevels, FactorsOutsideTheirRangesNeedAnOverride) {
   const Vehicle v{1.0, 0.8, 0.3};
   BoxLevels wide;
   wide.k1 = 1.5;
   const std::string msg = test::messageOf<std::invalid_argument>([&] { (void)alertLimits(v, wide); });
-  EXPECT_NE(msg.find("k1 = 1.5 is outside seed 000's range [1.1, 1.3]"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("k1 = 1.5 is outside the box levels' range [1.1, 1.3]"), std::string::npos) << msg;
   wide.override_ranges = true;
   const LevelLimits l = alertLimits(v, wide);
   EXPECT_DOUBLE_EQ(l.level1.hal_m, 1.5);

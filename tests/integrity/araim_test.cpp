@@ -1,4 +1,4 @@
-// ARAIM MHSS against the published worked examples and the properties seed 003 and the ADD
+// ARAIM MHSS against the published worked examples and the properties CN 110687557 A and the ADD
 // promise. Example geometry: Blanch et al., ION GNSS 2012, Appendix J = WG-C ARAIM ADD v3.0,
 // Appendix D (5 GPS + 5 Galileo satellites, C_int/C_acc as printed there).
 #include "integrity/araim/fde.hpp"
@@ -145,7 +145,7 @@ TEST(AraimPl, SolvedLevelSatisfiesTheRiskEquationAndBeatsEqualAllocation) {
     const AraimResult r = araimProtectionLevels(g, m, cfg);
     if (!r.pl_computed) continue;
     ++computed;
-    // Optimised (seed 003) ≤ equal allocation.
+    // Optimised (CN 110687557 A) ≤ equal allocation.
     EXPECT_LE(r.vpl_m, r.vpl_equal_allocation_m + 1e-9);
     EXPECT_LE(r.hpl_m, r.hpl_equal_allocation_m + 1e-9);
     // The risk equation: at VPL the risk is within budget, TOL_PL lower it is not.

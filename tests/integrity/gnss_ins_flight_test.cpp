@@ -1,4 +1,4 @@
-// Whole simulated flights through the GNSS/INS navigator: seed 001's experiments (Zhao & Song
+// Whole simulated flights through the GNSS/INS navigator: the fault-mode experiments (Zhao & Song
 // 2024, §4.2), fault injection, outages, reproducibility and a small Monte Carlo. The truth is
 // the simulator's; every number asserted is measured against it.
 #include "integrity/sim/run.hpp"
@@ -17,7 +17,7 @@ std::string examplePath(const std::string& name) {
 }
 
 const OrbitSource& orbits() {
-  static const OrbitSource o = loadOrbits(loadScenario(examplePath("seed001_no_fault.json")));
+  static const OrbitSource o = loadOrbits(loadScenario(examplePath("gnss_ins_no_fault.json")));
   return o;
 }
 
@@ -59,10 +59,10 @@ double meanAbsUp(const RunResult& run, double t0, double t1) {
   return n ? sum / n : NAN;
 }
 
-// Seed 001 Fig. 6: the survey flight without faults; every method's PL bounds the error.
+// Zhao & Song 2024 Fig. 6: the survey flight without faults; every method's PL bounds the error.
 TEST(GnssInsFlight, NoFaultSurveyIsBoundedByEveryMethod) {
-  const Flight f = fly("seed001_no_fault.json");
-  EXPECT_GE(f.run.duration_s, 750.0);  // seed 001's 750 s survey
+  const Flight f = fly("gnss_ins_no_fault.json");
+  EXPECT_GE(f.run.duration_s, 750.0);  // Zhao & Song's 750 s survey
   ASSERT_GE(f.run.epochs.size(), 740u);
   for (int m = 0; m < kNumMethods; ++m) expectBounded(f.run, static_cast<Method>(m));
   // Accuracy of the filter: dual-frequency pseudoranges, consumer IMU, baro and heading aiding.
@@ -80,24 +80,24 @@ TEST(GnssInsFlight, NoFaultSurveyIsBoundedByEveryMethod) {
   }
 }
 
-// Seed 001 Fig. 7: 20×10⁻⁴ g on the vertical accelerometer, 200–250 s. The paper's detector
+// Zhao & Song 2024 Fig. 7: 20×10⁻⁴ g on the vertical accelerometer, 200–250 s. The paper's detector
 // does not see it; the vertical error grows while it acts and the PL still bounds it.
 TEST(GnssInsFlight, VerticalAccelerometerFaultRaisesTheErrorAndStaysBounded) {
-  const Flight clean = fly("seed001_no_fault.json");
-  const Flight faulty = fly("seed001_accel_fault.json");
+  const Flight clean = fly("gnss_ins_no_fault.json");
+  const Flight faulty = fly("gnss_ins_accel_fault.json");
   ASSERT_EQ(faulty.scenario.faults.size(), 1u);
   EXPECT_NEAR(faulty.scenario.faults[0].magnitude, 20e-4 * 9.80665, 1e-12);
   EXPECT_GT(meanAbsUp(faulty.run, 205, 250), meanAbsUp(clean.run, 205, 250) + 0.15);
   EXPECT_NEAR(meanAbsUp(faulty.run, 100, 190), meanAbsUp(clean.run, 100, 190), 1e-9);  // same draws before
-  expectBounded(faulty.run, Method::kSeed001);
-  expectBounded(faulty.run, Method::kSeed000);
+  expectBounded(faulty.run, Method::kFaultMode);
+  expectBounded(faulty.run, Method::kThreeHypothesisIns);
   for (const EpochRecord& e : faulty.run.epochs) EXPECT_FALSE(e.imu_fault_detected) << e.t_s;
 }
 
-// Seed 001 Fig. 9: 20σ₀ on G19, 200–250 s: the LSR test detects and excludes it at every
+// Zhao & Song 2024 Fig. 9: 20σ₀ on G19, 200–250 s: the LSR test detects and excludes it at every
 // epoch, so the fault never reaches the filter.
 TEST(GnssInsFlight, TwentySigmaSatelliteFaultIsExcludedBeforeFusion) {
-  const Flight f = fly("seed001_sat_20sigma.json");
+  const Flight f = fly("gnss_ins_sat_20sigma.json");
   const SatId g19{Constellation::kGps, 19};
   int fault_epochs = 0, excluded = 0, false_exclusions = 0;
   for (const EpochRecord& e : f.run.epochs) {
@@ -113,13 +113,13 @@ TEST(GnssInsFlight, TwentySigmaSatelliteFaultIsExcludedBeforeFusion) {
   EXPECT_EQ(fault_epochs, 50);
   EXPECT_EQ(excluded, fault_epochs);
   EXPECT_LE(false_exclusions, 2);
-  expectBounded(f.run, Method::kSeed001);
+  expectBounded(f.run, Method::kFaultMode);
   expectBounded(f.run, Method::kRaim);
 }
 
-// Seed 001 Fig. 12: accelerometer 200–250 s, G19 10σ₀ 500–550 s; the final PL bounds both.
+// Zhao & Song 2024 Fig. 12: accelerometer 200–250 s, G19 10σ₀ 500–550 s; the final PL bounds both.
 TEST(GnssInsFlight, CombinedFaultsAreBoundedByTheFinalProtectionLevel) {
-  const Flight f = fly("seed001_combined.json");
+  const Flight f = fly("gnss_ins_combined.json");
   int sat = 0, imu = 0;
   for (const EpochRecord& e : f.run.epochs) {
     sat += e.satellite_fault_active ? 1 : 0;
@@ -139,13 +139,13 @@ TEST(GnssInsFlight, LargeGyroFaultIsDetectedAndTheSystemDegradesToGnss) {
   gyro.t_start_s = 200;
   gyro.t_end_s = 260;
   gyro.magnitude = 0.05;  // rad/s, 100× the consumer bias σ
-  const Flight f = fly("seed001_no_fault.json", {gyro}, true);
+  const Flight f = fly("gnss_ins_no_fault.json", {gyro}, true);
   double first_detection = -1, last_degraded = -1;
   for (const EpochRecord& e : f.run.epochs) {
     if (e.imu_fault_detected && first_detection < 0) first_detection = e.t_s;
     if (e.degraded) {
       last_degraded = e.t_s;
-      const MethodSample& s = of(e, Method::kSeed001);
+      const MethodSample& s = of(e, Method::kFaultMode);
       const MethodSample& r = of(e, Method::kRaim);
       EXPECT_EQ(s.hpl_m, r.hpl_m);
       EXPECT_EQ(s.hpe_m, r.hpe_m);
@@ -157,17 +157,17 @@ TEST(GnssInsFlight, LargeGyroFaultIsDetectedAndTheSystemDegradesToGnss) {
   // to re-converge), then `recover_s` more; back to the integrated solution before the end.
   EXPECT_GT(last_degraded, 260.0);
   EXPECT_FALSE(f.run.epochs.back().degraded);
-  expectBounded(f.run, Method::kSeed001);
+  expectBounded(f.run, Method::kFaultMode);
 }
 
-// Seed 002: dead reckoning through a GNSS outage; no integrity is claimed there.
+// Dead reckoning (docs/method.md §5.1; Electronics and Control Systems 2012) through a GNSS outage; no integrity is claimed there.
 TEST(GnssInsFlight, OutageIsBridgedByDeadReckoningAndReportedUnavailable) {
   FaultSpec outage;
   outage.target = FaultTarget::kGnssOutage;
   outage.t_start_s = 300;
   outage.t_end_s = 330;
   outage.magnitude = 1;
-  const Flight f = fly("seed001_no_fault.json", {outage}, true);
+  const Flight f = fly("gnss_ins_no_fault.json", {outage}, true);
   int outage_epochs = 0;
   double error_at_end = 0;
   for (const EpochRecord& e : f.run.epochs) {
@@ -175,7 +175,7 @@ TEST(GnssInsFlight, OutageIsBridgedByDeadReckoningAndReportedUnavailable) {
       ++outage_epochs;
       EXPECT_TRUE(e.outage);
       EXPECT_EQ(e.visible, 0);
-      EXPECT_FALSE(of(e, Method::kSeed001).available);
+      EXPECT_FALSE(of(e, Method::kFaultMode).available);
       error_at_end = e.error_enu_m.norm();
     }
     if (e.t_s >= 360) {
@@ -184,11 +184,11 @@ TEST(GnssInsFlight, OutageIsBridgedByDeadReckoningAndReportedUnavailable) {
   }
   EXPECT_EQ(outage_epochs, 30);
   EXPECT_LT(error_at_end, 50.0);  // 30 s of consumer-grade dead reckoning with baro and heading
-  expectBounded(f.run, Method::kSeed001);
+  expectBounded(f.run, Method::kFaultMode);
 }
 
 TEST(GnssInsFlight, SameSeedSameFlightOtherSeedOtherNoise) {
-  const Scenario s = loadScenario(examplePath("seed001_sat_10sigma.json"));
+  const Scenario s = loadScenario(examplePath("gnss_ins_sat_10sigma.json"));
   const RunResult a = runScenario(s, orbits(), 7);
   const RunResult b = runScenario(s, orbits(), 7);
   const RunResult c = runScenario(s, orbits(), 8);
@@ -203,16 +203,16 @@ TEST(GnssInsFlight, SameSeedSameFlightOtherSeedOtherNoise) {
 }
 
 // A small Monte Carlo (the full ≥ 10⁶-epoch run is `skylane simulate --monte-carlo`, see the
-// README): random geometry, flight and injected faults; seed 001's PL is never exceeded.
-TEST(GnssInsFlight, MonteCarloBatchHasNoMisleadingSeed001Epoch) {
-  const Scenario base = loadScenario(examplePath("seed001_no_fault.json"));
+// README): random geometry, flight and injected faults; the fault-mode PL is never exceeded.
+TEST(GnssInsFlight, MonteCarloBatchHasNoMisleadingFaultModeEpoch) {
+  const Scenario base = loadScenario(examplePath("gnss_ins_no_fault.json"));
   std::uint64_t last = 0;
   const MonteCarloResult r = monteCarlo(base, orbits(), 24, 2, [&last](std::uint64_t d, std::uint64_t) { last = std::max(last, d); });
   EXPECT_EQ(r.runs, 24u);
   EXPECT_EQ(last, 24u);
   EXPECT_GT(r.epochs, 5000u);
   EXPECT_GT(r.faulted_epochs, 500u);
-  const MethodStats& s = r.methods[static_cast<int>(Method::kSeed001)];
+  const MethodStats& s = r.methods[static_cast<int>(Method::kFaultMode)];
   EXPECT_EQ(s.horizontal.misleading, 0u);
   EXPECT_EQ(s.vertical.misleading, 0u);
   for (const MethodStats& m : r.methods) {

@@ -15,7 +15,7 @@
 namespace skylane::integrity {
 namespace {
 
-// --- Risk allocation (seed 001: J. Zhao & D. Song, Acta Aeronautica et Astronautica Sinica 45(7), 2024) ---
+// --- Risk allocation (J. Zhao & D. Song, Acta Aeronautica et Astronautica Sinica 45(7), 2024) ---
 
 /// Half a unit in the 5th significant digit of `printed`: the paper prints five digits.
 double halfUnitOf5Digits(double printed) {
@@ -37,7 +37,7 @@ double multiPrior(int n, double p) {
   return sum;
 }
 
-constexpr int kSats = 10;  // seed 001's example: K = 10 satellites in view
+constexpr int kSats = 10;  // Zhao & Song's example: K = 10 satellites in view
 /// Relative tolerance for priors and budgets against an independent closed form (a few rounding
 /// errors of sums of ≤ 10 terms).
 constexpr double kRelTol = 1e-12;

@@ -26,7 +26,7 @@ const maps::Geodetic kZurich{maps::deg2rad(47.3769), maps::deg2rad(8.5417), 460.
 
 // --- Trajectory --------------------------------------------------------------------------------
 
-/// Length of seed 001's survey flown by skylane: `lines` lines of `len` joined by `lines − 1`
+/// Length of Zhao & Song's survey flown by skylane: `lines` lines of `len` joined by `lines − 1`
 /// cross legs of `spacing`, every one of the 2(lines − 1) right-angle corners rounded by an arc of
 /// radius r, which replaces two tangent lengths r·tan 45° of straight flight by r·π/2 of arc.
 double surveyLength(int lines, double len, double spacing, double r) {
@@ -45,9 +45,9 @@ TEST(SimTrajectory, SurveyDurationIsTheFilletedLengthOverTheSpeed) {
   EXPECT_TRUE(test::nearVec(t.at(t.duration_s()).p_enu_m, Eigen::Vector3d(600.0, 1000.0, 60.0), 1e-6));
 }
 
-// Seed 001's survey spans 0–750 s in its figures: the bundled example flies 7 lines of 1010 m,
+// Zhao & Song's survey spans 0–750 s in their figures: the bundled example flies 7 lines of 1010 m,
 // 100 m apart, at 10 m/s with 30 m turns, which lasts ≥ 750 s (7 lines of 1000 m: 744.5 s).
-TEST(SimTrajectory, SeedSurveyLastsAtLeastThePapersPlottedSpan) {
+TEST(SimTrajectory, SurveyLastsAtLeastThePapersPlottedSpan) {
   const Trajectory t(kZurich, lawnmower(7, 1010.0, 100.0, 60.0, 10.0, 0.0), 30.0);
   EXPECT_GE(t.duration_s(), 750.0);
 }
@@ -221,7 +221,7 @@ TEST(SimFaultSpec, StepHoldsInsideTheWindowAndRampGrows) {
   EXPECT_NEAR(ramp.valueAt(230.0) - ramp.valueAt(220.0), ramp.valueAt(220.0) - ramp.valueAt(210.0), 1e-12);
 }
 
-TEST(SimImuSpec, TurnOnBiasesAreSeed000Table1) {
+TEST(SimImuSpec, TurnOnBiasesAreTheImuGradeTable) {
   const ImuSpec av = imuSpec(ImuGrade::kAviation);
   EXPECT_DOUBLE_EQ(av.accel_bias_mps2, 3e-4);
   EXPECT_DOUBLE_EQ(av.gyro_bias_radps, 5e-8);
@@ -383,7 +383,7 @@ TEST(SimScenario, ValidLawnmowerScenarioParses) {
   const FaultSpec& acc = s.faults[1];
   EXPECT_EQ(acc.target, FaultTarget::kAccelerometer);
   EXPECT_EQ(acc.axis, 2);
-  EXPECT_NEAR(acc.magnitude, 20e-4 * kG_mps2, 1e-15);  // seed 001: 20 × 10⁻⁴ g
+  EXPECT_NEAR(acc.magnitude, 20e-4 * kG_mps2, 1e-15);  // Zhao & Song 2024: 20 × 10⁻⁴ g
   const FaultSpec& gyro = s.faults[2];
   EXPECT_EQ(gyro.target, FaultTarget::kGyro);
   EXPECT_EQ(gyro.axis, 0);
@@ -404,9 +404,9 @@ TEST(SimScenario, ValidLawnmowerScenarioParses) {
   EXPECT_EQ(s.sensors.imu.accel_bias_mps2, 1e-2);
   EXPECT_EQ(e.baro_noise_m, s.sensors.baro_noise_m);
   EXPECT_EQ(e.heading_noise_rad, s.sensors.heading_noise_rad);
-  EXPECT_DOUBLE_EQ(s.navigator.seed000.lambda, 5.0 / 12.0);  // seed 000: tactical λ
-  EXPECT_DOUBLE_EQ(s.navigator.seed000.phmi_h, 5e-8);
-  EXPECT_DOUBLE_EQ(s.navigator.seed000.phmi_v, 5e-8);
+  EXPECT_DOUBLE_EQ(s.navigator.three_hypothesis_ins.lambda, 5.0 / 12.0);  // US 10,466,362: tactical λ
+  EXPECT_DOUBLE_EQ(s.navigator.three_hypothesis_ins.phmi_h, 5e-8);
+  EXPECT_DOUBLE_EQ(s.navigator.three_hypothesis_ins.phmi_v, 5e-8);
   EXPECT_NEAR(s.navigator.elevation_mask_rad, maps::deg2rad(5.0), 1e-15);
 
   // The same scenario with the consumer grade: the filter follows.
@@ -414,7 +414,7 @@ TEST(SimScenario, ValidLawnmowerScenarioParses) {
   consumer["imu"]["grade"] = "consumer";
   const Scenario c = parseScenario(consumer, "test.json", ".");
   EXPECT_EQ(c.navigator.ekf.accel_bias_mps2, 3e-2);
-  EXPECT_DOUBLE_EQ(c.navigator.seed000.lambda, 9.0 / 12.0);
+  EXPECT_DOUBLE_EQ(c.navigator.three_hypothesis_ins.lambda, 9.0 / 12.0);
 }
 
 TEST(SimScenario, ErrorsNameTheFieldAndWhatWasExpected) {

@@ -320,7 +320,7 @@ TEST_F(TrackerOnExample, PlSourceSaysWhereThePlsCameFrom) {
   const json fix = tracker.processJson(f).back();
   EXPECT_EQ(fix.at("pl_source"), "onboard");
   EXPECT_NE(fix.at("note").get<std::string>().find("raw pseudoranges gave no PL"), std::string::npos);
-  // An INS block alone: seed 000's nominal-INS PLs.
+  // An INS block alone: the three-hypothesis nominal-INS PLs.
   TrackFix g = fixAt(a, r.departure.plus(2), along(r, 2), 0.5, 0.5, 2);
   g.hpl_m.reset();
   g.vpl_m.reset();
@@ -599,9 +599,9 @@ TEST(TrackerRaw, SatelliteFaultIsExcludedByTheRerunAndTheFlightRecoversWithoutAR
   EXPECT_TRUE(ofType(all, "violation").empty());
 }
 
-// --- GNSS/INS: IMU increments with the pseudoranges (seed 001's flow) --------------------------
+// --- GNSS/INS: IMU increments with the pseudoranges (the fault-mode flow) --------------------------
 
-/// A UAV whose corridor (HAL₁ = 48 m) holds seed 001's fault-mode PLs (≈ 15 m, ≈ 25 m with a
+/// A UAV whose corridor (HAL₁ = 48 m) holds the fault-mode PLs (≈ 15 m, ≈ 25 m with a
 /// satellite excluded) and the simulator's corner cutting (30 m turn radius).
 Approved largeUav() {
   Approved a = approveMission(exampleMission([](json& doc) {
@@ -669,7 +669,7 @@ std::vector<json> allEvents(const std::vector<TrackedFix>& replay) {
   return out;
 }
 
-TEST(TrackerGnssIns, FixesWithImuIncrementsUseSeed001sFlowAndItsPlsBoundTheError) {
+TEST(TrackerGnssIns, FixesWithImuIncrementsUseTheFaultModeFlowAndItsPlsBoundTheError) {
   // GIVEN the large UAV flown by the simulator with a tactical IMU, barometer and magnetometer
   const Approved a = largeUav();
   const std::vector<TrackedFix> replay = trackGnssIns(a, {}, 21);
@@ -781,7 +781,7 @@ TEST(TrackerGnssIns, AnAccelerometerFaultDegradesToGnssAloneAndTheErrorStaysBoun
     ++fixes;
     if (fix.value("ins_degraded", false)) {
       ++degraded;
-      // THEN the IMU innovation test sends the flow to GNSS alone (seed 001 class 1)
+      // THEN the IMU innovation test sends the flow to GNSS alone (fault-mode class 1)
       EXPECT_GE(sf.t_s, 60.0);
     }
     bounded += plsBound(fix, sf.truth);
@@ -983,7 +983,7 @@ TEST(TrackFixJson, ErrorsNameTheFieldAndWhatWasExpected) {
   EXPECT_DOUBLE_EQ(*ok.hpl_m, 1.5);
 }
 
-TEST(TrackFixJson, InsBlockGivesSeed000NominalPl) {
+TEST(TrackFixJson, InsBlockGivesTheNominalInsPl) {
   // Consumer grade: λ = 9/12, P_nom = 0.5e-7 / 3: K = Q⁻¹(1.25e-8) = 5.5738 (normal table).
   const auto [h, v] = insNominalPl({2, 0.3, 0.4, 1.0});
   EXPECT_NEAR(h, 5.5738 * 0.5, 1e-3);
