@@ -45,7 +45,7 @@ seed() {  # target corpus-dir
     geometry) cp "$root"/fuzz/corpus/geometry/* "$c"/ ;;
     text_fields) cp "$root"/fuzz/corpus/text_fields/* "$c"/ ;;
     zones) cp "$data"/geozones/*.json "$data"/geozones/*.geojson "$data"/geozones/*.plan "$c"/ ;;
-    buildings) cp "$root"/fuzz/corpus/buildings/* "$root"/examples/skymask/*.geojson "$c"/ ;;
+    buildings) cp "$root"/examples/skymask/*.geojson "$c"/ ;;
     fence) cp "$root"/fuzz/corpus/fence/* "$c"/ ;;
     scenario) cp "$root"/fuzz/corpus/scenario/* "$c"/ ;;
     nmea) cp "$root"/fuzz/corpus/nmea/* "$c"/ ;;

@@ -43,7 +43,11 @@ def json_values(path, renames):
     try:
         return [normalise(json.loads(text), renames)]
     except json.JSONDecodeError:
+        pass
+    try:
         return [normalise(json.loads(l), renames) for l in text.splitlines() if l.strip()]
+    except json.JSONDecodeError:  # not JSON after all (e.g. a log with a .json name): as text
+        return text_lines(path, renames)
 
 
 def text_lines(path, renames):
@@ -65,6 +69,8 @@ def files(root):
 def main():
     base, new = sys.argv[1], sys.argv[2]
     renames = load_renames(sys.argv[3] if len(sys.argv) > 3 else None)
+    # Each run's output folder appears in its outputs (sources, messages): the same placeholder.
+    renames = {**{os.path.abspath(base): "<OUT>", base: "<OUT>", os.path.abspath(new): "<OUT>", new: "<OUT>"}, **renames}
     base_files, new_files = files(base), files(new)
     problems = [f"only in the base: {f}" for f in sorted(base_files - new_files)]
     problems += [f"only in the new: {f}" for f in sorted(new_files - base_files)]
