@@ -5,9 +5,15 @@
 # Carlo proofs run in the plain build only (they are statistics, not memory checks, and take
 # many times longer instrumented). Any sanitizer report fails the test that made it.
 # Usage: scripts/sanitize.sh   (after scripts/setup.sh has installed the packages)
+# -O1 without -g: sanitizer reports keep function names, and ccache can reuse the objects of a
+# checkout in another folder (with -g it hashes the build folder). Hidden visibility: at -O1 the
+# executables emit Eigen template instances that OMPL's shared library would otherwise bind to
+# (ELF interposition), so OMPL freed with its own Eigen code memory our copy had allocated — ASan
+# reported a bad free in every planning test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSKYLANE_SANITIZE=ON -DSKYLANE_WERROR=ON \
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" -DSKYLANE_SANITIZE=ON -DSKYLANE_WERROR=ON \
+  -DCMAKE_CXX_VISIBILITY_PRESET=hidden -DCMAKE_VISIBILITY_INLINES_HIDDEN=ON \
   -DSKYLANE_BUILD_TESTS=ON -DSKYLANE_BUILD_BENCH=OFF -DSKYLANE_FUZZ_REPLAY=ON
 cmake --build build-asan -j "$(nproc)"
 # halt_on_error: a UBSan report is a failure, not a line in a log; leaks are reported at exit.
