@@ -1,11 +1,14 @@
 #include "cli/fence_commands.hpp"
 
+#include "geofence/verdict_json.hpp"
+
 #include "airspace/validation.hpp"
 #include "cli/json_numbers.hpp"
 #include "cli/skymask_commands.hpp"
 #include "geofence/corridor_file.hpp"
 #include "geofence/fix.hpp"
 #include "geofence/obstruction_files.hpp"
+#include "geofence/verdict_json.hpp"
 #include "maps/geoid.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
@@ -118,35 +121,21 @@ void runFenceCheck(const FenceCheckOptions& o) {
 }  // namespace
 
 json fenceVerdictJson(const geofence::FenceVerdict& v, const geofence::Fence& fence) {
-  json out;
-  out["verdict"] = geofence::verdictName(v.verdict);
-  out["violated"] = v.violated ? json(geofence::levelName(*v.violated)) : json(nullptr);
-  json checks = json::array();
-  for (const geofence::Check& c : v.checks) {
-    json j;
-    j["level"] = geofence::levelName(c.level);
-    j["verdict"] = geofence::verdictName(c.verdict);
-    j["subject"] = c.subject;
-    j["margin_h_m"] = metresOrNull(c.margin_h_m);
-    j["margin_v_m"] = metresOrNull(c.margin_v_m);
-    if (c.level == geofence::Level::kCorridor || c.level == geofence::Level::kAirspace) {
+  json out = v;  // the one form (geofence/verdict_json.hpp), with what the fence knows of each check
+  for (std::size_t i = 0; i < v.checks.size(); ++i) {
+    const geofence::Check& c = v.checks[i];
+    json& j = out["checks"][i];
+    if (geofence::isBoxLevel(c)) {
       const geofence::AlertLimits& l = (c.level == geofence::Level::kCorridor ? fence.level1() : fence.level2()).limits();
       j["hal_m"] = metresOrNull(l.hal_m);
       j["val_m"] = metresOrNull(l.val_m);
-      j["across_joint"] = c.across_joint;
-    } else {
-      j["clearance_m"] = metresOrNull(*c.clearance_m);
-      j["exact"] = c.exact;
-      if (c.level == geofence::Level::kZone) {
-        const airspace::Zone& z = fence.zones()[c.index];
-        j["name"] = z.name;
-        j["restriction"] = std::string(airspace::restrictionName(z.restriction));
-        j["file"] = z.source;
-      }
+    } else if (c.level == geofence::Level::kZone) {
+      const airspace::Zone& z = fence.zones()[c.index];
+      j["name"] = z.name;
+      j["restriction"] = std::string(airspace::restrictionName(z.restriction));
+      j["file"] = z.source;
     }
-    checks.push_back(j);
   }
-  out["checks"] = checks;
   return out;
 }
 

@@ -1,5 +1,6 @@
 #include "planner/report_formats.hpp"
 
+#include "geofence/verdict_json.hpp"
 #include "maps/file_digest.hpp"
 #include "maps/json_node.hpp"
 #include "maps/json_numbers.hpp"
@@ -65,10 +66,8 @@ json predictedSampleJson(const PredictedSample& s, const ApprovalReport& r) {
          {"hal2_m", roundToMm(r.limits.level2.hal_m)},
          {"val2_m", roundToMm(r.limits.level2.val_m)}};
   for (const geofence::Check& c : s.fence.checks) {
-    if (c.level == geofence::Level::kAirspace) {
-      p["margin_h_m"] = roundToMm(c.margin_h_m);
-      p["margin_v_m"] = roundToMm(c.margin_v_m);
-    }
+    // The sample shows the level-2 check's margins (geofence/verdict_json.hpp's form).
+    if (c.level == geofence::Level::kAirspace) p.update(geofence::pickMembers(json(c), {"margin_h_m", "margin_v_m"}));
   }
   return p;
 }

@@ -1,5 +1,6 @@
 #include "planner/tracking/fix_steps.hpp"
 
+#include "geofence/verdict_json.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/json_numbers.hpp"
 #include "planner/tracking/tracker.hpp"
@@ -329,10 +330,7 @@ TrackEvent violationEvent(const TrackedFlight& f, const FixWork& w, geofence::Le
   e["verdict"] = geofence::verdictName(v);
   for (const geofence::Check& c : w.verdict.checks) {
     if (c.level != level || c.verdict == geofence::Verdict::kInside) continue;
-    e["subject"] = c.subject;
-    e["margin_h_m"] = metresOrNull(c.margin_h_m);
-    e["margin_v_m"] = metresOrNull(c.margin_v_m);
-    if (c.clearance_m) e["clearance_m"] = metresOrNull(*c.clearance_m);
+    e.body.update(geofence::pickMembers(json(c), {"subject", "margin_h_m", "margin_v_m", "clearance_m"}));
     break;
   }
   if (level == geofence::Level::kCorridor) {

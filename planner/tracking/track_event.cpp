@@ -1,5 +1,6 @@
 #include "planner/tracking/track_event.hpp"
 
+#include "geofence/verdict_json.hpp"
 #include "maps/json_numbers.hpp"
 
 #include <algorithm>
@@ -13,14 +14,7 @@ using nlohmann::json;
 using maps::metresOrNull;
 using maps::roundToDeg8;
 using maps::roundToMm;
-
-namespace {
-
-bool isBoxLevel(const geofence::Check& c) {
-  return c.level == geofence::Level::kCorridor || c.level == geofence::Level::kAirspace;
-}
-
-}  // namespace
+using geofence::isBoxLevel;
 
 TrackEvent trackEvent(const char* type, const std::string& flight, const maps::GpsTime& t) {
   TrackEvent e;
@@ -50,16 +44,11 @@ void to_json(json& j, const FixRecord& f) {
   json levels = json::object();
   json near = json::array();
   for (const geofence::Check& c : f.verdict.checks) {
+    const json check = c;  // the one form (geofence/verdict_json.hpp); the fix event shows a part
     if (isBoxLevel(c)) {
-      levels[geofence::levelName(c.level)] = {{"verdict", geofence::verdictName(c.verdict)},
-                                             {"margin_h_m", metresOrNull(c.margin_h_m)},
-                                             {"margin_v_m", metresOrNull(c.margin_v_m)},
-                                             {"segment", c.index}};
+      levels[geofence::levelName(c.level)] = geofence::pickMembers(check, {"verdict", "margin_h_m", "margin_v_m", "segment"});
     } else {
-      near.push_back({{"level", geofence::levelName(c.level)},
-                      {"subject", c.subject},
-                      {"verdict", geofence::verdictName(c.verdict)},
-                      {"clearance_m", metresOrNull(c.clearance_m.value_or(0.0))}});
+      near.push_back(geofence::pickMembers(check, {"level", "subject", "verdict", "clearance_m"}));
     }
   }
   j["levels"] = levels;
@@ -218,7 +207,11 @@ void writeNear(LineWriter& w, const FixRecord& f) {
     w.item();
     w.open('{');
     w.key("clearance_m");
-    w.metres(c.clearance_m.value_or(0.0));
+    if (c.clearance_m) {
+      w.metres(*c.clearance_m);
+    } else {
+      w.null();
+    }
     w.key("level");
     w.string(geofence::levelName(c.level));
     w.key("subject");
