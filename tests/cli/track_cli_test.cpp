@@ -218,7 +218,10 @@ TEST_F(TrackCli, SigtermSavesTheStateAndExitsCleanly) {
   }
   const RunResult r = sh("mkfifo " + fifo + "; (cat " + all + "; sleep 5) > " + fifo + " & " + kBin + " track --approval " +
                          approval() + " --input " + fifo + " --db " + db + " --no-replan > " + *dir_ +
-                         "/term_events.jsonl 2> " + *dir_ + "/term_err.txt & pid=$!; sleep 1; kill -TERM $pid; wait $pid; echo status=$?");
+                         "/term_events.jsonl 2> " + *dir_ + "/term_err.txt & pid=$!; " +
+                         // the signal once the 30 fixes are out (the quiet FIFO flushes them), however slow the build
+                         "for i in $(seq 600); do [ \"$(grep -c '\"event\":\"fix\"' " + *dir_ +
+                         "/term_events.jsonl)\" -ge 30 ] && break; sleep 0.1; done; kill -TERM $pid; wait $pid; echo status=$?");
   EXPECT_NE(r.out.find("status=0"), std::string::npos) << r.out;
   EXPECT_EQ(ofType(readEvents(*dir_ + "/term_events.jsonl"), "fix").size(), 30u);
   std::ifstream err(*dir_ + "/term_err.txt");
