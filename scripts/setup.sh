@@ -4,7 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-PACKAGES=(g++ cmake make ccache pkg-config universal-ctags
+PACKAGES=(g++ cmake make ccache pkg-config universal-ctags python3
   libeigen3-dev libgeographiclib-dev libcli11-dev nlohmann-json3-dev libboost-dev
   libcgal-dev libgmp-dev libmpfr-dev libfcl-dev libgdal-dev proj-data
   libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev libode-dev libssl-dev libsqlite3-dev
