@@ -105,11 +105,7 @@ geofence::Verdict worstVerdict(const geofence::FenceVerdict& v, geofence::Level 
 }
 
 TrackEvent rejectedFix(const TrackFix& fix, const std::string& id, const std::string& why) {
-  TrackEvent e;
-  e.type = "rejected_input";
-  e["source"] = fix.source;
-  e["error"] = why;
-  if (fix.line > 0) e["line"] = fix.line;
+  TrackEvent e = rejectedInputEvent(fix.source, fix.line, why);
   e.flight = id;
   return e;
 }

@@ -24,6 +24,15 @@ TrackEvent trackEvent(const char* type, const std::string& flight, const maps::G
   return e;
 }
 
+TrackEvent rejectedInputEvent(const std::string& source, std::size_t line, const std::string& why) {
+  TrackEvent e;
+  e.type = "rejected_input";
+  e["source"] = source;
+  e["error"] = why;
+  if (line > 0) e["line"] = line;
+  return e;
+}
+
 void to_json(json& j, const FixRecord& f) {
   j["line"] = f.line;
   j["lat"] = roundToDeg8(f.lat_rad);

@@ -54,6 +54,9 @@ struct TrackEvent {
 /// \brief An event of `type` for `flight` at `t` with an empty body.
 [[nodiscard]] TrackEvent trackEvent(const char* type, const std::string& flight, const maps::GpsTime& t);
 
+/// \brief A `rejected_input` event: a record of `source` (line `line`, 0: none) that could not be taken, and why.
+[[nodiscard]] TrackEvent rejectedInputEvent(const std::string& source, std::size_t line, const std::string& why);
+
 /// \brief FixRecord's members as JSON (merged into the `fix` event's object).
 void to_json(nlohmann::json& j, const FixRecord& f);
 

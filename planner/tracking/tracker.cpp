@@ -142,12 +142,7 @@ void Tracker::restore(const std::string& id, const FlightState& state, const jso
 }
 
 TrackEvent Tracker::rejectedInput(const std::string& source, std::size_t line, const std::string& why) const {
-  TrackEvent e;
-  e.type = "rejected_input";
-  e["source"] = source;
-  e["error"] = why;
-  if (line > 0) e["line"] = line;
-  return e;
+  return rejectedInputEvent(source, line, why);
 }
 
 std::vector<json> Tracker::processJson(const TrackFix& fix) {
