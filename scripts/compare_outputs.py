@@ -57,6 +57,19 @@ def text_lines(path, renames):
     return lines
 
 
+def first_difference(a, b, path="$"):
+    """The JSON path of the first place where a and b differ, with both values there."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        for k in sorted(set(a) | set(b)):
+            if a.get(k, "<absent>") != b.get(k, "<absent>"):
+                return first_difference(a.get(k, "<absent>"), b.get(k, "<absent>"), f"{path}.{k}")
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        for i, (x, y) in enumerate(zip(a, b)):
+            if x != y:
+                return first_difference(x, y, f"{path}[{i}]")
+    return path, json.dumps(a)[:120], json.dumps(b)[:120]
+
+
 def files(root):
     out = set()
     for d, _, names in os.walk(root):
@@ -80,8 +93,13 @@ def main():
         read = json_values if json_like else text_lines
         vb, vn = read(b, renames), read(n, renames)
         if vb != vn:
-            first = next((i for i, (x, y) in enumerate(zip(vb, vn)) if x != y), min(len(vb), len(vn)))
-            problems.append(f"{rel}: differs from item/line {first + 1} ({len(vb)} vs {len(vn)})")
+            differing = [i for i, (x, y) in enumerate(zip(vb, vn)) if x != y]
+            first = differing[0] if differing else min(len(vb), len(vn))
+            where = ""
+            if differing:
+                path, x, y = first_difference(vb[first], vn[first])
+                where = f"; first at {path}: {x} vs {y}"
+            problems.append(f"{rel}: {len(differing)} item(s)/line(s) differ, from {first + 1} ({len(vb)} vs {len(vn)}){where}")
     for p in problems:
         print("compare_example:", p)
     print(f"compare_example: {len(base_files & new_files)} files compared, {len(problems)} difference(s)")

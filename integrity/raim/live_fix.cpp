@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 
 namespace skylane::integrity {
@@ -23,71 +24,80 @@ using Located = LocatedRange;
 /// The linearised problem at a converged point.
 struct Linearised {
   bool ok = false;
-  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();  ///< the solution (last point plus its last step)
+  maps::Geodetic user;                          ///< the last linearisation point
+  std::array<double, kNumConstellations> clock{};  ///< receiver clocks at the solution [m]
   Geometry g;
-  Eigen::VectorXd y;          ///< prefit residuals at x
+  Eigen::VectorXd y;          ///< prefit residuals at the last linearisation point
   std::vector<int> index;     ///< per geometry row: index into the located ranges
 };
 
-/// Iterated WLS over `active` (indices into `located`) from x0.
-Linearised converge(const std::vector<Located>& located, const std::vector<int>& active, const Eigen::Vector3d& x0,
+/// One linearisation at x: the geometry of the active ranges above the mask and their prefit
+/// residuals (the clocks start, on the first call, at each constellation's mean residual).
+Linearised linearise(const std::vector<Located>& located, const std::vector<int>& active, const Eigen::Vector3d& x,
+                     const LiveFixConfig& cfg, std::array<double, kNumConstellations>& clock, bool& clocks_set) {
+  Linearised out;
+  const maps::Geodetic user = maps::ecefToGeodetic(x);
+  const double tau = cfg.model.iono_tau_vert_m.value_or(ionoTauVert_m(geomagneticLatitude(user)));
+  std::vector<SatLook> looks;
+  std::vector<double> ranges;
+  for (int k : active) {
+    const Located& s = located[static_cast<std::size_t>(k)];
+    const maps::LookAngles look = maps::lookAngles(x, s.sat_ecef_m);
+    if (look.elevation_rad < cfg.elevation_mask_rad) continue;
+    looks.push_back({s.sat, look});
+    ranges.push_back((s.sat_ecef_m - x).norm());
+    out.index.push_back(k);
+  }
+  out.g = buildGeometry(looks, cfg.model, tau);
+  const int n = out.g.numSats();
+  if (n < out.g.numStates()) return out;
+  auto pr = [&](int i) { return located[static_cast<std::size_t>(out.index[static_cast<std::size_t>(i)])].pr_m; };
+  if (!clocks_set) {  // each receiver clock starts at the mean of its constellation's residuals
+    for (Constellation c : out.g.clocks) {
+      double sum = 0.0;
+      int count = 0;
+      for (int i = 0; i < n; ++i) {
+        if (out.g.sats[static_cast<std::size_t>(i)].constellation != c) continue;
+        sum += pr(i) - ranges[static_cast<std::size_t>(i)];
+        ++count;
+      }
+      clock[static_cast<int>(c)] = sum / count;
+    }
+    clocks_set = true;
+  }
+  out.y.resize(n);
+  for (int i = 0; i < n; ++i) {
+    out.y[i] = pr(i) - (ranges[static_cast<std::size_t>(i)] + clock[static_cast<int>(out.g.sats[static_cast<std::size_t>(i)].constellation)]);
+  }
+  out.ok = true;
+  out.x = x;
+  out.user = user;
+  return out;
+}
+
+/// Iterated WLS over `active` (indices into the ranges) from x0, the ranges seen anew from each
+/// linearisation point.
+Linearised converge(const RangesSeenFrom& ranges_from, const std::vector<int>& active, const Eigen::Vector3d& x0,
                     const LiveFixConfig& cfg) {
   Linearised out;
   Eigen::Vector3d x = x0;
   std::array<double, kNumConstellations> clock{};
   bool clocks_set = false;
+  Eigen::VectorXd dx;
   for (int it = 0; it < kMaxIterations; ++it) {
-    const maps::Geodetic user = maps::ecefToGeodetic(x);
-    const double tau = cfg.model.iono_tau_vert_m.value_or(ionoTauVert_m(geomagneticLatitude(user)));
-    std::vector<SatLook> looks;
-    std::vector<double> ranges;
-    std::vector<int> index;
-    for (int k : active) {
-      const Located& s = located[static_cast<std::size_t>(k)];
-      const maps::LookAngles look = maps::lookAngles(x, s.sat_ecef_m);
-      if (look.elevation_rad < cfg.elevation_mask_rad) continue;
-      looks.push_back({s.sat, look});
-      ranges.push_back((s.sat_ecef_m - x).norm());
-      index.push_back(k);
-    }
-    Geometry g = buildGeometry(looks, cfg.model, tau);
-    const int n = g.numSats();
-    if (n < g.numStates()) return out;
-    if (!clocks_set) {  // each receiver clock starts at the mean of its constellation's residuals
-      for (Constellation c : g.clocks) {
-        double sum = 0.0;
-        int count = 0;
-        for (int i = 0; i < n; ++i) {
-          if (g.sats[static_cast<std::size_t>(i)].constellation != c) continue;
-          sum += located[static_cast<std::size_t>(index[static_cast<std::size_t>(i)])].pr_m - ranges[static_cast<std::size_t>(i)];
-          ++count;
-        }
-        clock[static_cast<int>(c)] = sum / count;
-      }
-      clocks_set = true;
-    }
-    Eigen::VectorXd y(n);
-    for (int i = 0; i < n; ++i) {
-      const Located& s = located[static_cast<std::size_t>(index[static_cast<std::size_t>(i)])];
-      y[i] = s.pr_m - (ranges[static_cast<std::size_t>(i)] + clock[static_cast<int>(s.sat.constellation)]);
-    }
-    const WlsSolution w = solveWls(g.G, g.sigma_int);
-    if (!w.ok) return out;
-    const Eigen::VectorXd dx = w.S * y;
-    out.ok = true;
-    out.x = x;
-    out.g = std::move(g);
-    out.y = y;
-    out.index = index;
-    if (dx.head<3>().norm() < kConvergence_m) break;
-    const maps::LocalFrame frame(user);
-    x = frame.enuToEcef(dx.head<3>());
+    Linearised lin = linearise(ranges_from(x), active, x, cfg, clock, clocks_set);
+    if (!lin.ok) return Linearised{};
+    const WlsSolution w = solveWls(lin.g.G, lin.g.sigma_int);
+    if (!w.ok) return Linearised{};
+    dx = w.S * lin.y;
+    x = maps::LocalFrame(lin.user).enuToEcef(dx.head<3>());
+    out = std::move(lin);
     for (std::size_t c = 0; c < out.g.clocks.size(); ++c) clock[static_cast<int>(out.g.clocks[c])] += dx[3 + static_cast<Eigen::Index>(c)];
+    if (dx.head<3>().norm() < kConvergence_m) break;
   }
-  // The solution is the last linearisation point plus its (small) last step.
-  const WlsSolution w = solveWls(out.g.G, out.g.sigma_int);
-  const maps::LocalFrame frame(maps::ecefToGeodetic(out.x));
-  out.x = frame.enuToEcef((w.S * out.y).head<3>());
+  out.x = x;  // the last linearisation point plus its (small) last step
+  out.clock = clock;
   return out;
 }
 
@@ -112,8 +122,84 @@ Eigen::Vector2d largestSeparation(const Geometry& g, const Eigen::VectorXd& y) {
   return worst;
 }
 
-PlSummary plOf(const Geometry& g, const LiveFixConfig& cfg) {
-  return protectionLevels(g, cfg.method, cfg.model, cfg.raim, cfg.araim);
+/// The protection levels of a linearised geometry and its detection test: RAIM the normalised
+/// √WSSE against T_d (Brown's χ² test), ARAIM the largest solution separation over its threshold.
+struct GeometryCheck {
+  PlSummary pl;
+  double statistic = 0.0;
+  double threshold = 0.0;
+  bool fails = false;  ///< the detection test fires
+};
+
+GeometryCheck checkGeometry(const Linearised& lin, const LiveFixConfig& cfg) {
+  GeometryCheck out;
+  if (cfg.method == IntegrityMethod::kAraim) {
+    const AraimResult r = araimProtectionLevels(lin.g, cfg.model, cfg.araim);
+    out.pl = summarize(r);
+    out.threshold = 1.0;
+    if (r.pl_computed) out.statistic = solutionSeparationRatio(r, lin.y);
+    out.fails = out.statistic > out.threshold;
+    return out;
+  }
+  out.pl = summarize(raimProtectionLevels(lin.g, cfg.raim), cfg.araim.requirements);
+  const WlsSolution w = solveWls(lin.g.G, lin.g.sigma_int);
+  const Eigen::VectorXd r = lin.y - lin.g.G * (w.S * lin.y);
+  out.statistic = r.cwiseQuotient(lin.g.sigma_int).norm();
+  const int dof = lin.g.numSats() - lin.g.numStates();
+  if (dof > 0) {
+    out.threshold = raimThresholds(dof, cfg.raim.pfa, cfg.raim.pmd).threshold;
+    out.fails = out.statistic > out.threshold;
+  }
+  return out;
+}
+
+/// The geometry rows the method's FDE excludes (RAIM: Baarda's w-test, at least one exclusion;
+/// ARAIM: solution separation); empty unless the exclusion makes the test pass.
+std::vector<int> excludedRows(const Linearised& lin, const LiveFixConfig& cfg) {
+  if (cfg.method == IntegrityMethod::kAraim) {
+    const AraimFdeResult r = araimFde(lin.g, lin.y, cfg.model, cfg.araim);
+    return r.fault_excluded ? r.excluded : std::vector<int>{};
+  }
+  RaimConfig raim = cfg.raim;
+  raim.max_exclusions = std::max(1, cfg.raim.max_exclusions);
+  const RaimFdeResult r = raimFde(lin.g, lin.y, raim);
+  return r.fault_excluded ? r.excluded : std::vector<int>{};
+}
+
+/// The range indices of `lin` without its `rows`; their satellites go to `excluded`.
+std::vector<int> keptRanges(const Linearised& lin, const std::vector<int>& rows, std::vector<SatId>& excluded) {
+  std::vector<int> kept;
+  for (std::size_t row = 0; row < lin.index.size(); ++row) {
+    if (std::find(rows.begin(), rows.end(), static_cast<int>(row)) == rows.end()) {
+      kept.push_back(lin.index[row]);
+    } else {
+      excluded.push_back(lin.g.sats[row]);
+    }
+  }
+  return kept;
+}
+
+/// The solution, its protection levels and test, and — detected, not excluded — PL_det.
+void fillSolution(const Linearised& lin, const GeometryCheck& check, LiveFix& out) {
+  out.solved = true;
+  out.p_ecef = lin.x;
+  out.position = maps::ecefToGeodetic(lin.x);
+  out.clock_m = lin.g.clocks.empty() ? 0.0 : lin.clock[static_cast<int>(lin.g.clocks[0])];
+  out.used = lin.g.sats;
+  out.pl = check.pl;
+  out.test_statistic = check.statistic;
+  out.threshold = check.threshold;
+  out.fault_free_hpl_m = out.pl.hpl_m;
+  out.fault_free_vpl_m = out.pl.vpl_m;
+  if (out.fault_detected && !out.fault_excluded && out.pl.pl_computed) {
+    // PL_det of the file comment: the fault-free PL plus the largest leave-one-out shift.
+    const Eigen::Vector2d sep = largestSeparation(lin.g, lin.y);
+    out.pl.hpl_m += sep.x();
+    out.pl.vpl_m += sep.y();
+    out.pl.available = false;
+    out.pl.reason = "fault detected and not excluded";
+    out.note += "fault detected; PL grown by the largest leave-one-out shift";
+  }
 }
 
 }  // namespace
@@ -170,75 +256,50 @@ std::optional<double> meanClockResidual_m(const std::vector<RawRange>& ranges, c
   return sum / count;
 }
 
-LiveFix solveLiveFix(const std::vector<RawRange>& ranges, const maps::Geodetic& initial, const GpsTime& t,
-                     const LiveFixConfig& cfg, bool exclude, const OrbitSource* orbits) {
-  if (!std::isfinite(initial.lat_rad) || !std::isfinite(initial.lon_rad) || !std::isfinite(initial.h_ell_m)) {
-    throw std::invalid_argument("solveLiveFix: the initial position is not finite");
-  }
+LiveFix solveEpoch(const RangesSeenFrom& ranges_from, const Eigen::Vector3d& x0_ecef, const LiveFixConfig& cfg,
+                   bool exclude) {
   LiveFix out;
-  const Eigen::Vector3d x0 = maps::geodeticToEcef(initial);
-  const std::vector<Located> located = locateRanges(ranges, x0, t, orbits, out.missing_orbit);
-  if (!out.missing_orbit.empty()) out.note += std::to_string(out.missing_orbit.size()) + " satellite(s) without an orbit; ";
-  if (x0.norm() < kMinEarthRadius_m) {
-    out.note += "the reported position is not near the Earth's surface";
-    return out;
-  }
-  std::vector<int> all(located.size());
-  for (std::size_t i = 0; i < located.size(); ++i) all[i] = static_cast<int>(i);
-  Linearised lin = converge(located, all, x0, cfg);
+  std::vector<int> all(ranges_from(x0_ecef).size());
+  std::iota(all.begin(), all.end(), 0);
+  Linearised lin = converge(ranges_from, all, x0_ecef, cfg);
   if (!lin.ok) {
-    out.note += "too few satellites (" + std::to_string(located.size()) + ") or a singular geometry for a position";
+    out.note += "too few satellites (" + std::to_string(all.size()) + ") or a singular geometry for a position";
     return out;
   }
-
-  // Detection (and, when asked, exclusion) at the converged all-in-view point.
-  std::vector<int> excluded_rows;
-  if (cfg.method == IntegrityMethod::kAraim) {
-    AraimConfig araim = cfg.araim;
-    const AraimFdeResult r = araimFde(lin.g, lin.y, cfg.model, araim);
-    out.fault_detected = r.fault_detected;
-    if (exclude && r.fault_excluded) excluded_rows = r.excluded;
-  } else {
-    RaimConfig raim = cfg.raim;
-    raim.max_exclusions = exclude ? std::max(1, cfg.raim.max_exclusions) : 0;
-    const RaimFdeResult r = raimFde(lin.g, lin.y, raim);
-    out.fault_detected = r.fault_detected;
-    if (exclude && r.fault_excluded) excluded_rows = r.excluded;
-  }
-
-  if (!excluded_rows.empty()) {
-    std::vector<int> kept;
-    for (std::size_t row = 0; row < lin.index.size(); ++row) {
-      if (std::find(excluded_rows.begin(), excluded_rows.end(), static_cast<int>(row)) == excluded_rows.end()) {
-        kept.push_back(lin.index[row]);
-      } else {
-        out.excluded.push_back(located[static_cast<std::size_t>(lin.index[row])].sat);
-      }
-    }
-    Linearised again = converge(located, kept, lin.x, cfg);
+  GeometryCheck check = checkGeometry(lin, cfg);
+  out.fault_detected = check.fails;
+  const std::vector<int> rows = exclude && check.fails ? excludedRows(lin, cfg) : std::vector<int>{};
+  if (!rows.empty()) {
+    Linearised again = converge(ranges_from, keptRanges(lin, rows, out.excluded), lin.x, cfg);
     if (!again.ok) {
       out.note += "the geometry after the exclusion is singular";
       return out;
     }
     lin = std::move(again);
+    check = checkGeometry(lin, cfg);
     out.fault_excluded = true;
   }
-  out.solved = true;
-  out.p_ecef = lin.x;
-  out.position = maps::ecefToGeodetic(lin.x);
-  out.used = lin.g.sats;
-  out.pl = plOf(lin.g, cfg);
-  out.fault_free_hpl_m = out.pl.hpl_m;
-  out.fault_free_vpl_m = out.pl.vpl_m;
-  if (out.fault_detected && !out.fault_excluded && out.pl.pl_computed) {
-    // PL_det of the file comment: the fault-free PL plus the largest leave-one-out shift.
-    const Eigen::Vector2d sep = largestSeparation(lin.g, lin.y);
-    out.pl.hpl_m += sep.x();
-    out.pl.vpl_m += sep.y();
-    out.pl.available = false;
-    out.pl.reason = "fault detected and not excluded";
-    out.note += "fault detected; PL grown by the largest leave-one-out shift";
+  fillSolution(lin, check, out);
+  return out;
+}
+
+LiveFix solveLiveFix(const std::vector<RawRange>& ranges, const maps::Geodetic& initial, const GpsTime& t,
+                     const LiveFixConfig& cfg, bool exclude, const OrbitSource* orbits) {
+  if (!std::isfinite(initial.lat_rad) || !std::isfinite(initial.lon_rad) || !std::isfinite(initial.h_ell_m)) {
+    throw std::invalid_argument("solveLiveFix: the initial position is not finite");
   }
+  const Eigen::Vector3d x0 = maps::geodeticToEcef(initial);
+  std::vector<SatId> missing;
+  const std::vector<LocatedRange> located = locateRanges(ranges, x0, t, orbits, missing);
+  LiveFix out;
+  if (x0.norm() < kMinEarthRadius_m) {
+    out.note = "the reported position is not near the Earth's surface";
+  } else {
+    out = solveEpoch([&located](const Eigen::Vector3d&) -> const std::vector<LocatedRange>& { return located; }, x0, cfg,
+                     exclude);
+  }
+  if (!missing.empty()) out.note = std::to_string(missing.size()) + " satellite(s) without an orbit; " + out.note;
+  out.missing_orbit = std::move(missing);
   return out;
 }
 

@@ -1,7 +1,9 @@
 #pragma once
 /// \file
-/// \brief One live epoch from raw pseudoranges (live corridor tracking): the position, the
-/// protection levels with the mission's method, and fault detection and exclusion on demand.
+/// \brief The one integrity call for an epoch of pseudoranges: the position, the protection levels
+/// with the chosen method, and fault detection and exclusion on demand. Live corridor tracking
+/// calls it with a fix's raw ranges (solveLiveFix); single-point positioning from RINEX
+/// (spp.hpp) calls it with ranges corrected from the broadcast ephemerides (solveEpoch).
 ///
 /// Measurement model: P_i = |r_s,i − r| + c·δt_r,c(i) + ε_i, with r_s,i the satellite's position
 /// at transmit time in the reception ECEF frame (light time and Sagnac applied, as
@@ -29,6 +31,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -89,10 +92,24 @@ struct LiveFix {
   bool fault_detected = false;       ///< the detection test of the all-in-view solution fired
   bool fault_excluded = false;
   PlSummary pl;                      ///< of the final geometry (first pass: PL_det when detected)
+  double clock_m = 0.0;              ///< receiver clock of the first constellation in the geometry [m]
+  double test_statistic = 0.0;       ///< of the final geometry: RAIM √WSSE (normalised), ARAIM max |Δx|/T
+  double threshold = 0.0;            ///< RAIM T_d (0 without redundancy), ARAIM 1
   double fault_free_hpl_m = 0.0, fault_free_vpl_m = 0.0;  ///< the PL before the detection term
 };
 
-/// \brief Solves one epoch. `initial` is the reported position (the linearisation point);
+/// \brief The epoch's ranges seen from a linearisation point (ECEF [m]): the satellites in the
+/// reception frame and the pseudoranges with every correction that depends on the point applied
+/// (atmosphere, Earth rotation). Returns the same satellites in the same order at every point.
+using RangesSeenFrom = std::function<const std::vector<LocatedRange>&(const Eigen::Vector3d& x_ecef)>;
+
+/// \brief Solves one epoch from `x0_ecef`: iterated WLS over every range above the mask, the
+/// method's detection test at the converged point and, with `exclude`, its exclusion and the
+/// solution of the remaining geometry (see the file comment for the two passes).
+[[nodiscard]] LiveFix solveEpoch(const RangesSeenFrom& ranges_from, const Eigen::Vector3d& x0_ecef,
+                                 const LiveFixConfig& cfg, bool exclude);
+
+/// \brief Solves one live epoch with solveEpoch(). `initial` is the reported position (the linearisation point);
 /// `orbits` gives satellite positions a range does not carry (nullptr: every range must).
 /// \throws std::invalid_argument for a non-finite pseudorange or position.
 [[nodiscard]] LiveFix solveLiveFix(const std::vector<RawRange>& ranges, const maps::Geodetic& initial, const GpsTime& t,

@@ -1,10 +1,11 @@
 #include "integrity/raim/spp.hpp"
 
-#include "integrity/araim/fde.hpp"
 #include "integrity/gnss/atmosphere.hpp"
+#include "integrity/raim/live_fix.hpp"
 
 #include <Eigen/Cholesky>
 
+#include <algorithm>
 #include <cmath>
 
 namespace skylane::integrity {
@@ -76,39 +77,9 @@ std::vector<Measurement> collect(const ObservationEpoch& ep, const ObservationDa
   return out;
 }
 
-/// Receiver clock per constellation [m].
-using Clocks = std::array<double, kNumConstellations>;
-
-/// One FDE solution at a linearisation point, RAIM or ARAIM alike.
-struct FdeOutcome {
-  bool ok = false;
-  Eigen::VectorXd dx;
-  Geometry final_geometry;
-  std::vector<int> excluded;
-  bool fault_detected = false;
-  double statistic = 0, threshold = 0;
-  PlSummary pl;
-};
-
-/// The solver's state through the iterations.
-struct SppState {
-  Eigen::Vector3d x = Eigen::Vector3d::Zero();  ///< receiver, ECEF [m]
-  Clocks clock{};
-  FdeOutcome fde;
-  std::vector<const Measurement*> in_view;  ///< the measurements of the last geometry, in its order
-};
-
-/// The prefit residuals and look angles of the measurements above the mask at the state's point.
-struct Prefit {
-  std::vector<SatLook> looks;
-  std::vector<double> residuals_m;
-  bool any_single = false;  ///< a single-frequency measurement is among them
-};
-
 /// Phase A: unweighted, no atmosphere, no mask — brings any start point to the Earth's surface.
-void findInitialPosition(const std::vector<Measurement>& meas, SppState& s) {
-  Eigen::Vector3d& x = s.x;
-  Clocks& clock = s.clock;
+void findInitialPosition(const std::vector<Measurement>& meas, Eigen::Vector3d& x) {
+  double clock = 0.0;
   for (int it = 0; it < kMaxIterations; ++it) {
     const int n = static_cast<int>(meas.size());
     if (n < 4) break;
@@ -121,105 +92,88 @@ void findInitialPosition(const std::vector<Measurement>& meas, SppState& s) {
       const double rho = d.norm();
       G.block<1, 3>(i, 0) = -(d / rho).transpose();
       G(i, 3) = 1.0;
-      y[i] = m.pr_m - (rho + clock[0] - m.sat_clock_m);
+      y[i] = m.pr_m - (rho + clock - m.sat_clock_m);
     }
     const Eigen::Vector4d dx = (G.transpose() * G).ldlt().solve(G.transpose() * y);
     if (!dx.allFinite()) break;
     x += dx.head<3>();
-    clock[0] += dx[3];
+    clock += dx[3];
     if (dx.head<3>().norm() < 1.0) break;
   }
-  for (double& c : clock) c = clock[0];
 }
 
-/// Prefit residuals with the atmosphere, for the measurements above the mask; the state's
-/// in_view lists them.
-Prefit prefitResiduals(const std::vector<Measurement>& meas, const maps::Geodetic& user, const NavigationData& nav,
-                       const SppConfig& cfg, const GpsTime& t, SppState& s) {
-  Prefit out;
-  s.in_view.clear();
-  for (const Measurement& m : meas) {
-    const Eigen::Vector3d p = earthRotationCorrection(m.p_sat_tx, (m.p_sat_tx - s.x).norm() / kSpeedOfLight_mps);
-    const maps::LookAngles look = maps::lookAngles(s.x, p);
-    if (look.elevation_rad < cfg.elevation_mask_rad) continue;
-    double iono = 0.0;
-    if (!m.iono_free) {
-      out.any_single = true;
-      // Galileo E1 shares L1's frequency; the GPS model stands in for NeQuick G here.
-      if (nav.klobuchar) iono = klobucharDelay_m(*nav.klobuchar, user, look, t);
+/// The measurements as the epoch solver sees them from a point: each satellite rotated into the
+/// reception frame (Sagnac, over the flight time from that point) and, above the mask, its
+/// pseudorange corrected for the satellite clock, the broadcast ionosphere (single frequency) and
+/// the troposphere at that point.
+class CorrectedRanges {
+ public:
+  CorrectedRanges(const std::vector<Measurement>& meas, const NavigationData& nav, const SppConfig& cfg, const GpsTime& t)
+      : meas_(meas), nav_(nav), mask_rad_(cfg.elevation_mask_rad), t_(t) {}
+
+  const std::vector<LocatedRange>& from(const Eigen::Vector3d& x) {
+    const maps::Geodetic user = maps::ecefToGeodetic(x);
+    ranges_.clear();
+    for (const Measurement& m : meas_) {
+      const Eigen::Vector3d p = earthRotationCorrection(m.p_sat_tx, (m.p_sat_tx - x).norm() / kSpeedOfLight_mps);
+      const maps::LookAngles look = maps::lookAngles(x, p);
+      double pr = m.pr_m + m.sat_clock_m;
+      if (look.elevation_rad >= mask_rad_) {
+        // Galileo E1 shares L1's frequency; the GPS model stands in for NeQuick G here.
+        if (!m.iono_free && nav_.klobuchar) pr -= klobucharDelay_m(*nav_.klobuchar, user, look, t_);
+        pr -= saastamoinenDelay_m(user, look.elevation_rad);
+      }
+      ranges_.push_back({m.sat, pr, p});
     }
-    const double tropo = saastamoinenDelay_m(user, look.elevation_rad);
-    const double rho = (p - s.x).norm();
-    out.residuals_m.push_back(m.pr_m - (rho + s.clock[static_cast<int>(m.sat.constellation)] - m.sat_clock_m + iono + tropo));
-    out.looks.push_back({m.sat, look});
-    s.in_view.push_back(&m);
+    return ranges_;
   }
+
+  /// Whether a single-frequency measurement is above the mask at x.
+  bool anySingleFrequencyAbove(const Eigen::Vector3d& x) const {
+    return std::any_of(meas_.begin(), meas_.end(), [&](const Measurement& m) {
+      const Eigen::Vector3d p = earthRotationCorrection(m.p_sat_tx, (m.p_sat_tx - x).norm() / kSpeedOfLight_mps);
+      return !m.iono_free && maps::lookAngles(x, p).elevation_rad >= mask_rad_;
+    });
+  }
+
+ private:
+  const std::vector<Measurement>& meas_;
+  const NavigationData& nav_;
+  double mask_rad_;
+  GpsTime t_;
+  std::vector<LocatedRange> ranges_;
+};
+
+/// The epoch solver's settings for SPP: the airborne error model of the frequencies in view.
+LiveFixConfig epochConfig(const SppConfig& cfg, bool single_frequency) {
+  LiveFixConfig out;
+  out.method = cfg.method;
+  out.model = cfg.model;
+  out.model.setUserModel(single_frequency ? UserErrorModel::kSingleFrequency : UserErrorModel::kDualFrequency);
+  out.raim = cfg.raim;
+  out.araim = cfg.araim;
+  out.elevation_mask_rad = cfg.elevation_mask_rad;
   return out;
 }
 
-/// FDE of the configured method (RAIM or ARAIM) on one linearisation.
-FdeOutcome runFde(const Geometry& g, const Eigen::VectorXd& y, const SppConfig& cfg) {
-  if (cfg.method == IntegrityMethod::kAraim) {
-    ErrorModel araim_model = cfg.model;  // the ISM priors; σ's come from `g`
-    const AraimFdeResult r = araimFde(g, y, araim_model, cfg.araim);
-    return {r.solution_ok, r.dx, r.final_geometry, r.excluded, r.fault_detected, r.max_test_ratio, 1.0, summarize(r.pl)};
-  }
-  const RaimFdeResult r = raimFde(g, y, cfg.raim);
-  FdeOutcome fde{r.solution_ok, r.dx, r.final_geometry, r.excluded, r.fault_detected, r.test_statistic, r.threshold,
-                 summarize(r.pl, cfg.araim.requirements)};
-  if (r.fault_detected && !r.fault_excluded) fde.pl.reason = r.pl.reason;
-  return fde;
-}
-
-/// Moves the state by the FDE solution's update (ENU at `user`); returns the position step [m].
-double applyUpdate(const maps::Geodetic& user, SppState& s) {
-  const maps::LocalFrame frame(user);
-  const Eigen::Vector3d dx_ecef = frame.enuToEcef(s.fde.dx.head<3>()) - s.x;
-  s.x += dx_ecef;
-  for (std::size_t k = 0; k < s.fde.final_geometry.clocks.size(); ++k) {
-    s.clock[static_cast<int>(s.fde.final_geometry.clocks[k])] += s.fde.dx[3 + static_cast<int>(k)];
-  }
-  return dx_ecef.norm();
-}
-
-/// Phase B: weighted, corrected, masked, with FDE at each linearisation point; false (with the
-/// reason in the note) when FDE finds no solution.
-bool solveWeighted(const ObservationEpoch& ep, const std::vector<Measurement>& meas, const NavigationData& nav,
-                   const SppConfig& cfg, SppState& s, SppEpoch& out) {
-  for (int it = 0; it < kMaxIterations; ++it) {
-    const maps::Geodetic user = maps::ecefToGeodetic(s.x);
-    const double tau = cfg.model.iono_tau_vert_m.value_or(ionoTauVert_m(geomagneticLatitude(user)));
-    const Prefit pre = prefitResiduals(meas, user, nav, cfg, ep.t, s);
-    ErrorModel model = cfg.model;
-    model.setUserModel(pre.any_single ? UserErrorModel::kSingleFrequency : UserErrorModel::kDualFrequency);
-    const Geometry g = buildGeometry(pre.looks, model, tau);
-    const Eigen::VectorXd y =
-        Eigen::Map<const Eigen::VectorXd>(pre.residuals_m.data(), static_cast<Eigen::Index>(pre.residuals_m.size()));
-    s.fde = runFde(g, y, cfg);
-    if (!s.fde.ok) {
-      out.note += s.fde.pl.reason;
-      return false;
-    }
-    const double step_m = applyUpdate(user, s);
-    out.iono_free = !pre.any_single;
-    if (step_m < kConvergence_m) break;
-  }
-  return true;
-}
-
-/// The solved epoch: position, clock, satellites used and excluded, and the FDE's verdict.
-void fillSolution(const SppState& s, SppEpoch& out) {
-  out.solved = true;
-  out.p_ecef = s.x;
-  out.position = maps::ecefToGeodetic(s.x);
-  out.clock_m = s.fde.final_geometry.clocks.empty() ? 0.0 : s.clock[static_cast<int>(s.fde.final_geometry.clocks[0])];
-  out.used = s.fde.final_geometry.sats;
-  for (int idx : s.fde.excluded) out.excluded.push_back(s.in_view[static_cast<std::size_t>(idx)]->sat);
-  out.fault_detected = s.fde.fault_detected;
-  out.test_statistic = s.fde.statistic;
-  out.threshold = s.fde.threshold;
-  out.pl = s.fde.pl;
-  if (!out.pl.pl_computed) out.note += out.pl.reason;
+/// The solved epoch: position, clock, satellites used and excluded, and the test's verdict.
+void fillSolution(const LiveFix& f, const std::vector<Measurement>& meas, SppEpoch& out) {
+  out.solved = f.solved;
+  out.note += f.note;
+  if (!f.solved) return;
+  out.p_ecef = f.p_ecef;
+  out.position = f.position;
+  out.clock_m = f.clock_m;
+  out.used = f.used;
+  out.excluded = f.excluded;
+  out.iono_free = std::none_of(meas.begin(), meas.end(), [&](const Measurement& m) {
+    return !m.iono_free && std::find(f.used.begin(), f.used.end(), m.sat) != f.used.end();
+  });
+  out.fault_detected = f.fault_detected;
+  out.test_statistic = f.test_statistic;
+  out.threshold = f.threshold;
+  out.pl = f.pl;
+  if (!out.pl.pl_computed && !out.pl.reason.empty()) out.note += out.pl.reason;
 }
 
 }  // namespace
@@ -230,15 +184,17 @@ SppEpoch solveSppEpoch(const ObservationEpoch& ep, const ObservationData& obs, c
   out.t = ep.t;
   out.source_line = ep.source_line;
   const std::vector<Measurement> meas = collect(ep, obs, nav, cfg, out.note);
-  SppState s;
-  s.x = initial_ecef.value_or(Eigen::Vector3d::Zero());
-  if (s.x.norm() < kMinEarthRadius_m) findInitialPosition(meas, s);
-  if (s.x.norm() < kMinEarthRadius_m) {
+  Eigen::Vector3d x = initial_ecef.value_or(Eigen::Vector3d::Zero());
+  if (x.norm() < kMinEarthRadius_m) findInitialPosition(meas, x);
+  if (x.norm() < kMinEarthRadius_m) {
     out.note += "no initial position could be found (" + std::to_string(meas.size()) + " satellites)";
     return out;
   }
-  if (!solveWeighted(ep, meas, nav, cfg, s, out)) return out;
-  fillSolution(s, out);
+  CorrectedRanges ranges(meas, nav, cfg, ep.t);
+  const LiveFixConfig epoch_cfg = epochConfig(cfg, ranges.anySingleFrequencyAbove(x));
+  const LiveFix f = solveEpoch([&ranges](const Eigen::Vector3d& at) -> const std::vector<LocatedRange>& { return ranges.from(at); },
+                               x, epoch_cfg, true);
+  fillSolution(f, meas, out);
   return out;
 }
 

@@ -3,6 +3,9 @@
 // broadcast ionosphere, Saastamoinen troposphere, 15° mask).
 #include "integrity/raim/spp.hpp"
 
+#include "integrity/gnss/atmosphere.hpp"
+#include "integrity/raim/live_fix.hpp"
+
 #include "tests/test_util.hpp"
 
 #include <algorithm>
@@ -144,6 +147,64 @@ TEST(Spp, Rinex3GpsPlusGalileoWithTwoReceiverClocks) {
     EXPECT_TRUE(e.excluded.empty());
     EXPECT_LT(e.test_statistic, e.threshold);
   }
+}
+
+/// The epoch's L1 code ranges as a live fix would carry them, corrected here from the broadcast
+/// ephemeris (IS-GPS-200 §20.3.3.3.3: transmit time, satellite clock and T_GD, Sagnac), the
+/// Klobuchar ionosphere and the Saastamoinen troposphere, all seen from `x`: an independent
+/// preparation of the ranges the one epoch solver is given.
+std::vector<RawRange> correctedL1Ranges(const ObservationEpoch& ep, const ObservationData& obs, const NavigationData& nav,
+                                        const Eigen::Vector3d& x) {
+  std::vector<RawRange> out;
+  const int c1 = findObsType(obs.types[static_cast<int>(Constellation::kGps)], 'C', 1, "CWPXSLYM");
+  const maps::Geodetic user = maps::ecefToGeodetic(x);
+  for (const SatObservation& so : ep.sats) {
+    if (so.sat.constellation != Constellation::kGps) continue;
+    const double pr = so.values[static_cast<std::size_t>(c1)];
+    const BroadcastEphemeris* eph = selectEphemeris(nav, so.sat, ep.t);
+    if (!std::isfinite(pr) || !eph) continue;
+    GpsTime t_tx = ep.t.plus(-pr / kSpeedOfLight_mps);
+    t_tx = t_tx.plus(-satelliteState(*eph, t_tx).clock_s);
+    const SatelliteState st = satelliteState(*eph, t_tx);
+    const Eigen::Vector3d p = earthRotationCorrection(st.p_ecef, (st.p_ecef - x).norm() / kSpeedOfLight_mps);
+    const maps::LookAngles look = maps::lookAngles(x, p);
+    if (look.elevation_rad < 0.0) continue;
+    const double corrected = pr + kSpeedOfLight_mps * (st.clock_s - eph->tgd_s) - klobucharDelay_m(*nav.klobuchar, user, look, ep.t) -
+                             saastamoinenDelay_m(user, look.elevation_rad);
+    out.push_back({so.sat, corrected, p});
+  }
+  return out;
+}
+
+TEST(Spp, SolvesEveryEpochWithTheLiveFixSolver) {
+  // SPP and live tracking make one integrity call: an epoch solved by SPP, given again as the
+  // corrected ranges a live fix carries, gives the same position, satellites, test and PL.
+  const ObservationData obs = loadRinexObs(test::dataPath("gnss/30400920.05o"));
+  const NavigationData nav = loadRinexNav(test::dataPath("gnss/30400920.05n"));
+  ASSERT_TRUE(nav.klobuchar);
+  SppConfig cfg;
+  cfg.iono = IonoMode::kKlobuchar;
+  LiveFixConfig live;
+  live.model.setUserModel(UserErrorModel::kSingleFrequency);
+  live.elevation_mask_rad = cfg.elevation_mask_rad;
+  int compared = 0;
+  for (std::size_t i = 0; i < obs.epochs.size(); ++i) {
+    const SppEpoch e = solveSppEpoch(obs.epochs[i], obs, nav, cfg, obs.approx_position_ecef);
+    if (!e.solved || !e.pl.pl_computed) continue;
+    const std::vector<RawRange> ranges = correctedL1Ranges(obs.epochs[i], obs, nav, e.p_ecef);
+    const LiveFix f = solveLiveFix(ranges, e.position, e.t, live, true, nullptr);
+    ASSERT_TRUE(f.solved) << f.note;
+    EXPECT_LT((f.p_ecef - e.p_ecef).norm(), 1e-3) << formatRfc3339(e.t);
+    EXPECT_EQ(f.used, e.used);
+    EXPECT_EQ(f.fault_detected, e.fault_detected);
+    EXPECT_NEAR(f.test_statistic, e.test_statistic, 1e-3);
+    // (a 5-satellite epoch has PLs of ~100 km: there, 1e-8 of the PL)
+    EXPECT_NEAR(f.pl.hpl_m, e.pl.hpl_m, 1e-3 + 1e-8 * e.pl.hpl_m);
+    EXPECT_NEAR(f.pl.vpl_m, e.pl.vpl_m, 1e-3 + 1e-8 * e.pl.vpl_m);
+    EXPECT_NEAR(f.clock_m, e.clock_m, 1e-3);
+    ++compared;
+  }
+  EXPECT_GT(compared, 100);
 }
 
 TEST(Spp, EpochWithTooFewSatellitesIsReportedNotCrashed) {
