@@ -150,7 +150,7 @@ void runApprove(const ApproveOptions& o) {
   const planner::ApprovalReport r = approver.approve([show](const std::string& s) {
     if (show) std::cerr << "skylane: approve: " << s << "\n";
   });
-  const json j = planner::approvalReportJson(r, approver.mission());
+  const json j = r;
   if (!o.out_dir.empty()) {
     std::filesystem::create_directories(o.out_dir);
     std::ofstream(std::filesystem::path(o.out_dir) / "report.json") << j.dump(2) << "\n";

@@ -6,6 +6,7 @@
 
 #include "geofence/obstruction_files.hpp"
 #include "integrity/predict.hpp"
+#include "maps/file_digest.hpp"
 #include "maps/geoid.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/plane_frame.hpp"
@@ -13,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <memory>
 
@@ -30,6 +32,26 @@ double integrityPenalty(double r) {
 }
 
 }  // namespace
+
+MissionRecord missionRecord(const Mission& m) {
+  MissionRecord r;
+  r.name = m.name;
+  r.source = m.source;
+  if (!m.source.empty()) r.source_absolute = std::filesystem::absolute(m.source).lexically_normal().string();
+  r.k1 = m.levels.k1;
+  r.k2 = m.levels.k2;
+  r.seed = m.seed;
+  auto add = [&r](const std::string& role, const std::string& path) {
+    if (!path.empty()) r.inputs.push_back({role, path, maps::fileSha256Hex(path)});
+  };
+  // A mission parsed from memory (a request, a test) names no file: nothing to digest.
+  if (std::filesystem::is_regular_file(m.source)) add("mission", m.source);
+  for (const std::string& f : m.zone_files) add("zones", f);
+  add("buildings", m.buildings_file);
+  add("terrain", m.terrain_file);
+  for (const std::string& f : m.orbit_files) add("orbits", f);
+  return r;
+}
 
 Approver::Impl::Impl(Mission mission)
     : m(std::move(mission)),
@@ -53,6 +75,7 @@ Approver::Impl::Impl(Mission mission)
     index = std::make_unique<maps::BuildingIndex>(obstructions->buildings(), origin);
   }
   orbits = integrity::loadOrbitFiles(m.orbit_files, m.source, "$.orbits");
+  record = missionRecord(m);  // the files as they were read
   // Search box: every mission point ± margin; heights from the terrain's range over it.
   Eigen::Vector2d lo(kInf, kInf), hi(-kInf, -kInf);
   for (const MissionPoint& p : m.points) {

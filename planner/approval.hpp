@@ -99,8 +99,30 @@ struct PlannerStats {
   int departures_tried = 0;
 };
 
+/// \brief One input file of an approval and its SHA-256 when the approver read it.
+struct InputDigest {
+  std::string role;  ///< "mission", "zones", "buildings", "terrain", "orbits"
+  std::string file;
+  std::string sha256;
+};
+
+/// \brief What a report says of its mission, so that the report stands alone: the approval can
+/// be audited and replayed against exactly these files.
+struct MissionRecord {
+  std::string name;
+  std::string source;           ///< the mission file as given
+  std::string source_absolute;  ///< its absolute path (for a tracker started elsewhere)
+  double k1 = 0.0, k2 = 0.0;    ///< the box levels' factors
+  std::uint64_t seed = 0;       ///< the planner's seed
+  std::vector<InputDigest> inputs;
+};
+
+/// \brief The record of a mission: its names, factors, seed and every input file's digest.
+[[nodiscard]] MissionRecord missionRecord(const Mission& m);
+
 /// \brief The outcome of an approval.
 struct ApprovalReport {
+  MissionRecord mission;
   bool approved = false;
   std::vector<Reason> reasons;
   maps::GpsTime departure;

@@ -120,6 +120,7 @@ enum class AttemptOutcome {
 
 struct Approver::Impl {
   Mission m;
+  MissionRecord record;  ///< the mission's names and its inputs' digests when they were read
   maps::PlaneFrame frame;
   maps::Terrain terrain;
   geofence::LevelLimits limits;

@@ -103,6 +103,7 @@ ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, co
   ensureCostField(setup, say);
   fitSearchBox(setup);  // after the cost field: a replan's exemption grows with the PL predicted there
   ApprovalReport report;
+  report.mission = record;
   report.limits = limits;
   AttemptHistory history;
   for (const maps::GpsTime& departure : departures) {

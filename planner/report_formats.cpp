@@ -1,12 +1,10 @@
 #include "planner/report_formats.hpp"
 
 #include "geofence/verdict_json.hpp"
-#include "maps/file_digest.hpp"
 #include "maps/json_node.hpp"
 #include "maps/json_numbers.hpp"
 
 #include <cmath>
-#include <filesystem>
 
 namespace skylane::planner {
 
@@ -14,15 +12,15 @@ namespace {
 
 using nlohmann::json;
 
-double round7(double deg) { return std::round(deg * 1e7) / 1e7; }
+using maps::roundToDeg8;
 using maps::roundToMm;
 
 nlohmann::json lonLat(const maps::PlaneFrame& frame, const Eigen::Vector2d& xy) {
   const Eigen::Vector2d ll = frame.toLatLon(xy);
-  return {round7(maps::rad2deg(ll.y())), round7(maps::rad2deg(ll.x()))};
+  return {roundToDeg8(ll.y()), roundToDeg8(ll.x())};
 }
 
-double deg(double rad) { return round7(maps::rad2deg(rad)); }
+double deg(double rad) { return roundToDeg8(rad); }
 
 nlohmann::json reasonJson(const Reason& r, const maps::GpsTime& dep) {
   json j;
@@ -81,7 +79,7 @@ json zonesJson(const ApprovalReport& r) {
   return zones;
 }
 
-json plannerJson(const ApprovalReport& r, const Mission& m) {
+json plannerJson(const ApprovalReport& r) {
   return {{"algorithm", r.planner.algorithm},
           {"status", r.planner.status},
           {"straight_line", r.planner.straight_line},
@@ -91,31 +89,24 @@ json plannerJson(const ApprovalReport& r, const Mission& m) {
           {"iterations", r.planner.iterations},
           {"stopped_by_time", r.planner.stopped_by_time},
           {"departures_tried", r.planner.departures_tried},
-          {"seed", m.seed}};
+          {"seed", r.mission.seed}};
 }
 
 /// The inputs' digests: the approval can be audited and replayed against exactly these files.
-json inputsJson(const Mission& m) {
+json inputsJson(const MissionRecord& m) {
   json inputs = json::array();
-  auto add = [&inputs](const std::string& role, const std::string& path) {
-    if (!path.empty()) inputs.push_back({{"role", role}, {"file", path}, {"sha256", maps::fileSha256Hex(path)}});
-  };
-  add("mission", m.source);
-  for (const std::string& f : m.zone_files) add("zones", f);
-  add("buildings", m.buildings_file);
-  add("terrain", m.terrain_file);
-  for (const std::string& f : m.orbit_files) add("orbits", f);
+  for (const InputDigest& d : m.inputs) inputs.push_back({{"role", d.role}, {"file", d.file}, {"sha256", d.sha256}});
   return inputs;
 }
 
 }  // namespace
 
-nlohmann::json approvalReportJson(const ApprovalReport& r, const Mission& m) {
-  json j;
+void to_json(nlohmann::json& j, const ApprovalReport& r) {
+  const MissionRecord& m = r.mission;
+  j = json::object();
   j["mission"] = m.name;
   j["source"] = m.source;
-  // Where the mission is for a tracker started in another directory.
-  if (!m.source.empty()) j["source_absolute"] = std::filesystem::absolute(m.source).lexically_normal().string();
+  if (!m.source_absolute.empty()) j["source_absolute"] = m.source_absolute;
   j["decision"] = r.approved ? "approved" : "rejected";
   j["reasons"] = json::array();
   for (const Reason& x : r.reasons) j["reasons"].push_back(reasonJson(x, r.departure));
@@ -123,19 +114,18 @@ nlohmann::json approvalReportJson(const ApprovalReport& r, const Mission& m) {
   if (r.earliest_passing_departure) j["earliest_passing_departure"] = maps::formatRfc3339(*r.earliest_passing_departure);
   j["route"] = routeJson(r);
   j["corridor"] = {{"level", 1}, {"hal_m", roundToMm(r.limits.level1.hal_m)}, {"val_m", roundToMm(r.limits.level1.val_m)},
-                   {"k", m.levels.k1}, {"centre_line", "route"}};
+                   {"k", m.k1}, {"centre_line", "route"}};
   j["airspace"] = {{"level", 2}, {"hal_m", roundToMm(r.limits.level2.hal_m)}, {"val_m", roundToMm(r.limits.level2.val_m)},
-                   {"k", m.levels.k2}, {"centre_line", "route"}};
+                   {"k", m.k2}, {"centre_line", "route"}};
   json predicted = json::array();
   for (const PredictedSample& s : r.predicted) predicted.push_back(predictedSampleJson(s, r));
   j["predicted"] = predicted;
   j["level1_exceedances"] = r.level1_exceedances;
   j["zones"] = zonesJson(r);
-  j["planner"] = plannerJson(r, m);
+  j["planner"] = plannerJson(r);
   j["elapsed_s"] = std::round(r.elapsed_s * 1e3) / 1e3;
   j["inputs"] = inputsJson(m);
   j["software"] = {{"name", "skylane"}, {"planner_seed", m.seed}};
-  return j;
 }
 
 std::vector<Eigen::Vector2d> segmentOutline(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double hal_m) {
@@ -152,7 +142,7 @@ nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission
   json features = json::array();
   json line = json::array();
   for (const RoutePoint& p : report.route) {
-    line.push_back({round7(maps::rad2deg(p.lon_rad)), round7(maps::rad2deg(p.lat_rad)), roundToMm(p.alt_amsl_m)});
+    line.push_back({deg(p.lon_rad), deg(p.lat_rad), roundToMm(p.alt_amsl_m)});
   }
   features.push_back({{"type", "Feature"},
                       {"geometry", {{"type", "LineString"}, {"coordinates", line}}},
@@ -166,7 +156,7 @@ nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission
     const RoutePoint& p = report.route[i];
     features.push_back(
         {{"type", "Feature"},
-         {"geometry", {{"type", "Point"}, {"coordinates", {round7(maps::rad2deg(p.lon_rad)), round7(maps::rad2deg(p.lat_rad)), roundToMm(p.alt_amsl_m)}}}},
+         {"geometry", {{"type", "Point"}, {"coordinates", {deg(p.lon_rad), deg(p.lat_rad), roundToMm(p.alt_amsl_m)}}}},
          {"properties",
           {{"kind", "route_point"}, {"index", i}, {"eta", maps::formatRfc3339(report.departure.plus(p.eta_s), 1)},
            {"h_ell_m", roundToMm(p.h_ell_m)}, {"alt_amsl_m", roundToMm(p.alt_amsl_m)}}}});
@@ -194,7 +184,7 @@ nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission
   for (const Reason& r : report.reasons) {
     if (!r.lat_rad || !r.lon_rad) continue;
     features.push_back({{"type", "Feature"},
-                        {"geometry", {{"type", "Point"}, {"coordinates", {round7(maps::rad2deg(*r.lon_rad)), round7(maps::rad2deg(*r.lat_rad))}}}},
+                        {"geometry", {{"type", "Point"}, {"coordinates", {deg(*r.lon_rad), deg(*r.lat_rad)}}}},
                         {"properties", {{"kind", "reason"}, {"reason", r.kind}, {"subject", r.subject}, {"message", r.message}}}});
   }
   return {{"type", "FeatureCollection"}, {"features", features}};
@@ -211,7 +201,7 @@ nlohmann::json operationalIntentVolumes(const ApprovalReport& report, const maps
     json vertices = json::array();
     for (const Eigen::Vector2d& v : segmentOutline(a.xyz, b.xyz, lim.hal_m)) {
       const Eigen::Vector2d ll = frame.toLatLon(v);
-      vertices.push_back({{"lat", round7(maps::rad2deg(ll.x()))}, {"lng", round7(maps::rad2deg(ll.y()))}});
+      vertices.push_back({{"lat", deg(ll.x())}, {"lng", deg(ll.y())}});
     }
     const double lower = std::min(a.h_ell_m, b.h_ell_m) - lim.val_m;
     const double upper = std::max(a.h_ell_m, b.h_ell_m) + lim.val_m;
@@ -225,6 +215,8 @@ nlohmann::json operationalIntentVolumes(const ApprovalReport& report, const maps
   }
   return volumes;
 }
+
+void from_json(const nlohmann::json& j, ApprovedFlight& f) { f = parseApprovalReport(j, "approval report"); }
 
 ApprovedFlight parseApprovalReport(const nlohmann::json& doc, const std::string& source) {
   const maps::JsonNode root{doc, "$", source};

@@ -13,10 +13,11 @@
 
 namespace skylane::planner {
 
-/// \brief The approval report (`skylane approve` prints it, `report.json`; README "The report"):
-/// decision, reasons, departure, route with ETAs, both box levels, predicted samples, zones,
-/// planner statistics and the inputs' SHA-256 digests.
-[[nodiscard]] nlohmann::json approvalReportJson(const ApprovalReport& report, const Mission& mission);
+/// \brief The one JSON form of an approval report (`skylane approve` prints it, `report.json`;
+/// README "The report"): decision, reasons, departure, route with ETAs, both box levels,
+/// predicted samples, zones, planner statistics and the inputs' SHA-256 digests. Numbers by the
+/// rule of maps/json_numbers.hpp.
+void to_json(nlohmann::json& j, const ApprovalReport& report);
 
 /// \brief What live tracking needs of an approval report.
 struct ApprovedFlight {
@@ -31,9 +32,12 @@ struct ApprovedFlight {
   geofence::AlertLimits level1, level2;
 };
 
-/// \brief Reads the fields of approvalReportJson that tracking uses.
+/// \brief Reads the fields of a report's JSON form that tracking and an autopilot link act on.
 /// \throws maps::ParseError naming `source`, the JSON path, the value and what was expected.
 [[nodiscard]] ApprovedFlight parseApprovalReport(const nlohmann::json& doc, const std::string& source);
+
+/// \brief parseApprovalReport() of a document with no file name ("approval report").
+void from_json(const nlohmann::json& j, ApprovedFlight& f);
 
 /// \brief The footprint of one segment's box in the map frame: the rectangle around a→b
 /// widened by `hal_m` on each side and lengthened by `hal_m` at both ends, so that it also

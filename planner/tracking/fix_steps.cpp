@@ -453,7 +453,7 @@ void replanIfPersistent(const TrackerOptions& o, TrackedFlight& f, FixWork& w) {
   ApprovalReport r;
   try {
     r = f.approver->replanFrom(w.volume.volume.p_map, fix.time, st.next_stop);
-    rp["report"] = approvalReportJson(r, f.approver->mission());  // digests the input files again
+    rp["report"] = r;
   } catch (const std::exception& err) {  // the fix stays accepted; the replan is what failed
     rp["decision"] = "error";
     rp["error"] = err.what();

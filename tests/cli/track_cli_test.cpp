@@ -120,9 +120,13 @@ TEST_F(TrackCli, GarbageAndTruncatedLinesAreReportedAndEveryGoodFixIsChecked) {
   for (const json& e : ofType(events, "fix")) EXPECT_EQ(e.at("verdict"), "inside") << e.dump();
 }
 
-/// Runs `command` in the background, kills it with SIGKILL (no chance to save) after `seconds`.
-RunResult killAfter(const std::string& command, double seconds) {
-  return sh(command + " > /dev/null 2>&1 & pid=$!; sleep " + std::to_string(seconds) + "; kill -9 $pid 2>/dev/null; wait $pid; echo status=$?");
+/// Runs `command` in the background and kills it with SIGKILL (no chance to save) once its
+/// database (with its write-ahead log) has grown past 256 KiB — some hundreds of fixes stored,
+/// however slow the build (a sanitizer's) — or after two minutes.
+RunResult killOnceStoring(const std::string& command, const std::string& db) {
+  return sh(command + " > /dev/null 2>&1 & pid=$!; for i in $(seq 1 1200); do "
+                      "s=$(cat '" + db + "' '" + db + "-wal' 2>/dev/null | wc -c); [ \"$s\" -gt 262144 ] && break; "
+                      "kill -0 $pid 2>/dev/null || break; sleep 0.1; done; kill -9 $pid 2>/dev/null; wait $pid; echo status=$?");
 }
 
 TEST_F(TrackCli, KilledAndRestartedTrackerLosesNoAcceptedFix) {
@@ -136,7 +140,7 @@ TEST_F(TrackCli, KilledAndRestartedTrackerLosesNoAcceptedFix) {
   }
   const std::string cmd = kBin + " track --approval " + approval() + " --input " + all + " --db " + db + " --batch 50 --no-replan";
   // WHEN the tracker is killed mid-stream and restarted with the same database and input
-  const RunResult first = killAfter(cmd, 1.0);
+  const RunResult first = killOnceStoring(cmd, db);
   ASSERT_NE(first.out.find("status=137"), std::string::npos) << "the first run ended before the kill: " << first.out;
   // (the report file is moved away: the restarted tracker takes the approval from its database)
   const std::string report = *dir_ + "/approve/report.json";
@@ -189,7 +193,7 @@ TEST_F(TrackCli, KilledNmeaTrackerRestartedWithoutAnIdLosesNoEpoch) {
   // WHEN the tracker is killed mid-stream and restarted on the same database and file
   const std::string cmd = kBin + " track --approval " + report + " --format nmea --input " + all + " --db " + db +
                           " --batch 9 --no-replan";
-  const RunResult first = killAfter(cmd, 1.0);
+  const RunResult first = killOnceStoring(cmd, db);
   ASSERT_NE(first.out.find("status=137"), std::string::npos) << "the first run ended before the kill: " << first.out;
   const RunResult second = sh(cmd + " 2>&1 > /dev/null");
   ASSERT_EQ(second.status, 0) << second.out;

@@ -46,7 +46,7 @@ Approved approveMission(Mission m) {
   a.approver = std::make_shared<Approver>(std::move(m));
   a.report = a.approver->approve();
   EXPECT_TRUE(a.report.approved);
-  a.flight = parseApprovalReport(approvalReportJson(a.report, a.approver->mission()), "report.json");
+  a.flight = parseApprovalReport(nlohmann::json(a.report), "report.json");
   return a;
 }
 
@@ -71,6 +71,17 @@ TrackFix fixAt(const Approver& a, const maps::GpsTime& t, const Eigen::Vector3d&
 
 using test::ofType;
 
+/// The file's SHA-256 as coreutils' sha256sum prints it (an implementation independent of ours).
+std::string sha256sum(const std::string& path) {
+  std::string out;
+  FILE* p = popen(("sha256sum '" + path + "'").c_str(), "r");
+  if (!p) return out;
+  char buf[65] = {};
+  if (std::fread(buf, 1, 64, p) == 64) out.assign(buf, 64);
+  pclose(p);
+  return out;
+}
+
 /// The unit vector across the route's first segment (left of the direction of flight).
 Eigen::Vector3d acrossFirstSegment(const ApprovalReport& r) {
   const Eigen::Vector2d d = (r.route[1].xyz - r.route[0].xyz).head<2>().normalized();
@@ -87,6 +98,33 @@ class TrackerOnExample : public ::testing::Test {
   static Approved* example_;
 };
 Approved* TrackerOnExample::example_ = nullptr;
+
+TEST_F(TrackerOnExample, TheReportsJsonFormReadsBackIntoTheFlightTrackingActsOn) {
+  const ApprovalReport& r = example_->report;
+  const json j = r;
+  const ApprovedFlight f = j.get<ApprovedFlight>();  // from_json: the same reader as a report file
+  EXPECT_TRUE(f.approved);
+  EXPECT_EQ(f.mission_name, r.mission.name);
+  EXPECT_EQ(f.mission_source, kExampleDir + "/mission.json");
+  // The digest is of the mission file as the approver read it (an independent SHA-256 here).
+  ASSERT_FALSE(r.mission.inputs.empty());
+  EXPECT_EQ(r.mission.inputs.front().role, "mission");
+  EXPECT_EQ(f.mission_sha256, sha256sum(kExampleDir + "/mission.json"));
+  EXPECT_EQ(f.departure.week, r.departure.week);
+  EXPECT_NEAR(f.departure.sow, r.departure.sow, 1e-9);
+  ASSERT_EQ(f.route.size(), r.route.size());
+  for (std::size_t i = 0; i < r.route.size(); ++i) {
+    // One rounding rule: 1e-8° (≈ 1 mm) and the millimetre.
+    EXPECT_NEAR(maps::rad2deg(f.route[i].lat_rad), maps::rad2deg(r.route[i].lat_rad), 0.51e-8);
+    EXPECT_NEAR(maps::rad2deg(f.route[i].lon_rad), maps::rad2deg(r.route[i].lon_rad), 0.51e-8);
+    EXPECT_NEAR(f.route[i].h_ell_m, r.route[i].h_ell_m, 0.51e-3);
+    EXPECT_NEAR(f.route[i].eta_s, r.route[i].eta_s, 0.51e-3);
+  }
+  EXPECT_NEAR(f.level1.hal_m, r.limits.level1.hal_m, 0.51e-3);
+  EXPECT_NEAR(f.level2.val_m, r.limits.level2.val_m, 0.51e-3);
+  // A document that is not a report is refused by name.
+  EXPECT_THROW((void)json{{"decision", "maybe"}}.get<ApprovedFlight>(), maps::ParseError);
+}
 
 TEST_F(TrackerOnExample, FixesOnTheRouteWithSmallPlsAreInsideEveryLevel) {
   Tracker tracker;
