@@ -123,7 +123,8 @@ TEST_F(TrackerOnExample, TheReportsJsonFormReadsBackIntoTheFlightTrackingActsOn)
   EXPECT_NEAR(f.level1.hal_m, r.limits.level1.hal_m, 0.51e-3);
   EXPECT_NEAR(f.level2.val_m, r.limits.level2.val_m, 0.51e-3);
   // A document that is not a report is refused by name.
-  EXPECT_THROW((void)json{{"decision", "maybe"}}.get<ApprovedFlight>(), maps::ParseError);
+  const json not_a_report = {{"decision", "maybe"}};
+  EXPECT_THROW((void)not_a_report.get<ApprovedFlight>(), maps::ParseError);
 }
 
 TEST_F(TrackerOnExample, FixesOnTheRouteWithSmallPlsAreInsideEveryLevel) {
