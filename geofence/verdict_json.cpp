@@ -1,6 +1,9 @@
 #include "geofence/verdict_json.hpp"
 
+#include "maps/json_node.hpp"
 #include "maps/json_numbers.hpp"
+
+#include <limits>
 
 namespace skylane::geofence {
 
@@ -27,6 +30,78 @@ void to_json(json& j, const FenceVerdict& v) {
   j["verdict"] = verdictName(v.verdict);
   j["violated"] = v.violated ? json(levelName(*v.violated)) : json(nullptr);
   j["checks"] = v.checks;
+}
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+const std::string kSource = "fence verdict";
+
+Level levelOf(const maps::JsonNode& n) {
+  const std::string s = n.str();
+  for (Level l : {Level::kCorridor, Level::kAirspace, Level::kZone, Level::kObstacle}) {
+    if (s == levelName(l)) return l;
+  }
+  n.fail("level1, level2, zone or obstacle");
+}
+
+Verdict verdictOf(const maps::JsonNode& n) {
+  const std::string s = n.str();
+  for (Verdict v : {Verdict::kInside, Verdict::kOutside, Verdict::kIndeterminate}) {
+    if (s == verdictName(v)) return v;
+  }
+  n.fail("inside, outside or indeterminate");
+}
+
+/// A length of the one form: a number, or null for an unlimited one (the member must be there).
+double metresOf(const maps::JsonNode& n, const char* key) {
+  if (!n.j.contains(key)) (void)n.at(key);  // names the missing member
+  const maps::JsonNode v{n.j.at(key), n.path + "." + key, n.source};
+  return v.j.is_null() ? kInf : v.number();
+}
+
+Check checkOf(const maps::JsonNode& n) {
+  Check c;
+  c.level = levelOf(n.at("level"));
+  c.verdict = verdictOf(n.at("verdict"));
+  c.subject = n.at("subject").str();
+  c.margin_h_m = metresOf(n, "margin_h_m");
+  c.margin_v_m = metresOf(n, "margin_v_m");
+  if (isBoxLevel(c)) {
+    const double segment = n.at("segment").number();
+    if (!(segment >= 0.0) || segment != static_cast<double>(static_cast<std::size_t>(segment))) n.at("segment").fail("a segment index ≥ 0");
+    c.index = static_cast<std::size_t>(segment);
+    c.across_joint = n.at("across_joint").boolean();
+  } else {
+    if (n.has("clearance_m")) c.clearance_m = n.at("clearance_m").number();
+    c.exact = n.at("exact").boolean();
+  }
+  return c;
+}
+
+}  // namespace
+
+void from_json(const json& j, Check& c) {
+  if (!j.is_object()) maps::JsonNode{j, "$", kSource}.fail("a check object");
+  c = checkOf(maps::JsonNode{j, "$", kSource});
+}
+
+void from_json(const json& j, FenceVerdict& v) {
+  const maps::JsonNode root{j, "$", kSource};
+  if (!j.is_object()) root.fail("a verdict object");
+  v = FenceVerdict{};
+  v.verdict = verdictOf(root.at("verdict"));
+  if (root.has("violated")) v.violated = levelOf(root.at("violated"));
+  const maps::JsonNode checks = root.at("checks");
+  for (std::size_t i = 0; i < checks.array().size(); ++i) {
+    const maps::JsonNode c = checks.item(i);
+    if (!c.j.is_object()) c.fail("a check object");
+    v.checks.push_back(checkOf(c));
+    // The deciding check: the first of the violated level with the verdict's outcome.
+    const Check& last = v.checks.back();
+    if (!v.deciding && v.violated && last.level == *v.violated && last.verdict == v.verdict) v.deciding = i;
+  }
+  if (v.violated && !v.deciding) root.at("violated").fail("a level with a check of the verdict's outcome");
 }
 
 json pickMembers(const json& object, std::initializer_list<const char*> keys) {

@@ -20,6 +20,14 @@ namespace skylane::geofence {
 void to_json(nlohmann::json& j, const Check& c);
 void to_json(nlohmann::json& j, const FenceVerdict& v);
 
+/// \brief The one form read back (a zone's or obstacle's index in its scene is not part of it:
+/// 0). A null margin is an unlimited one (+∞).
+/// \throws maps::ParseError naming the JSON path, the value and what was expected.
+void from_json(const nlohmann::json& j, Check& c);
+/// \brief As from_json(Check); `deciding` is the first check of the violated level whose verdict
+/// is the verdict's.
+void from_json(const nlohmann::json& j, FenceVerdict& v);
+
 /// \brief Whether a check is of a box level (corridor or airspace) rather than a zone or obstacle.
 [[nodiscard]] inline bool isBoxLevel(const Check& c) { return c.level == Level::kCorridor || c.level == Level::kAirspace; }
 

@@ -1,12 +1,15 @@
 #include "planner/tracking/track_event.hpp"
 
 #include "geofence/verdict_json.hpp"
+#include "maps/json_node.hpp"
 #include "maps/json_numbers.hpp"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace skylane::planner {
 
@@ -74,6 +77,106 @@ json TrackEvent::toJson() const {
   if (time) j["time"] = maps::formatRfc3339(*time, 3);
   if (fix) to_json(j, *fix);
   return j;
+}
+
+namespace {
+
+const std::string kEventSource = "track event";
+/// The event types the engine writes (TrackEvent::type points at one of them).
+constexpr std::array<const char*, 7> kEventTypes{"fix", "violation", "recovered", "monitoring_rerun",
+                                                 "replan", "stale", "rejected_input"};
+
+const char* eventTypeOf(const maps::JsonNode& n) {
+  const std::string s = n.str();
+  for (const char* t : kEventTypes) {
+    if (s == t) return t;
+  }
+  n.fail("fix, violation, recovered, monitoring_rerun, replan, stale or rejected_input");
+}
+
+PlSource plSourceOf(const maps::JsonNode& n) {
+  const std::string s = n.str();
+  for (PlSource p : {PlSource::kOnboard, PlSource::kRaw, PlSource::kNmeaGst, PlSource::kIns, PlSource::kGnssIns}) {
+    if (s == plSourceName(p)) return p;
+  }
+  n.fail("onboard, raw, nmea_gst, ins or gnss_ins");
+}
+
+/// A box level's part of the fix event ({verdict, margins, segment}) as a check of `level`.
+geofence::Check boxCheckOf(const json& part, geofence::Level level) {
+  json whole = part;
+  whole["level"] = geofence::levelName(level);
+  whole["subject"] = "segment " + std::to_string(part.value("segment", 0));
+  whole["across_joint"] = false;
+  return whole.get<geofence::Check>();
+}
+
+/// A zone's or obstacle's part ({level, subject, verdict, clearance_m}) as a check.
+geofence::Check nearCheckOf(const json& part) {
+  json whole = part;
+  whole["margin_h_m"] = nullptr;
+  whole["margin_v_m"] = nullptr;
+  whole["exact"] = false;
+  return whole.get<geofence::Check>();
+}
+
+/// The members of a fix event that are not the FixRecord's.
+const std::array<const char*, 17> kFixMembers{"line", "lat", "lon", "h_ell_m", "hpl_m", "vpl_m", "pl_source",
+                                              "fault_detected", "excluded", "ins_degraded", "verdict", "violated",
+                                              "levels", "near", "route_version", "rerun", "note"};
+
+}  // namespace
+
+void from_json(const json& j, FixRecord& f) {
+  const maps::JsonNode n{j, "$", kEventSource};
+  f = FixRecord{};
+  f.line = static_cast<std::size_t>(n.at("line").number());
+  f.lat_rad = maps::deg2rad(n.at("lat").number());
+  f.lon_rad = maps::deg2rad(n.at("lon").number());
+  f.h_ell_m = n.at("h_ell_m").number();
+  f.hpl_m = n.has("hpl_m") ? n.at("hpl_m").number() : std::numeric_limits<double>::infinity();
+  f.vpl_m = n.has("vpl_m") ? n.at("vpl_m").number() : std::numeric_limits<double>::infinity();
+  f.pl_source = plSourceOf(n.at("pl_source"));
+  if (n.has("fault_detected")) f.fault_detected = n.at("fault_detected").boolean();
+  if (n.has("excluded")) {
+    const maps::JsonNode ex = n.at("excluded");
+    for (std::size_t i = 0; i < ex.array().size(); ++i) {
+      const auto sat = integrity::parseSatId(ex.item(i).str());
+      if (!sat) ex.item(i).fail("a satellite such as G05 or E11");
+      f.excluded.push_back(*sat);
+    }
+  }
+  if (n.has("ins_degraded")) f.ins_degraded = n.at("ins_degraded").boolean();
+  json verdict{{"verdict", j.at("verdict")}, {"violated", j.value("violated", json())}, {"checks", json::array()}};
+  for (const auto& [name, part] : n.at("levels").j.items()) {
+    const geofence::Level level = name == "level1" ? geofence::Level::kCorridor : geofence::Level::kAirspace;
+    verdict["checks"].push_back(boxCheckOf(part, level));
+  }
+  for (const json& part : n.at("near").array()) verdict["checks"].push_back(nearCheckOf(part));
+  f.verdict = verdict.get<geofence::FenceVerdict>();
+  f.route_version = static_cast<int>(n.at("route_version").number());
+  f.rerun = n.has("rerun") && n.at("rerun").boolean();
+  if (n.has("note")) f.note = n.at("note").str();
+}
+
+void from_json(const json& j, TrackEvent& e) {
+  const maps::JsonNode n{j, "$", kEventSource};
+  if (!j.is_object()) n.fail("an event object");
+  e = TrackEvent{};
+  e.type = eventTypeOf(n.at("event"));
+  if (n.has("flight")) e.flight = n.at("flight").str();
+  if (n.has("time")) {
+    const auto t = maps::parseRfc3339(n.at("time").str());
+    if (!t) n.at("time").fail("an RFC 3339 date-time");
+    e.time = *t;
+  }
+  json body = j;
+  for (const char* k : {"event", "flight", "time"}) body.erase(k);
+  if (e.is("fix")) {
+    e.fix = j.get<FixRecord>();
+    for (const char* k : kFixMembers) body.erase(k);
+  }
+  if (!body.empty()) e.body = std::move(body);
 }
 
 namespace {

@@ -2,7 +2,7 @@
 /// \file
 /// \brief The events of the tracking engine: {"event": type, "flight", "time", …}. A `fix` event
 /// holds a FixRecord (typed: its JSON is made only when it is written); the others their fields
-/// in `body`. One serialisation: toJson(); jsonLine() is the same object written without
+/// in `body`. One serialisation: toJson() (read back by from_json); jsonLine() is the same object written without
 /// building it, for the stream's hot path (a test checks both agree for every event kind).
 
 #include "geofence/fence.hpp"
@@ -59,5 +59,15 @@ struct TrackEvent {
 
 /// \brief FixRecord's members as JSON (merged into the `fix` event's object).
 void to_json(nlohmann::json& j, const FixRecord& f);
+
+/// \brief A `fix` event's members read back. The event shows a part of each check (box levels:
+/// verdict, margins, segment; zones and obstacles: level, subject, verdict, clearance): the
+/// rest takes its default (no joint, not exact, unlimited margins of a zone).
+/// \throws maps::ParseError naming the JSON path, the value and what was expected.
+void from_json(const nlohmann::json& j, FixRecord& f);
+
+/// \brief An event read back from its JSON form: toJson() of the result is the input.
+/// \throws maps::ParseError for an unknown event type or a bad member.
+void from_json(const nlohmann::json& j, TrackEvent& e);
 
 }  // namespace skylane::planner

@@ -159,6 +159,8 @@ TEST_F(TrackerOnExample, JsonLineWritesTheSameEventAsTheJsonObject) {
     for (const TrackEvent& e : tracker.process(f)) {
       // THEN the line parses to the very object toJson builds (members, numbers, nulls)
       EXPECT_EQ(json::parse(e.jsonLine()), e.toJson()) << e.jsonLine();
+      // AND the JSON form reads back into an event that writes it again (from_json)
+      EXPECT_EQ(e.toJson().get<TrackEvent>().toJson(), e.toJson()) << e.jsonLine();
       fixes += e.is("fix");
     }
   }
@@ -245,6 +247,8 @@ TEST_F(TrackerOnExample, PersistentDriftReplansFromTheVehicleWithACorridorClearO
   const auto next = tracker.processJson(fixAt(*example_->approver, r.departure.plus(43), replan_from, 0.5, 0.5, 44));
   EXPECT_EQ(next.back().at("levels").at("level1").at("verdict"), "inside") << next.back().dump();
   EXPECT_EQ(next.back().at("route_version"), 1);
+  // AND every event (fix, violation, monitoring_rerun, replan) reads back into the same JSON
+  for (const json& e : all) EXPECT_EQ(e.get<TrackEvent>().toJson(), e) << e.dump();
 }
 
 TEST_F(TrackerOnExample, ProtectionVolumeTouchingAProhibitedZoneIsReportedAtOnce) {
@@ -290,6 +294,7 @@ TEST_F(TrackerOnExample, BadOrderUnknownFlightsAndStaleFlightsAreReportedAndSkip
   ASSERT_EQ(dup.size(), 1u);
   EXPECT_EQ(dup[0].at("event"), "rejected_input");
   EXPECT_NE(dup[0].at("error").get<std::string>().find("duplicate time"), std::string::npos);
+  EXPECT_EQ(dup[0].get<TrackEvent>().toJson(), dup[0]);  // the JSON form reads back
   auto back = tracker.processJson(fixAt(a, r.departure.plus(9), along(r, 9), 0.5, 0.5, 3));
   EXPECT_NE(back[0].at("error").get<std::string>().find("out of order"), std::string::npos);
   auto jump = tracker.processJson(fixAt(a, r.departure.plus(4000), along(r, 20), 0.5, 0.5, 4));
