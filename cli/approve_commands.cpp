@@ -4,6 +4,7 @@
 #include "cli/zones_commands.hpp"
 #include "maps/file_digest.hpp"
 #include "planner/approval.hpp"
+#include "link/qgc_plan.hpp"
 #include "planner/report_formats.hpp"
 
 #include <nlohmann/json.hpp>
@@ -160,8 +161,12 @@ void runApprove(const ApproveOptions& o) {
     std::ofstream(dir / "route.geojson") << planner::routeGeoJson(r, approver.mission(), approver.frame()).dump(1) << "\n";
     // An operational intent is only for an approved route (F3548 state "Accepted").
     std::filesystem::remove(dir / "operational_intent.json");
+    std::filesystem::remove(dir / "mission.plan");
     if (r.approved) {
       std::ofstream(dir / "operational_intent.json") << planner::operationalIntentJson(r, approver.frame()).dump(1) << "\n";
+      // The route and its fence for a ground station (QGroundControl) to upload to the vehicle,
+      // made from the report as written (so that `plan export report.json` gives the same file).
+      std::ofstream(dir / "mission.plan") << link::qgcPlan(j.get<planner::ApprovedFlight>(), approver).dump(2) << "\n";
     }
   }
   std::cout << j.dump(2) << "\n";
@@ -179,8 +184,8 @@ void addApproveCommands(CLI::App& app) {
                                    "plan a route around active zones, predict its protection levels and approve or reject it");
   c->add_option("mission", o->mission, "mission JSON file")->required()->check(CLI::ExistingFile);
   c->add_option("--out", o->out_dir,
-                 "also write report.json, route.geojson, operational_intent.json (ASTM F3548 Volume4D), map.svg and "
-                 "pl.svg into this directory");
+                 "also write report.json, route.geojson, map.svg and pl.svg into this directory, and for an approved "
+                 "route operational_intent.json (ASTM F3548 Volume4D) and mission.plan (QGroundControl plan)");
   c->add_flag("--progress", o->progress, "print the steps even when stderr is not a terminal");
   c->callback([o]() { runApprove(*o); });
 }

@@ -4,6 +4,7 @@
 #include "cli/approve_commands.hpp"
 #include "cli/fence_commands.hpp"
 #include "cli/integrity_commands.hpp"
+#include "cli/plan_commands.hpp"
 #include "cli/simulate_commands.hpp"
 #include "cli/skymask_commands.hpp"
 #include "cli/track_commands.hpp"
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
   skylane::cli::addSimulateCommands(app);
   skylane::cli::addApproveCommands(app);
   skylane::cli::addTrackCommands(app);
+  skylane::cli::addPlanCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

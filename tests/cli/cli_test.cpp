@@ -424,6 +424,29 @@ TEST(Cli, ApproveWritesTheReportAndItsExchangeFormats) {
   EXPECT_EQ(oi["operational_intent"]["volumes"].size(), j["route"].size() - 1);
 }
 
+TEST(Cli, ApprovePlanAndPlanExportWriteTheSameQgroundcontrolPlan) {
+  // GIVEN an approved mission written with --out
+  const std::string out = test::scratchPath("approve_plan");
+  const std::string example = std::string(SKYLANE_TEST_DATA) + "/../../examples/approve";
+  ASSERT_EQ(run("approve " + example + "/mission.json --out " + out).status, 0);
+  // WHEN its report is exported again, and a rejected report is offered
+  const RunResult r = run("plan export " + out + "/report.json -o " + out + "/export.plan --firmware px4");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::string rejected = test::scratchPath("approve_plan_rejected");
+  (void)run("approve " + example + "/mission_rejected.json --out " + rejected);
+  const RunResult refused = run("plan export " + rejected + "/report.json");
+  // THEN both plans are the same file but for the firmware type, and the rejected route has none
+  std::ifstream a(out + "/mission.plan"), b(out + "/export.plan");
+  json pa = json::parse(a), pb = json::parse(b);
+  EXPECT_EQ(pa["fileType"], "Plan");
+  EXPECT_EQ(pb["mission"]["firmwareType"], 12);  // MAV_AUTOPILOT_PX4
+  pb["mission"]["firmwareType"] = pa["mission"]["firmwareType"];
+  EXPECT_EQ(pa, pb);
+  EXPECT_FALSE(std::filesystem::exists(rejected + "/mission.plan"));
+  EXPECT_EQ(refused.status, 2) << refused.out;
+  EXPECT_NE(refused.out.find("'$.decision'"), std::string::npos) << refused.out;
+}
+
 TEST(Cli, ApproveRejectsAGoalInAProhibitedZoneWithExitOne) {
   const RunResult r = run("approve " + std::string(SKYLANE_TEST_DATA) + "/../../examples/approve/mission_rejected.json");
   EXPECT_EQ(r.status, 1) << r.out;

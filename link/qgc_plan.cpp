@@ -1,0 +1,172 @@
+#include "link/qgc_plan.hpp"
+
+#include "airspace/applicability.hpp"
+#include "geofence/fence.hpp"
+#include "maps/json_numbers.hpp"
+#include "planner/report_formats.hpp"
+
+#include <boost/geometry.hpp>
+#include <boost/geometry/geometries/multi_polygon.hpp>
+#include <boost/geometry/geometries/point_xy.hpp>
+#include <boost/geometry/geometries/polygon.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace skylane::link {
+namespace {
+
+using nlohmann::json;
+using maps::roundToDeg8;
+using maps::roundToMm;
+
+namespace bg = boost::geometry;
+using BgPoint = bg::model::d2::point_xy<double>;
+using BgPolygon = bg::model::polygon<BgPoint, false>;  // counter-clockwise, closed
+using BgMulti = bg::model::multi_polygon<BgPolygon>;
+
+// MAVLink MAV_CMD and MAV_FRAME values (common.xml), QGroundControl's AltitudeMode.
+constexpr int kNavWaypoint = 16;
+constexpr int kNavLand = 21;
+constexpr int kNavTakeoff = 22;
+constexpr int kFrameGlobalAmsl = 0;      ///< MAV_FRAME_GLOBAL: altitude above mean sea level
+constexpr int kQgcAltitudeAbsolute = 2;  ///< QGroundControl AltMode "Absolute" (frame 0)
+
+/// A SimpleItem: one MISSION_ITEM with its seven parameters (null where NaN).
+json simpleItem(int command, int jump_id, const std::array<double, 4>& p1to4, double lat_rad, double lon_rad, double alt_amsl_m) {
+  json params = json::array();
+  for (double p : p1to4) params.push_back(std::isfinite(p) ? json(p) : json(nullptr));
+  params.push_back(roundToDeg8(lat_rad));
+  params.push_back(roundToDeg8(lon_rad));
+  params.push_back(roundToMm(alt_amsl_m));
+  return {{"AMSLAltAboveTerrain", nullptr}, {"Altitude", roundToMm(alt_amsl_m)}, {"AltitudeMode", kQgcAltitudeAbsolute},
+          {"autoContinue", true}, {"command", command}, {"doJumpId", jump_id}, {"frame", kFrameGlobalAmsl},
+          {"params", params}, {"type", "SimpleItem"}};
+}
+
+/// The ground's AMSL height under a mission stop: the stop is at cruise height above the ground
+/// (ellipsoidal); the geoid undulation is the route point's own h_ell − alt_amsl.
+double groundAmsl(const Eigen::Vector3d& stop, double cruise_agl_m, const planner::RoutePoint& near) {
+  return stop.z() - cruise_agl_m - (near.h_ell_m - near.alt_amsl_m);
+}
+
+json missionItems(const planner::ApprovedFlight& r, const planner::Approver& a) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<planner::RoutePoint>& route = r.route;
+  json items = json::array();
+  int id = 0;
+  items.push_back(simpleItem(kNavTakeoff, ++id, {0.0, 0.0, 0.0, nan}, route.front().lat_rad, route.front().lon_rad,
+                             route.front().alt_amsl_m));
+  for (std::size_t i = 1; i < route.size(); ++i) {
+    items.push_back(simpleItem(kNavWaypoint, ++id, {0.0, r.level1.hal_m, 0.0, nan}, route[i].lat_rad, route[i].lon_rad,
+                               route[i].alt_amsl_m));
+  }
+  const double land_m = groundAmsl(a.missionStops().back(), a.mission().cruise_agl_m, route.back());
+  items.push_back(simpleItem(kNavLand, ++id, {0.0, 0.0, 0.0, nan}, route.back().lat_rad, route.back().lon_rad, land_m));
+  return items;
+}
+
+/// [[lat, lon], …] of a ring given counter-clockwise, written clockwise.
+json clockwiseLatLon(std::vector<json> ccw) {
+  std::reverse(ccw.begin(), ccw.end());
+  return json(std::move(ccw));
+}
+
+json inclusionPolygon(const planner::ApprovedFlight& r, const maps::PlaneFrame& frame) {
+  std::vector<json> ring;
+  for (const Eigen::Vector2d& xy : airspaceOutline(r.route, r.level2.hal_m)) {
+    const Eigen::Vector2d ll = frame.toLatLon(xy);
+    ring.push_back({roundToDeg8(ll.x()), roundToDeg8(ll.y())});
+  }
+  return {{"inclusion", true}, {"polygon", clockwiseLatLon(std::move(ring))}, {"version", 1}};
+}
+
+/// The counted zones active at some instant of the flight, one fence per volume.
+void addExclusions(const planner::ApprovedFlight& r, const planner::Approver& a, json& polygons, json& circles) {
+  const maps::GpsTime t0 = r.departure, t1 = r.departure.plus(r.route.back().eta_s);
+  const geofence::ZonePolicy& policy = a.obstructions().policy();
+  for (const airspace::Zone& z : a.obstructions().zones()) {
+    if (!geofence::counts(z, policy) || !airspace::isActiveDuring(z, t0, t1)) continue;
+    for (const airspace::Volume& v : z.volumes) {
+      const airspace::Outline& o = v.outline;
+      if (o.kind == airspace::Outline::Kind::kCircle) {
+        circles.push_back({{"circle", {{"center", {roundToDeg8(o.centre.lat_rad), roundToDeg8(o.centre.lon_rad)}},
+                                       {"radius", roundToMm(o.radius_m)}}},
+                           {"inclusion", false},
+                           {"version", 1}});
+        continue;
+      }
+      std::vector<json> ring;
+      for (const airspace::LatLon& p : o.ring) ring.push_back({roundToDeg8(p.lat_rad), roundToDeg8(p.lon_rad)});
+      polygons.push_back({{"inclusion", false}, {"polygon", clockwiseLatLon(std::move(ring))}, {"version", 1}});
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector2d> airspaceOutline(const std::vector<planner::RoutePoint>& route, double hal_m) {
+  BgMulti merged;
+  for (std::size_t i = 1; i < route.size(); ++i) {
+    BgPolygon box;
+    for (const Eigen::Vector2d& p : planner::segmentOutline(route[i - 1].xyz, route[i].xyz, hal_m)) {
+      bg::append(box.outer(), BgPoint(p.x(), p.y()));
+    }
+    bg::correct(box);  // closes the ring
+    BgMulti out;
+    bg::union_(merged, box, out);
+    merged = std::move(out);
+  }
+  if (merged.empty()) return {};
+  // Consecutive boxes overlap around their shared point: the union is one polygon. (A route that
+  // loops back on itself encloses a hole, which the outer ring does not exclude.)
+  const auto largest = std::max_element(merged.begin(), merged.end(),
+                                        [](const BgPolygon& x, const BgPolygon& y) { return bg::area(x) < bg::area(y); });
+  std::vector<Eigen::Vector2d> ring;
+  for (const BgPoint& p : largest->outer()) ring.emplace_back(p.x(), p.y());
+  if (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
+  return ring;
+}
+
+nlohmann::json qgcPlan(const planner::ApprovalReport& report, const planner::Approver& approver, const PlanVehicle& vehicle) {
+  planner::ApprovedFlight flight;
+  flight.approved = report.approved;
+  flight.departure = report.departure;
+  flight.route = report.route;
+  flight.level1 = report.limits.level1;
+  flight.level2 = report.limits.level2;
+  return qgcPlan(flight, approver, vehicle);
+}
+
+nlohmann::json qgcPlan(planner::ApprovedFlight report, const planner::Approver& approver, const PlanVehicle& vehicle) {
+  if (report.route.size() < 2) throw std::invalid_argument("qgcPlan: the report has no route of two points or more");
+  for (planner::RoutePoint& p : report.route) {  // the map frame of the mission (a report file has none)
+    const Eigen::Vector2d xy = approver.frame().toPlane(p.lat_rad, p.lon_rad);
+    p.xyz = Eigen::Vector3d(xy.x(), xy.y(), p.h_ell_m);
+  }
+  const planner::Mission& m = approver.mission();
+  const double home_m = groundAmsl(approver.missionStops().front(), m.cruise_agl_m, report.route.front());
+  const planner::MissionPoint& start = m.points.front();
+  json mission = {{"cruiseSpeed", m.cruise_speed_mps},
+                  {"firmwareType", vehicle.firmware_type},
+                  {"globalPlanAltitudeMode", kQgcAltitudeAbsolute},
+                  {"hoverSpeed", m.cruise_speed_mps},
+                  {"items", missionItems(report, approver)},
+                  {"plannedHomePosition", {roundToDeg8(start.lat_rad), roundToDeg8(start.lon_rad), roundToMm(home_m)}},
+                  {"vehicleType", vehicle.vehicle_type},
+                  {"version", 2}};
+  json polygons = json::array({inclusionPolygon(report, approver.frame())});
+  json circles = json::array();
+  addExclusions(report, approver, polygons, circles);
+  return {{"fileType", "Plan"},
+          {"geoFence", {{"circles", circles}, {"polygons", polygons}, {"version", 2}}},
+          {"groundStation", "skylane"},
+          {"mission", mission},
+          {"rallyPoints", {{"points", json::array()}, {"version", 2}}},
+          {"version", 1}};
+}
+
+}  // namespace skylane::link
