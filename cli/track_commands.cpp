@@ -7,6 +7,7 @@
 #include "integrity/gnss/nmea.hpp"
 #include "integrity/raim/spp.hpp"
 #include "integrity/sim/scenario.hpp"
+#include "link/mavlink/fix_source.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
@@ -41,6 +42,7 @@ struct TrackOptions {
   std::vector<std::string> approvals;
   std::string input = "-";
   std::string format = "jsonl";
+  int baud = 57600;
   std::vector<std::string> navs;
   std::string date;
   std::string db;
@@ -204,8 +206,8 @@ void addApprovals(planner::TrackingSession& session, const TrackOptions& o) {
   }
   const planner::Tracker& tracker = session.tracker();
   if (tracker.flights().empty()) throw ParseError("--approval", 0, "--approval", "", "at least one approval report");
-  if ((o.format == "nmea" || o.format == "rinex") && tracker.flights().size() != 1) {
-    throw ParseError("--format", 0, "--format", o.format, "one approval (an NMEA or RINEX stream is one vehicle)");
+  if ((o.format == "nmea" || o.format == "rinex" || o.format == "mavlink") && tracker.flights().size() != 1) {
+    throw ParseError("--format", 0, "--format", o.format, "one approval (an NMEA, RINEX or MAVLink stream is one vehicle)");
   }
 }
 
@@ -220,6 +222,9 @@ std::unique_ptr<planner::FixSource> openFixSource(const TrackOptions& o, const p
     cfg.model = m.model;
     cfg.elevation_mask_rad = maps::deg2rad(m.mask_deg);
     return std::make_unique<planner::RinexReplayFixSource>(o.input, o.navs, cfg);
+  }
+  if (o.format == "mavlink") {
+    return std::make_unique<link::mavlink::MavlinkFixSource>(link::openByteLink(o.input, o.baud), std::string());
   }
   std::unique_ptr<planner::LineInput> in = planner::openLineInput(o.input);
   if (o.format == "jsonl") return std::make_unique<planner::JsonLinesFixSource>(std::move(in));
@@ -261,8 +266,8 @@ void drawRoutes(TrackMap& map, const planner::Tracker& tracker) {
 }
 
 void runTrack(const TrackOptions& o) {
-  if (o.format != "jsonl" && o.format != "nmea" && o.format != "rinex") {
-    throw ParseError("--format", 0, "--format", o.format, "jsonl, nmea or rinex");
+  if (o.format != "jsonl" && o.format != "nmea" && o.format != "rinex" && o.format != "mavlink") {
+    throw ParseError("--format", 0, "--format", o.format, "jsonl, nmea, rinex or mavlink");
   }
   auto log = [](const std::string& m) { std::cerr << "skylane: track: " << m << "\n"; };
   planner::TrackingSession session(trackerOptions(o), o.db.empty() ? nullptr : std::make_unique<planner::TrackStore>(o.db),
@@ -372,8 +377,10 @@ void addTrackCommands(CLI::App& app) {
       "track", "live corridor tracking: check each fix against its corridor, airspace and zones; rerun monitoring; replan");
   c->add_option("--approval", o->approvals, "approval report (skylane approve --out DIR: DIR/report.json), as [ID=]FILE; repeatable")
       ->required();
-  c->add_option("--input", o->input, "FILE, - (stdin) or udp://127.0.0.1:PORT");
-  c->add_option("--format", o->format, "jsonl, nmea (GGA + GST [+ GBS]) or rinex (observation replay; needs --nav)");
+  c->add_option("--input", o->input, "FILE, - (stdin), udp://127.0.0.1:PORT or (mavlink) a serial device");
+  c->add_option("--format", o->format,
+                "jsonl, nmea (GGA + GST [+ GBS]), rinex (observation replay; needs --nav) or mavlink (MAVLink 1/2 telemetry)");
+  c->add_option("--baud", o->baud, "serial device speed for --format mavlink (default 57600)");
   c->add_option("--nav", o->navs, "RINEX navigation file(s) for --format rinex");
   c->add_option("--date", o->date, "UTC date YYYY-MM-DD of an NMEA stream without RMC/ZDA");
   c->add_option("--db", o->db, "SQLite database: approvals, flight states and events; a restart resumes from it");

@@ -96,10 +96,11 @@ const char* eventTypeOf(const maps::JsonNode& n) {
 
 PlSource plSourceOf(const maps::JsonNode& n) {
   const std::string s = n.str();
-  for (PlSource p : {PlSource::kOnboard, PlSource::kRaw, PlSource::kNmeaGst, PlSource::kIns, PlSource::kGnssIns}) {
+  for (PlSource p : {PlSource::kOnboard, PlSource::kRaw, PlSource::kNmeaGst, PlSource::kIns, PlSource::kGnssIns,
+                     PlSource::kMavlinkAccuracy}) {
     if (s == plSourceName(p)) return p;
   }
-  n.fail("onboard, raw, nmea_gst, ins or gnss_ins");
+  n.fail("onboard, raw, nmea_gst, ins, gnss_ins or mavlink_accuracy");
 }
 
 /// A box level's part of the fix event ({verdict, margins, segment}) as a check of `level`.

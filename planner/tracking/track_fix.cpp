@@ -24,6 +24,7 @@ const char* plSourceName(PlSource s) {
     case PlSource::kNmeaGst: return "nmea_gst";
     case PlSource::kIns: return "ins";
     case PlSource::kGnssIns: return "gnss_ins";
+    case PlSource::kMavlinkAccuracy: return "mavlink_accuracy";
   }
   return "?";
 }

@@ -69,10 +69,11 @@ struct ImuRecord {
 };
 
 /// \brief Where a fix's protection levels came from.
-enum class PlSource { kOnboard, kRaw, kNmeaGst, kIns, kGnssIns };
+enum class PlSource { kOnboard, kRaw, kNmeaGst, kIns, kGnssIns, kMavlinkAccuracy };
 
 /// \brief "onboard", "raw", "nmea_gst", "ins" (the INS σ block alone), "gnss_ins" (the fault-mode
-/// flow over the fix's pseudoranges and IMU increments).
+/// flow over the fix's pseudoranges and IMU increments), "mavlink_accuracy" (a MAVLink GPS
+/// message's h_acc/v_acc, link/mavlink/fix_source.hpp).
 [[nodiscard]] const char* plSourceName(PlSource s);
 
 /// \brief One fix of a stream.

@@ -72,11 +72,14 @@ void TrackingSession::emit(const std::vector<TrackEvent>& events) {
 }
 
 void TrackingSession::checkpoint(bool force) {
-  if (!store_ || (!force && pending_ < batch_)) return;
-  for (const std::string& id : touched_) store_->putState(id, flightStateJson(tracker_.state(id)), tracker_.routeJson(id));
-  touched_.clear();
-  if (source_ && resumable_) store_->setInputLine(source_->name(), source_->checkpointLine());
-  store_->commit();
+  if (!force && pending_ < batch_) return;
+  if (store_) {
+    for (const std::string& id : touched_) store_->putState(id, flightStateJson(tracker_.state(id)), tracker_.routeJson(id));
+    touched_.clear();
+    if (source_ && resumable_) store_->setInputLine(source_->name(), source_->checkpointLine());
+    store_->commit();
+  }
+  // The other sinks see each batch too, and a quiet live input's last events at once.
   for (EventSink* sink : sinks_) {
     if (sink != store_.get()) sink->flush();
   }

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <algorithm>
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include <set>
 #include <sstream>
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace skylane {
 namespace {
@@ -118,6 +120,47 @@ TEST_F(TrackCli, GarbageAndTruncatedLinesAreReportedAndEveryGoodFixIsChecked) {
   for (const json& e : ofType(events, "rejected_input")) rejected.insert(e.at("line").get<int>());
   EXPECT_EQ(rejected, bad_lines);
   for (const json& e : ofType(events, "fix")) EXPECT_EQ(e.at("verdict"), "inside") << e.dump();
+}
+
+TEST_F(TrackCli, MavlinkTelemetryOverUdpFromAnIndependentVehicleIsTracked) {
+  // GIVEN skylane tracking on a UDP port and a vehicle written on node-mavlink flying the approved
+  // route for 30 s at 5 Hz (h_acc 150 mm, v_acc 200 mm), with junk bytes, a frame with a flipped
+  // bit and a truncated copy of a frame among its datagrams
+  const int port = 20000 + static_cast<int>(getpid() % 20000);
+  char hex_port[8];
+  std::snprintf(hex_port, sizeof hex_port, "%04X", port);
+  const std::string events = *dir_ + "/mavlink_events.jsonl", err = *dir_ + "/mavlink_err.txt";
+  const std::string report = *dir_ + "/approve/report.json";
+  const std::string vehicle = std::string(SKYLANE_TEST_DATA) + "/../link/js/vehicle.mjs";
+  const RunResult r = sh(kBin + " track --approval " + report + " --format mavlink --input udp://127.0.0.1:" + std::to_string(port) +
+                         " --no-replan > " + events + " 2> " + err + " & pid=$!\n"
+                         // WHEN the tracker listens (its port is in /proc/net/udp), the vehicle flies
+                         "for i in $(seq 1 300); do grep -qi ':" + hex_port + " ' /proc/net/udp && break; sleep 0.1; done\n"
+                         "node " + vehicle + " --report " + report + " --port " + std::to_string(port) + " --seconds 30 --garbage || echo vehicle-failed\n"
+                         // and the tracker is stopped once it has written its fixes (or after a minute)
+                         "for i in $(seq 1 600); do [ $(grep -c '\"event\":\"fix\"' " + events + ") -ge 150 ] && break; sleep 0.1; done\n"
+                         "kill -TERM $pid; wait $pid; echo status=$?");
+  ASSERT_EQ(r.out.find("vehicle-failed"), std::string::npos) << r.out;
+  std::ifstream err_in(err);
+  const std::string stderr_text((std::istreambuf_iterator<char>(err_in)), std::istreambuf_iterator<char>());
+  ASSERT_NE(r.out.find("status=0"), std::string::npos) << r.out << stderr_text;
+  // THEN every GPS_RAW_INT but the corrupted one is a fix inside the corridor, its PLs from the
+  // accuracies by the documented rule (HPL = √(−2 ln 2e-9)·0.15 m, VPL = Q⁻¹(4.9e-8)·0.2 m)
+  const auto all = readEvents(events);
+  const auto fixes = ofType(all, "fix");
+  EXPECT_EQ(fixes.size(), 150u);
+  for (const json& f : fixes) {
+    EXPECT_EQ(f.at("pl_source"), "mavlink_accuracy");
+    EXPECT_EQ(f.at("verdict"), "inside") << f.dump();
+    EXPECT_NEAR(f.at("hpl_m").get<double>(), std::sqrt(-2.0 * std::log(2e-9)) * 0.15, 2e-3);
+    EXPECT_NEAR(f.at("vpl_m").get<double>(), 5.3314 * 0.2, 2e-3);
+  }
+  // AND the bad bytes are reported, not fatal
+  const auto rejected = ofType(all, "rejected_input");
+  ASSERT_GE(rejected.size(), 1u);
+  bool bad_checksum = false;
+  for (const json& e : rejected) bad_checksum = bad_checksum || e.at("error").get<std::string>().find("bad checksum") != std::string::npos;
+  EXPECT_TRUE(bad_checksum) << rejected.front().dump();
 }
 
 /// Runs `command` in the background and kills it with SIGKILL (no chance to save) once its
