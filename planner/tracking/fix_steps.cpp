@@ -422,6 +422,17 @@ void writeFixEvent(const TrackedFlight& f, FixWork& w) {
 namespace {
 
 /// An approved replan becomes the flight's route: both box levels, a new version, empty windows.
+/// Whether a replan must wait for the vehicle to take the current route: the link's answer is
+/// awaited, or it has neither joined the route (cleared in replanIfPersistent) nor run out of
+/// join_timeout_s.
+bool handoffHolds(const TrackerOptions& o, FlightState& st, const maps::GpsTime& t) {
+  if (!st.handoff_since) return false;
+  if (st.handoff_awaits_link) return true;
+  if (t - *st.handoff_since < o.join_timeout_s) return true;
+  st.handoff_since.reset();  // not joined in time: the route may be replanned again
+  return false;
+}
+
 void takeNewRoute(TrackedFlight& f, const ApprovalReport& r, TrackEvent& rp) {
   json intent = operationalIntentJson(r, f.approver->frame());
   rp["operational_intent"] = std::move(intent["operational_intent"]);
@@ -437,6 +448,21 @@ void takeNewRoute(TrackedFlight& f, const ApprovalReport& r, TrackEvent& rp) {
 }
 
 }  // namespace
+
+void holdReplanForHandoff(const TrackerOptions& o, TrackedFlight& f, FixWork& w) {
+  FlightState& st = f.st;
+  if (st.handoff_since && !st.handoff_awaits_link) {
+    // Joined: as many fixes in a row inside the route's level-1 corridor as the persistence
+    // window holds (a vehicle still flying its old route crosses the new corridor, it does not stay).
+    const bool inside = worstVerdict(w.verdict, geofence::Level::kCorridor) == geofence::Verdict::kInside;
+    st.handoff_inside = inside ? st.handoff_inside + 1 : 0;
+    if (st.handoff_inside >= o.level1_n) st.handoff_since.reset();
+  }
+  if (!w.trigger || !o.replan || st.arrived || !handoffHolds(o, st, w.fix.time)) return;
+  w.note += std::string(w.note.empty() ? "" : "; ") + "replan held: the vehicle has not yet taken route " +
+            std::to_string(st.route_version) + (st.handoff_awaits_link ? " (awaiting the link's answer)" : "");
+  w.trigger.reset();
+}
 
 void replanIfPersistent(const TrackerOptions& o, TrackedFlight& f, FixWork& w) {
   FlightState& st = f.st;
@@ -463,7 +489,12 @@ void replanIfPersistent(const TrackerOptions& o, TrackedFlight& f, FixWork& w) {
   }
   rp["decision"] = r.approved ? "approved" : "rejected";
   rp.body["report"].erase("predicted");  // the samples stay in the tracker's database with the route
-  if (r.approved) takeNewRoute(f, r, rp);
+  if (r.approved) {
+    takeNewRoute(f, r, rp);
+    st.handoff_since = fix.time;
+    st.handoff_awaits_link = o.handoff_by_link;
+    st.handoff_inside = 0;
+  }
   rp["route_version"] = st.route_version;
   rp["planning_time_s"] = std::round(r.elapsed_s * 1e4) / 1e4;
   w.out.push_back(std::move(rp));

@@ -79,6 +79,10 @@ void updatePersistence(const TrackerOptions& o, TrackedFlight& f, FixWork& w);
 void updateProgress(const TrackerOptions& o, TrackedFlight& f, const FixWork& w);
 /// \brief Step 7: the `fix` event.
 void writeFixEvent(const TrackedFlight& f, FixWork& w);
+/// \brief Step 6b: a persistent violation does not replan while the vehicle has not yet taken
+/// the current route (the link's answer awaited, or neither joined nor join_timeout_s over):
+/// the fix's note says so. A fix inside the route's level-1 corridor ends the wait.
+void holdReplanForHandoff(const TrackerOptions& o, TrackedFlight& f, FixWork& w);
 /// \brief Step 8: the replan decision, and the replan from where the vehicle is.
 void replanIfPersistent(const TrackerOptions& o, TrackedFlight& f, FixWork& w);
 

@@ -25,6 +25,9 @@ json flightStateJson(const FlightState& s) {
   j["reruns"] = s.rerun_count;
   j["replans"] = s.replans;
   j["clock_offset_s"] = s.clock_offset_s;
+  j["handoff_since"] = s.handoff_since ? json(maps::formatRfc3339(*s.handoff_since, 3)) : json(nullptr);
+  j["handoff_awaits_link"] = s.handoff_awaits_link;
+  j["handoff_inside"] = s.handoff_inside;
   return j;
 }
 
@@ -52,6 +55,9 @@ FlightState parseFlightState(const json& j, const std::string& source) {
     s.rerun_count = j.at("reruns").get<std::uint64_t>();
     s.replans = j.at("replans").get<std::uint64_t>();
     s.clock_offset_s = j.value("clock_offset_s", 0.0);
+    s.handoff_since = time("handoff_since");
+    s.handoff_awaits_link = j.value("handoff_awaits_link", false);
+    s.handoff_inside = j.value("handoff_inside", 0);
   } catch (const nlohmann::json::exception& e) {
     throw maps::ParseError(source, 0, "$", maps::quoteJson(j), std::string("a tracker flight state (") + e.what() + ")");
   }

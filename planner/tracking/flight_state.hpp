@@ -31,6 +31,11 @@ struct FlightState {
   double clock_offset_s = 0.0;
   std::optional<maps::GpsTime> jump_candidate;  ///< the last fix refused for a time jump (not stored)
   int jump_count = 0;
+  /// Since a replan (or the link's acknowledgement): the vehicle has not yet taken the current
+  /// route, and replans are held (tracker.hpp, join_timeout_s).
+  std::optional<maps::GpsTime> handoff_since;
+  bool handoff_awaits_link = false;  ///< the link's answer is still awaited
+  int handoff_inside = 0;            ///< fixes in a row inside the route's level 1 while waiting
 };
 
 /// \brief FlightState as JSON and back (the tracker database keeps it).

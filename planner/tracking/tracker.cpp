@@ -100,6 +100,20 @@ std::vector<std::string> Tracker::flights() const {
 
 std::string Tracker::onlyFlight() const { return flights_.size() == 1 ? flights_.begin()->first : std::string(); }
 
+void Tracker::handoffResult(const std::string& id, int route_version, bool acknowledged, const maps::GpsTime& t) {
+  const auto it = flights_.find(id);
+  if (it == flights_.end()) return;
+  FlightState& st = it->second->st;
+  if (route_version != st.route_version || !st.handoff_awaits_link) return;
+  st.handoff_awaits_link = false;
+  st.handoff_inside = 0;
+  if (acknowledged) {
+    st.handoff_since = t;  // the vehicle flies to the new route now: it has join_timeout_s to get there
+  } else {
+    st.handoff_since.reset();
+  }
+}
+
 const FlightState& Tracker::state(const std::string& id) const { return flights_.at(id)->st; }
 
 const Approver& Tracker::approver(const std::string& id) const { return *flights_.at(id)->approver; }
@@ -213,6 +227,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   rerunMonitoring(options_, f, w);
   updatePersistence(options_, f, w);
   updateProgress(options_, f, w);
+  holdReplanForHandoff(options_, f, w);
   writeFixEvent(f, w);
   replanIfPersistent(options_, f, w);
   return std::move(w.out);

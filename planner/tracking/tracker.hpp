@@ -68,6 +68,10 @@ struct TrackerOptions {
   int jump_confirm = 3;             ///< fixes in order on a jumped timeline before it is taken
   double waypoint_radius_m = 30.0;  ///< a mission waypoint is passed once a fix comes this close
   double horizon_m = 50.0;          ///< zones and obstacles this near a volume are listed in its fix event
+  /// After a replan the next one waits until the vehicle has taken the new route: a link's
+  /// acknowledgement (handoff_by_link), then a fix inside the new level-1 corridor — or this long.
+  double join_timeout_s = 60.0;
+  bool handoff_by_link = false;     ///< a link uploads each new route and reports the vehicle's answer
 };
 
 /// \brief Tracks many flights in one process.
@@ -100,6 +104,12 @@ class Tracker {
   [[nodiscard]] TrackEvent rejectedInput(const std::string& source, std::size_t line, const std::string& why) const;
   /// \brief `stale` events for flights silent for stale_after_s before `now` (stream time).
   [[nodiscard]] std::vector<TrackEvent> sweepStale(const maps::GpsTime& now);
+
+  /// \brief The vehicle's answer to the upload of route `route_version` (handoff_by_link):
+  /// acknowledged, the replan hold waits for it to join the route (join_timeout_s from `t`);
+  /// refused or timed out, the hold ends and a persistent violation may replan again. An answer
+  /// for another route version than the current one is ignored.
+  void handoffResult(const std::string& id, int route_version, bool acknowledged, const maps::GpsTime& t);
 
   /// \brief The ids of the flights tracked.
   [[nodiscard]] std::vector<std::string> flights() const;

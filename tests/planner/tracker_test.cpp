@@ -251,6 +251,65 @@ TEST_F(TrackerOnExample, PersistentDriftReplansFromTheVehicleWithACorridorClearO
   for (const json& e : all) EXPECT_EQ(e.get<TrackEvent>().toJson(), e) << e.dump();
 }
 
+/// Replans of a vehicle pushed 8 m aside by a 14 s gust (t = 40–53 s) that then flies on along
+/// its approved route to t = 160 s: its autopilot never got a new route (no link).
+int replansOfAVehicleThatIgnoresThem(const Approved& a, double join_timeout_s) {
+  TrackerOptions opt;
+  opt.join_timeout_s = join_timeout_s;
+  Tracker tracker(opt);
+  tracker.addFlight("F1", a.flight, a.approver);
+  const ApprovalReport& r = a.report;
+  const Eigen::Vector3d side = acrossFirstSegment(r);
+  int replans = 0;
+  for (int k = 0; k <= 160; ++k) {
+    const Eigen::Vector3d p = along(r, k) + (k >= 40 && k < 54 ? 8.0 : 0.0) * side;
+    for (const TrackEvent& e : tracker.process(fixAt(*a.approver, r.departure.plus(k), p, 0.5, 0.5, k + 1))) replans += e.is("replan");
+  }
+  return replans;
+}
+
+TEST_F(TrackerOnExample, AReplanWaitsForTheVehicleToJoinTheNewRouteOrForTheJoinTimeout) {
+  // Without the wait (the 10 s cooldown alone) every new route is replanned again as soon as
+  // the persistence window refills: the cascade of a vehicle that never got the route.
+  const int cascade = replansOfAVehicleThatIgnoresThem(*example_, 0.0);
+  const int damped = replansOfAVehicleThatIgnoresThem(*example_, 60.0);
+  const int never = replansOfAVehicleThatIgnoresThem(*example_, 1e9);
+  EXPECT_EQ(cascade, 5);
+  EXPECT_EQ(damped, 3);
+  // Waiting for ever, two remain: the pushed vehicle runs parallel to the first new route, which
+  // starts where it was, for the five fixes that count as joining it; back on its old route it is
+  // off the new one, and that persistent violation replans once more, onto the old route.
+  EXPECT_EQ(never, 2);
+}
+
+TEST_F(TrackerOnExample, WithALinkTheReplanWaitsForTheVehiclesAnswer) {
+  TrackerOptions opt;
+  opt.handoff_by_link = true;
+  opt.join_timeout_s = 1e9;
+  Tracker tracker(opt);
+  tracker.addFlight("F1", example_->flight, example_->approver);
+  const ApprovalReport& r = example_->report;
+  const Eigen::Vector3d side = acrossFirstSegment(r);
+  int replans = 0;
+  std::string held_note;
+  auto fly = [&](int from, int to) {
+    for (int k = from; k <= to; ++k) {
+      const Eigen::Vector3d p = along(r, k) + (k >= 40 ? 8.0 : 0.0) * side;
+      for (const TrackEvent& e : tracker.process(fixAt(*example_->approver, r.departure.plus(k), p, 0.5, 0.5, k + 1))) {
+        replans += e.is("replan");
+        if (e.is("fix") && e.fix->note.find("replan held") != std::string::npos) held_note = e.fix->note;
+      }
+    }
+  };
+  fly(0, 80);
+  EXPECT_EQ(replans, 1);
+  EXPECT_NE(held_note.find("awaiting the link's answer"), std::string::npos) << held_note;
+  // The vehicle refuses the upload: the hold ends, and the persistent violation replans again.
+  tracker.handoffResult("F1", tracker.state("F1").route_version, false, r.departure.plus(80));
+  fly(81, 100);
+  EXPECT_EQ(replans, 2);
+}
+
 TEST_F(TrackerOnExample, ProtectionVolumeTouchingAProhibitedZoneIsReportedAtOnce) {
   TrackerOptions opt;
   opt.replan = false;
