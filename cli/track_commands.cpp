@@ -8,6 +8,7 @@
 #include "integrity/raim/spp.hpp"
 #include "integrity/sim/scenario.hpp"
 #include "link/mavlink/fix_source.hpp"
+#include "link/mavlink/handoff.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
@@ -16,6 +17,8 @@
 #include "planner/tracking/tracker.hpp"
 #include "planner/tracking/tracking_session.hpp"
 
+
+#include <sys/stat.h>
 
 #include <atomic>
 #include <csignal>
@@ -43,6 +46,7 @@ struct TrackOptions {
   std::string input = "-";
   std::string format = "jsonl";
   int baud = 57600;
+  bool no_handoff = false;
   std::vector<std::string> navs;
   std::string date;
   std::string db;
@@ -188,8 +192,16 @@ std::pair<int, int> parseMofN(const std::string& text, const char* option) {
 }
 
 /// The tracker's options from the command line (the M/N rules, --no-replan).
+/// Whether the vehicle can be answered on the input: a MAVLink stream over UDP or a serial device.
+bool linkCanUpload(const TrackOptions& o) {
+  if (o.format != "mavlink" || o.no_handoff) return false;
+  struct stat info {};
+  return o.input.rfind("udp://", 0) == 0 || (stat(o.input.c_str(), &info) == 0 && S_ISCHR(info.st_mode));
+}
+
 planner::TrackerOptions trackerOptions(const TrackOptions& o) {
   planner::TrackerOptions topt = o.tracker;
+  topt.handoff_by_link = linkCanUpload(o);
   std::tie(topt.level1_m, topt.level1_n) = parseMofN(o.level1, "--level1");
   std::tie(topt.level2_m, topt.level2_n) = parseMofN(o.level2, "--level2");
   topt.replan = !o.no_replan;
@@ -286,6 +298,13 @@ void runTrack(const TrackOptions& o) {
   if (!o.map.empty()) session.addSink(track_map);
   installStopSignals(session.stopFlag());
   const std::unique_ptr<planner::FixSource> source = openFixSource(o, session.tracker());
+  // A MAVLink vehicle gets each new route and fence by the mission protocol on the same link.
+  std::unique_ptr<link::mavlink::MavlinkHandoff> handoff;
+  if (session.tracker().options().handoff_by_link) {
+    handoff = std::make_unique<link::mavlink::MavlinkHandoff>(dynamic_cast<link::mavlink::MavlinkFixSource&>(*source), session.tracker());
+    session.addSink(*handoff);
+    session.addTicker([h = handoff.get()] { return h->tick(); });
+  }
   const planner::SessionSummary sum = session.run(*source);
   if (!o.map.empty()) {
     std::ofstream(o.map) << track_map.svg(session.tracker());
@@ -381,6 +400,9 @@ void addTrackCommands(CLI::App& app) {
   c->add_option("--format", o->format,
                 "jsonl, nmea (GGA + GST [+ GBS]), rinex (observation replay; needs --nav) or mavlink (MAVLink 1/2 telemetry)");
   c->add_option("--baud", o->baud, "serial device speed for --format mavlink (default 57600)");
+  c->add_flag("--no-handoff", o->no_handoff, "--format mavlink: do not upload replanned routes to the vehicle");
+  c->add_option("--join-timeout", o->tracker.join_timeout_s,
+                "seconds a new route waits for the vehicle to join it before another replan (default 60)");
   c->add_option("--nav", o->navs, "RINEX navigation file(s) for --format rinex");
   c->add_option("--date", o->date, "UTC date YYYY-MM-DD of an NMEA stream without RMC/ZDA");
   c->add_option("--db", o->db, "SQLite database: approvals, flight states and events; a restart resumes from it");

@@ -120,6 +120,16 @@ void TrackingSession::finish() {
   for (EventSink* sink : sinks_) sink->flush();
 }
 
+void TrackingSession::tick() {
+  for (const Ticker& t : tickers_) {
+    std::vector<TrackEvent> events = t();
+    if (events.empty()) continue;
+    beginBatch();
+    emit(events);
+    checkpoint(true);  // a link's news goes out at once
+  }
+}
+
 SessionSummary TrackingSession::run(FixSource& source) {
   source_ = &source;
   // A rereadable input (not stdin, a FIFO or UDP) resumes where the last committed batch left it.
@@ -133,6 +143,7 @@ SessionSummary TrackingSession::run(FixSource& source) {
   auto last_wall = std::chrono::steady_clock::now();
   while (!stop_) {
     SourceRecord r = source.next(kIdlePollMs);
+    tick();
     if (r.kind == SourceRecord::Kind::kEnd) break;
     if (r.kind == SourceRecord::Kind::kIdle) {
       if (source.live()) sweepWhileQuiet(std::chrono::duration<double>(std::chrono::steady_clock::now() - last_wall).count());

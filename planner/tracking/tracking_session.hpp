@@ -54,6 +54,10 @@ class TrackingSession {
   std::string addApprovalFile(const std::string& report_path, const std::string& id = {});
   /// \brief Events go to `sink` too (not owned; it outlives the session's runs).
   void addSink(EventSink& sink) { sinks_.push_back(&sink); }
+  /// \brief Work that runs beside the stream (a link's mission upload): called after every
+  /// record and whenever the input is quiet; the events it returns are the session's.
+  using Ticker = std::function<std::vector<TrackEvent>()>;
+  void addTicker(Ticker ticker) { tickers_.push_back(std::move(ticker)); }
 
   /// \brief Processes `source` until it ends or a stop is requested, resuming a rereadable
   /// input at the line the database stored; ends with a stale sweep and a checkpoint.
@@ -79,12 +83,15 @@ class TrackingSession {
   void checkpoint(bool force);
   void sweepWhileQuiet(double quiet_s);
   void beginBatch();
+  /// Runs the tickers and emits what they return.
+  void tick();
 
   Tracker tracker_;
   std::unique_ptr<TrackStore> store_;
   int batch_;
   Log log_;
   std::vector<EventSink*> sinks_;
+  std::vector<Ticker> tickers_;
   std::map<std::string, std::string> report_of_;  ///< flight id → approval report file
   std::set<std::string> touched_;                 ///< flights changed since the last checkpoint
   int pending_ = 0;

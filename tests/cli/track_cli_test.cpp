@@ -163,6 +163,96 @@ TEST_F(TrackCli, MavlinkTelemetryOverUdpFromAnIndependentVehicleIsTracked) {
   EXPECT_TRUE(bad_checksum) << rejected.front().dump();
 }
 
+/// `skylane track --format mavlink` on a free UDP port beside the node-mavlink vehicle flying
+/// with `vehicle_args`; stopped once the vehicle has landed its flight. The events, and the
+/// vehicle's own summary line.
+struct MavlinkRun {
+  std::vector<json> events;
+  json vehicle;
+  std::string out;
+};
+
+MavlinkRun flyMavlinkVehicle(const std::string& dir, const std::string& name, const std::string& vehicle_args) {
+  static int n = 0;
+  const int port = 20000 + static_cast<int>((getpid() * 7 + ++n) % 20000);
+  char hex_port[8];
+  std::snprintf(hex_port, sizeof hex_port, "%04X", port);
+  const std::string events = dir + "/" + name + ".jsonl", vehicle_out = dir + "/" + name + "_vehicle.json";
+  const std::string report = dir + "/approve/report.json";
+  const std::string vehicle = std::string(SKYLANE_TEST_DATA) + "/../link/js/vehicle.mjs";
+  MavlinkRun run;
+  run.out = sh(kBin + " track --approval " + report + " --format mavlink --input udp://127.0.0.1:" + std::to_string(port) + " > " + events +
+               " 2> " + dir + "/" + name + "_err.txt & pid=$!\n"
+               "for i in $(seq 1 300); do grep -qi ':" + hex_port + " ' /proc/net/udp && break; sleep 0.1; done\n"
+               "node " + vehicle + " --report " + report + " --port " + std::to_string(port) + " " + vehicle_args + " > " + vehicle_out +
+               " || echo vehicle-failed\n"
+               "sleep 0.5; kill -TERM $pid; wait $pid; echo status=$?")
+                .out;
+  run.events = readEvents(events);
+  std::ifstream v(vehicle_out);
+  std::string line;
+  if (std::getline(v, line) && !line.empty()) run.vehicle = json::parse(line);
+  return run;
+}
+
+/// The handoff events' states of one mission type, in order.
+std::vector<std::string> handoffStates(const std::vector<json>& events, const std::string& type) {
+  std::vector<std::string> out;
+  for (const json& e : ofType(events, "handoff")) {
+    if (e.at("mission_type") == type) out.push_back(e.at("state"));
+  }
+  return out;
+}
+
+TEST_F(TrackCli, AReplanIsUploadedToTheVehicleWhichJoinsTheNewCorridorWithOneReplan) {
+  // GIVEN a vehicle (node-mavlink) pushed 8 m aside by a 14 s gust, flying at 5 × real time
+  const MavlinkRun r = flyMavlinkVehicle(*dir_, "handoff", "--seconds 70 --pace-ms 40 --gust-from 20 --gust-until 34 --gust-m 8");
+  ASSERT_NE(r.out.find("status=0"), std::string::npos) << r.out;
+  ASSERT_EQ(r.out.find("vehicle-failed"), std::string::npos) << r.out;
+  // THEN one replan, its route and fence uploaded and acknowledged by the vehicle's autopilot
+  const auto replans = ofType(r.events, "replan");
+  ASSERT_EQ(replans.size(), 1u);
+  EXPECT_EQ(replans[0].at("decision"), "approved");
+  EXPECT_EQ(handoffStates(r.events, "mission"), (std::vector<std::string>{"sent", "acknowledged"}));
+  EXPECT_EQ(handoffStates(r.events, "fence"), (std::vector<std::string>{"sent", "acknowledged"}));
+  EXPECT_EQ(r.vehicle.at("missions"), 1);
+  EXPECT_EQ(r.vehicle.at("fences"), 1);
+  EXPECT_EQ(r.vehicle.at("route_changes"), 1);
+  // AND the vehicle, flying the uploaded route, is back inside: the last level-1 event is
+  // `recovered`, and every fix after it is inside route 1's corridor
+  std::size_t last_recovered = 0;
+  for (std::size_t i = 0; i < r.events.size(); ++i) {
+    const json& e = r.events[i];
+    if ((e.at("event") == "recovered" || e.at("event") == "violation") && e.at("level") == "level1") last_recovered = i;
+  }
+  ASSERT_EQ(r.events[last_recovered].at("event"), "recovered") << r.events[last_recovered].dump();
+  int after = 0;
+  for (std::size_t i = last_recovered; i < r.events.size(); ++i) {
+    if (r.events[i].at("event") != "fix") continue;
+    EXPECT_EQ(r.events[i].at("levels").at("level1").at("verdict"), "inside") << r.events[i].dump();
+    EXPECT_EQ(r.events[i].at("route_version"), 1);
+    ++after;
+  }
+  EXPECT_GT(after, 100);
+}
+
+TEST_F(TrackCli, AVehicleThatRefusesTheUploadEndsTheHoldAndSaysWhy) {
+  const MavlinkRun r = flyMavlinkVehicle(*dir_, "refused", "--seconds 50 --pace-ms 40 --gust-from 20 --gust-until 34 --gust-m 8 --refuse");
+  ASSERT_NE(r.out.find("status=0"), std::string::npos) << r.out;
+  const auto states = handoffStates(r.events, "mission");
+  ASSERT_GE(states.size(), 2u);
+  EXPECT_EQ(states[0], "sent");
+  EXPECT_EQ(states[1], "refused");
+  for (const json& e : ofType(r.events, "handoff")) {
+    EXPECT_NE(e.at("state"), "acknowledged") << e.dump();
+    if (e.at("state") == "refused") {
+      EXPECT_EQ(e.at("result"), "MAV_MISSION_DENIED");
+    }
+  }
+  EXPECT_TRUE(handoffStates(r.events, "fence").empty());  // no fence for a route the vehicle refused
+  EXPECT_EQ(r.vehicle.at("route_changes"), 0);
+}
+
 /// Runs `command` in the background and kills it with SIGKILL (no chance to save) once its
 /// database (with its write-ahead log) has grown past 256 KiB — some hundreds of fixes stored,
 /// however slow the build (a sanitizer's) — or after two minutes.
