@@ -19,7 +19,7 @@ cmake --build build-asan -j "$(nproc)"
 # halt_on_error: a UBSan report is a failure, not a line in a log; leaks are reported at exit.
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:suppressions=$PWD/fuzz/ubsan.supp"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1"
-# Left out here: the consumer project (it builds against an install, not a memory check) and the
-# two kill-and-resume tests (they kill on a condition now, but have not yet been run
-# instrumented; they run in the plain build).
-ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -L 'unit|e2e|fuzz' -E 'Consumer\.|TrackCli\.Killed'
+# Left out here: the consumer project (it builds against an install, not a memory check). The
+# kill-and-resume tests run: they kill the tracker once its database holds some hundreds of fixes
+# (26 s and 21 s instrumented on the 2-core VM).
+ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -L 'unit|e2e|fuzz' -E 'Consumer\.'
