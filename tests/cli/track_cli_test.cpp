@@ -253,6 +253,24 @@ TEST_F(TrackCli, AVehicleThatRefusesTheUploadEndsTheHoldAndSaysWhy) {
   EXPECT_EQ(r.vehicle.at("route_changes"), 0);
 }
 
+TEST_F(TrackCli, ALinkLostForTenSecondsDelaysTheUploadWhichIsSentAgainAndLosesNoFix) {
+  // GIVEN the gust, and the link lost both ways for 10 s of flight (2 s of wall time) just after
+  // the replan has started its upload
+  const MavlinkRun r = flyMavlinkVehicle(*dir_, "lost_link",
+                                         "--seconds 60 --pace-ms 40 --gust-from 20 --gust-until 34 --gust-m 8 --silent-from 20.6 --silent-s 10");
+  ASSERT_NE(r.out.find("status=0"), std::string::npos) << r.out;
+  // THEN the upload is sent again until the vehicle hears it, and acknowledged
+  EXPECT_EQ(handoffStates(r.events, "mission"), (std::vector<std::string>{"sent", "acknowledged"}));
+  for (const json& e : ofType(r.events, "handoff")) {
+    if (e.at("mission_type") == "mission" && e.at("state") == "acknowledged") {
+      EXPECT_GE(e.at("resends").get<int>(), 1) << e.dump();
+    }
+  }
+  EXPECT_EQ(ofType(r.events, "replan").size(), 1u);
+  // AND every GPS fix the vehicle got through is tracked
+  EXPECT_EQ(ofType(r.events, "fix").size(), r.vehicle.at("gps_sent").get<std::size_t>());
+}
+
 /// Runs `command` in the background and kills it with SIGKILL (no chance to save) once its
 /// database (with its write-ahead log) has grown past 256 KiB — some hundreds of fixes stored,
 /// however slow the build (a sanitizer's) — or after two minutes.

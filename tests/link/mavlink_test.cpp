@@ -8,6 +8,7 @@
 //    node-mavlink with the same values;
 //  * garbage, truncated frames, bad checksums and unknown message ids are counted and skipped.
 #include "link/mavlink/wire.hpp"
+#include "link/mavlink/mission_upload.hpp"
 
 #include "tests/test_util.hpp"
 
@@ -16,6 +17,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -189,6 +191,59 @@ TEST(MavlinkWire, TrailingZerosAreTruncatedAndReadBackAsZeros) {
   ASSERT_TRUE(fr);
   EXPECT_EQ(fr->get<std::uint8_t>(def.field("type")), 0);
   EXPECT_EQ(fr->get<std::uint32_t>(def.field("opaque_id")), 0u);
+}
+
+}  // namespace
+}  // namespace skylane::link::mavlink
+
+namespace skylane::link::mavlink {
+namespace {
+
+/// A frame as the vehicle (system 1) would send it to the ground station (255).
+Frame vehicleFrame(std::uint32_t id, const std::function<void(PayloadWriter&)>& fill) {
+  PayloadWriter w(*findMessage(id));
+  w.set<std::uint8_t>("target_system", 255).set<std::uint8_t>("target_component", 190);
+  fill(w);
+  const std::vector<std::uint8_t> bytes = encodeFrame(w.def(), w.data(), 0, 1, 1);
+  FrameParser p;
+  p.push(bytes.data(), bytes.size());
+  return *p.next();
+}
+
+TEST(MissionUpload, ResendsAfterTheTimeoutAndGivesUpAfterFiveRetries) {
+  MissionUpload up(MissionType::kMission, std::vector<MissionItem>(3), LinkIds{});
+  std::uint8_t seq = 0;
+  ASSERT_EQ(up.start(0.0, seq).size(), 1u);  // MISSION_COUNT
+  EXPECT_TRUE(up.poll(1.4, seq).empty());    // not yet 1.5 s
+  for (int k = 1; k <= 5; ++k) EXPECT_EQ(up.poll(1.6 * k, seq).size(), 1u) << "resend " << k;
+  EXPECT_EQ(up.state(), MissionUpload::State::kSending);
+  EXPECT_TRUE(up.poll(9.7, seq).empty());
+  EXPECT_EQ(up.state(), MissionUpload::State::kTimedOut);
+  EXPECT_EQ(up.resends(), 5);
+}
+
+TEST(MissionUpload, SendsEachRequestedItemAndEndsOnTheVehiclesAcknowledgement) {
+  MissionUpload up(MissionType::kFence, std::vector<MissionItem>(2), LinkIds{});
+  std::uint8_t seq = 0;
+  (void)up.start(0.0, seq);
+  auto request = [](std::uint16_t k, std::uint8_t type) {
+    return vehicleFrame(kMissionRequestInt, [&](PayloadWriter& w) { w.set<std::uint16_t>("seq", k).set<std::uint8_t>("mission_type", type); });
+  };
+  EXPECT_TRUE(up.onFrame(request(0, 0), 0.1, seq).empty());  // a request for the MISSION list: not this upload
+  const auto item = up.onFrame(request(0, 1), 0.2, seq);
+  ASSERT_EQ(item.size(), 1u);
+  FrameParser p;
+  p.push(item[0].data(), item[0].size());
+  const auto fr = p.next();
+  ASSERT_TRUE(fr);
+  EXPECT_EQ(fr->msgid, kMissionItemInt);
+  EXPECT_EQ(fr->get<std::uint8_t>(fr->def->field("mission_type")), 1);
+  EXPECT_EQ(up.onFrame(request(1, 1), 0.3, seq).size(), 1u);
+  EXPECT_TRUE(up.onFrame(request(7, 1), 0.3, seq).empty());  // beyond the list: ignored
+  (void)up.onFrame(vehicleFrame(kMissionAck, [](PayloadWriter& w) { w.set<std::uint8_t>("type", 14).set<std::uint8_t>("mission_type", 1); }),
+                   0.4, seq);
+  EXPECT_EQ(up.state(), MissionUpload::State::kRefused);
+  EXPECT_EQ(missionResultName(up.result()), "MAV_MISSION_DENIED");
 }
 
 }  // namespace

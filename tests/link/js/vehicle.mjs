@@ -31,7 +31,7 @@ const silent = { from: num('silent-from', -1), s: num('silent-s', 0) }
 const departureMs = Date.parse(report.departure)
 const protocol = new MavLinkProtocolV2(1, 1)  // system 1, autopilot component
 const socket = dgram.createSocket('udp4')
-const summary = { missions: 0, fences: 0, acked: 0, refused: 0, route_changes: 0, items: [] }
+const summary = { missions: 0, fences: 0, acked: 0, refused: 0, route_changes: 0, items: [], gps_sent: 0 }
 let seq = 0
 
 // --- a local plane around the route's start (equirectangular: ample for a few km) -----------
@@ -107,6 +107,7 @@ function takeMission(items) {  // an accepted MISSION becomes the route from her
   summary.route_changes++
 }
 async function onPacket(packet) {
+  if (quiet) return  // a lost link loses both ways
   const id = packet.header.msgid
   if (id === common.MissionCount.MSG_ID) {
     const c = packet.protocol.data(packet.payload, common.MissionCount)
@@ -156,6 +157,7 @@ async function telemetry(k, t) {
   if (args.garbage && k === 10) await send(Buffer.from([0x00, 0x55, 0xfd, 0x02, 0x99]))  // junk
   if (args.garbage && k === 20) { bytes = Buffer.from(bytes); bytes[15] ^= 0x01 }           // a flipped bit
   if (args.garbage && k === 30) await send(bytes.subarray(0, 8))                              // a truncated copy
+  if (!quiet && !(args.garbage && k === 20)) summary.gps_sent++
   await send(bytes)
 }
 
