@@ -9,6 +9,7 @@
 #include "integrity/sim/scenario.hpp"
 #include "link/mavlink/fix_source.hpp"
 #include "link/mavlink/handoff.hpp"
+#include "link/plan_file_sink.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
@@ -47,6 +48,7 @@ struct TrackOptions {
   std::string format = "jsonl";
   int baud = 57600;
   bool no_handoff = false;
+  std::string plans;  ///< directory for each replan's .plan
   std::vector<std::string> navs;
   std::string date;
   std::string db;
@@ -305,6 +307,11 @@ void runTrack(const TrackOptions& o) {
     session.addSink(*handoff);
     session.addTicker([h = handoff.get()] { return h->tick(); });
   }
+  std::unique_ptr<link::PlanFileSink> plans;
+  if (!o.plans.empty()) {
+    plans = std::make_unique<link::PlanFileSink>(o.plans, session.tracker(), log);
+    session.addSink(*plans);
+  }
   const planner::SessionSummary sum = session.run(*source);
   if (!o.map.empty()) {
     std::ofstream(o.map) << track_map.svg(session.tracker());
@@ -401,6 +408,7 @@ void addTrackCommands(CLI::App& app) {
                 "jsonl, nmea (GGA + GST [+ GBS]), rinex (observation replay; needs --nav) or mavlink (MAVLink 1/2 telemetry)");
   c->add_option("--baud", o->baud, "serial device speed for --format mavlink (default 57600)");
   c->add_flag("--no-handoff", o->no_handoff, "--format mavlink: do not upload replanned routes to the vehicle");
+  c->add_option("--plans", o->plans, "write each accepted replan as DIR/<flight>-route<N>.plan (QGroundControl)");
   c->add_option("--join-timeout", o->tracker.join_timeout_s,
                 "seconds a new route waits for the vehicle to join it before another replan (default 60)");
   c->add_option("--nav", o->navs, "RINEX navigation file(s) for --format rinex");

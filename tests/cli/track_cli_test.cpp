@@ -172,7 +172,8 @@ struct MavlinkRun {
   std::string out;
 };
 
-MavlinkRun flyMavlinkVehicle(const std::string& dir, const std::string& name, const std::string& vehicle_args) {
+MavlinkRun flyMavlinkVehicle(const std::string& dir, const std::string& name, const std::string& vehicle_args,
+                             const std::string& track_args = "") {
   static int n = 0;
   const int port = 20000 + static_cast<int>((getpid() * 7 + ++n) % 20000);
   char hex_port[8];
@@ -181,7 +182,8 @@ MavlinkRun flyMavlinkVehicle(const std::string& dir, const std::string& name, co
   const std::string report = dir + "/approve/report.json";
   const std::string vehicle = std::string(SKYLANE_TEST_DATA) + "/../link/js/vehicle.mjs";
   MavlinkRun run;
-  run.out = sh(kBin + " track --approval " + report + " --format mavlink --input udp://127.0.0.1:" + std::to_string(port) + " > " + events +
+  run.out = sh(kBin + " track --approval " + report + " --format mavlink --input udp://127.0.0.1:" + std::to_string(port) + " " +
+               track_args + " > " + events +
                " 2> " + dir + "/" + name + "_err.txt & pid=$!\n"
                "for i in $(seq 1 300); do grep -qi ':" + hex_port + " ' /proc/net/udp && break; sleep 0.1; done\n"
                "node " + vehicle + " --report " + report + " --port " + std::to_string(port) + " " + vehicle_args + " > " + vehicle_out +
@@ -206,7 +208,9 @@ std::vector<std::string> handoffStates(const std::vector<json>& events, const st
 
 TEST_F(TrackCli, AReplanIsUploadedToTheVehicleWhichJoinsTheNewCorridorWithOneReplan) {
   // GIVEN a vehicle (node-mavlink) pushed 8 m aside by a 14 s gust, flying at 5 × real time
-  const MavlinkRun r = flyMavlinkVehicle(*dir_, "handoff", "--seconds 70 --pace-ms 40 --gust-from 20 --gust-until 34 --gust-m 8");
+  const std::string plans = *dir_ + "/handoff_plans";
+  const MavlinkRun r = flyMavlinkVehicle(*dir_, "handoff", "--seconds 70 --pace-ms 40 --gust-from 20 --gust-until 34 --gust-m 8",
+                                         "--plans " + plans);
   ASSERT_NE(r.out.find("status=0"), std::string::npos) << r.out;
   ASSERT_EQ(r.out.find("vehicle-failed"), std::string::npos) << r.out;
   // THEN one replan, its route and fence uploaded and acknowledged by the vehicle's autopilot
@@ -218,6 +222,11 @@ TEST_F(TrackCli, AReplanIsUploadedToTheVehicleWhichJoinsTheNewCorridorWithOneRep
   EXPECT_EQ(r.vehicle.at("missions"), 1);
   EXPECT_EQ(r.vehicle.at("fences"), 1);
   EXPECT_EQ(r.vehicle.at("route_changes"), 1);
+  // AND the route the vehicle took is the one written as a plan (--plans): as many items
+  std::ifstream plan_in(plans + "/Zurich_medical_supply_run__example_-route1.plan");
+  ASSERT_TRUE(plan_in) << "no plan file in " << plans;
+  const json plan = json::parse(plan_in);
+  EXPECT_EQ(r.vehicle.at("items").at(0), plan.at("mission").at("items").size());
   // AND the vehicle, flying the uploaded route, is back inside: the last level-1 event is
   // `recovered`, and every fix after it is inside route 1's corridor
   std::size_t last_recovered = 0;
