@@ -10,6 +10,7 @@
 #include "link/mavlink/fix_source.hpp"
 #include "link/mavlink/handoff.hpp"
 #include "link/plan_file_sink.hpp"
+#include "link/ubx/fix_source.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
@@ -220,8 +221,8 @@ void addApprovals(planner::TrackingSession& session, const TrackOptions& o) {
   }
   const planner::Tracker& tracker = session.tracker();
   if (tracker.flights().empty()) throw ParseError("--approval", 0, "--approval", "", "at least one approval report");
-  if ((o.format == "nmea" || o.format == "rinex" || o.format == "mavlink") && tracker.flights().size() != 1) {
-    throw ParseError("--format", 0, "--format", o.format, "one approval (an NMEA, RINEX or MAVLink stream is one vehicle)");
+  if (o.format != "jsonl" && tracker.flights().size() != 1) {
+    throw ParseError("--format", 0, "--format", o.format, "one approval (an NMEA, RINEX, MAVLink or UBX stream is one vehicle)");
   }
 }
 
@@ -240,6 +241,7 @@ std::unique_ptr<planner::FixSource> openFixSource(const TrackOptions& o, const p
   if (o.format == "mavlink") {
     return std::make_unique<link::mavlink::MavlinkFixSource>(link::openByteLink(o.input, o.baud), std::string());
   }
+  if (o.format == "ubx") return std::make_unique<link::ubx::UbxFixSource>(link::openByteLink(o.input, o.baud), std::string());
   std::unique_ptr<planner::LineInput> in = planner::openLineInput(o.input);
   if (o.format == "jsonl") return std::make_unique<planner::JsonLinesFixSource>(std::move(in));
   std::optional<integrity::NmeaDate> date;
@@ -280,8 +282,8 @@ void drawRoutes(TrackMap& map, const planner::Tracker& tracker) {
 }
 
 void runTrack(const TrackOptions& o) {
-  if (o.format != "jsonl" && o.format != "nmea" && o.format != "rinex" && o.format != "mavlink") {
-    throw ParseError("--format", 0, "--format", o.format, "jsonl, nmea, rinex or mavlink");
+  if (o.format != "jsonl" && o.format != "nmea" && o.format != "rinex" && o.format != "mavlink" && o.format != "ubx") {
+    throw ParseError("--format", 0, "--format", o.format, "jsonl, nmea, rinex, mavlink or ubx");
   }
   auto log = [](const std::string& m) { std::cerr << "skylane: track: " << m << "\n"; };
   planner::TrackingSession session(trackerOptions(o), o.db.empty() ? nullptr : std::make_unique<planner::TrackStore>(o.db),
@@ -405,8 +407,9 @@ void addTrackCommands(CLI::App& app) {
       ->required();
   c->add_option("--input", o->input, "FILE, - (stdin), udp://127.0.0.1:PORT or (mavlink) a serial device");
   c->add_option("--format", o->format,
-                "jsonl, nmea (GGA + GST [+ GBS]), rinex (observation replay; needs --nav) or mavlink (MAVLink 1/2 telemetry)");
-  c->add_option("--baud", o->baud, "serial device speed for --format mavlink (default 57600)");
+                "jsonl, nmea (GGA + GST [+ GBS]), rinex (observation replay; needs --nav), mavlink (MAVLink 1/2 telemetry) or "
+                "ubx (u-blox NAV-PVT with NAV-PL)");
+  c->add_option("--baud", o->baud, "serial device speed for --format mavlink or ubx (default 57600)");
   c->add_flag("--no-handoff", o->no_handoff, "--format mavlink: do not upload replanned routes to the vehicle");
   c->add_option("--plans", o->plans, "write each accepted replan as DIR/<flight>-route<N>.plan (QGroundControl)");
   c->add_option("--join-timeout", o->tracker.join_timeout_s,

@@ -14,7 +14,7 @@ build="${1:-$root/build-fuzz}"
 seconds="${2:-60}"
 shift $(( $# > 2 ? 2 : $# ))
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(yuma sem rinex_nav rinex_obs geometry text_fields zones buildings fence scenario mission nmea track mavlink)
+[ ${#targets[@]} -eq 0 ] && targets=(yuma sem rinex_nav rinex_obs geometry text_fields zones buildings fence scenario mission nmea track mavlink ubx)
 work="${SKYLANE_FUZZ_WORK:-/tmp/skylane-fuzz}"
 data="$root/tests/data"
 
@@ -52,6 +52,7 @@ seed() {  # target corpus-dir
     mission) cp "$root"/fuzz/corpus/mission/* "$c"/ ;;
     track) cp "$root"/fuzz/corpus/track/* "$c"/ ;;
     mavlink) cp "$root"/fuzz/corpus/mavlink/* "$c"/ ;;
+    ubx) cp "$root"/fuzz/corpus/ubx/* "$c"/ ;;
     *) echo "unknown target $t" >&2; exit 2 ;;
   esac
 }

@@ -8,7 +8,7 @@ PACKAGES=(g++ cmake make ccache pkg-config universal-ctags python3
   libeigen3-dev libgeographiclib-dev libcli11-dev nlohmann-json3-dev libboost-dev
   libcgal-dev libgmp-dev libmpfr-dev libfcl-dev libgdal-dev proj-data
   libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev libode-dev libssl-dev libsqlite3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev nodejs npm)
+  libgtest-dev libgmock-dev libbenchmark-dev nodejs npm python3-gps)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

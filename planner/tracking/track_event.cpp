@@ -97,10 +97,10 @@ const char* eventTypeOf(const maps::JsonNode& n) {
 PlSource plSourceOf(const maps::JsonNode& n) {
   const std::string s = n.str();
   for (PlSource p : {PlSource::kOnboard, PlSource::kRaw, PlSource::kNmeaGst, PlSource::kIns, PlSource::kGnssIns,
-                     PlSource::kMavlinkAccuracy}) {
+                     PlSource::kMavlinkAccuracy, PlSource::kUbxPl, PlSource::kUbxAccuracy}) {
     if (s == plSourceName(p)) return p;
   }
-  n.fail("onboard, raw, nmea_gst, ins, gnss_ins or mavlink_accuracy");
+  n.fail("onboard, raw, nmea_gst, ins, gnss_ins, mavlink_accuracy, ubx_pl or ubx_accuracy");
 }
 
 /// A box level's part of the fix event ({verdict, margins, segment}) as a check of `level`.

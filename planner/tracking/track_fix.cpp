@@ -25,6 +25,8 @@ const char* plSourceName(PlSource s) {
     case PlSource::kIns: return "ins";
     case PlSource::kGnssIns: return "gnss_ins";
     case PlSource::kMavlinkAccuracy: return "mavlink_accuracy";
+    case PlSource::kUbxPl: return "ubx_pl";
+    case PlSource::kUbxAccuracy: return "ubx_accuracy";
   }
   return "?";
 }

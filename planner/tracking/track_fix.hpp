@@ -69,11 +69,12 @@ struct ImuRecord {
 };
 
 /// \brief Where a fix's protection levels came from.
-enum class PlSource { kOnboard, kRaw, kNmeaGst, kIns, kGnssIns, kMavlinkAccuracy };
+enum class PlSource { kOnboard, kRaw, kNmeaGst, kIns, kGnssIns, kMavlinkAccuracy, kUbxPl, kUbxAccuracy };
 
 /// \brief "onboard", "raw", "nmea_gst", "ins" (the INS σ block alone), "gnss_ins" (the fault-mode
 /// flow over the fix's pseudoranges and IMU increments), "mavlink_accuracy" (a MAVLink GPS
-/// message's h_acc/v_acc, link/mavlink/fix_source.hpp).
+/// message's h_acc/v_acc, link/mavlink/fix_source.hpp), "ubx_pl" (a u-blox receiver's UBX-NAV-PL,
+/// converted to the mission's risk) and "ubx_accuracy" (UBX-NAV-PVT's hAcc/vAcc; link/ubx/).
 [[nodiscard]] const char* plSourceName(PlSource s);
 
 /// \brief One fix of a stream.
@@ -91,6 +92,7 @@ struct TrackFix {
   std::optional<double> baro_h_m, mag_heading_rad;
   std::string source;  ///< "file:line"
   std::size_t line = 0;
+  std::string note;    ///< what the source wants the fix event to say (e.g. a receiver PL it could not use)
 };
 
 /// \brief Parses one JSON-lines fix (the file comment's schema).

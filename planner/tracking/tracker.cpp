@@ -211,6 +211,7 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   }
   TrackedFlight& f = *it->second;
   FixWork w(fix);
+  w.note = fix.note;
   w.pos = {fix.lat_rad, fix.lon_rad, fix.h_ell_m};
   w.hpl_m = fix.hpl_m;
   w.vpl_m = fix.vpl_m;

@@ -280,6 +280,28 @@ TEST_F(TrackCli, ALinkLostForTenSecondsDelaysTheUploadWhichIsSentAgainAndLosesNo
   EXPECT_EQ(ofType(r.events, "fix").size(), r.vehicle.at("gps_sent").get<std::size_t>());
 }
 
+TEST_F(TrackCli, AUbxRecordingIsTrackedWithTheReceiversOwnProtectionLevels) {
+  // GIVEN a recorded u-blox stream (frames built by gpsd's UBX module): a NAV-PVT with its NAV-PL
+  const std::string ubx = *dir_ + "/receiver.ubx";
+  const RunResult made = sh("/usr/bin/python3 " + std::string(SKYLANE_TEST_DATA) + "/../link/py/ubx_oracle.py encode | "
+                            "python3 -c \"import sys, json; sys.stdout.buffer.write(b''.join(bytes.fromhex(json.loads(l)['hex']) "
+                            "for l in list(sys.stdin)[:2]))\" > " + ubx);
+  ASSERT_EQ(made.status, 0) << made.out;
+  // WHEN skylane tracks it
+  const RunResult r = sh(kBin + " track --approval " + *dir_ + "/approve/report.json --format ubx --input " + ubx + " --no-replan");
+  ASSERT_EQ(r.status, 0) << r.out;
+  // THEN one fix, its PLs the receiver's (frame 3, TMIR 1e-5 %) converted to the mission's risk
+  std::vector<json> events;
+  std::istringstream in(r.out);
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line[0] == '{') events.push_back(json::parse(line));
+  }
+  const auto fixes = ofType(events, "fix");
+  ASSERT_EQ(fixes.size(), 1u) << r.out;
+  EXPECT_EQ(fixes[0].at("pl_source"), "ubx_pl");
+  EXPECT_NEAR(fixes[0].at("hpl_m").get<double>(), 2.495, 2e-3);
+}
+
 /// Runs `command` in the background and kills it with SIGKILL (no chance to save) once its
 /// database (with its write-ahead log) has grown past 256 KiB — some hundreds of fixes stored,
 /// however slow the build (a sanitizer's) — or after two minutes.
