@@ -8,12 +8,16 @@ PACKAGES=(g++ cmake make ccache pkg-config universal-ctags python3
   libeigen3-dev libgeographiclib-dev libcli11-dev nlohmann-json3-dev libboost-dev
   libcgal-dev libgmp-dev libmpfr-dev libfcl-dev libgdal-dev proj-data
   libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev libode-dev libssl-dev libsqlite3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev nodejs npm python3-gps)
+  libgtest-dev libgmock-dev libbenchmark-dev python3-gps)
 
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# Node.js and npm (the link tests' independent MAVLink implementation): Debian's packages unless
+# the commands are there already (a Node.js that bundles npm conflicts with Debian's npm).
+command -v node > /dev/null 2>&1 || missing+=(nodejs)
+command -v npm > /dev/null 2>&1 || missing+=(npm)
 if [ ${#missing[@]} -gt 0 ]; then
   echo "skylane setup: installing ${missing[*]}" >&2
   SUDO=""
