@@ -5,6 +5,7 @@
 #include "maps/file_digest.hpp"
 #include "planner/approval.hpp"
 #include "link/qgc_plan.hpp"
+#include "planner/operational_intent.hpp"
 #include "planner/report_formats.hpp"
 
 #include <nlohmann/json.hpp>
@@ -163,7 +164,7 @@ void runApprove(const ApproveOptions& o) {
     std::filesystem::remove(dir / "operational_intent.json");
     std::filesystem::remove(dir / "mission.plan");
     if (r.approved) {
-      std::ofstream(dir / "operational_intent.json") << planner::operationalIntentJson(r, approver.frame()).dump(1) << "\n";
+      std::ofstream(dir / "operational_intent.json") << json(planner::operationalIntent(r, approver.frame())).dump(1) << "\n";
       // The route and its fence for a ground station (QGroundControl) to upload to the vehicle,
       // made from the report as written (so that `plan export report.json` gives the same file).
       std::ofstream(dir / "mission.plan") << link::qgcPlan(j.get<planner::ApprovedFlight>(), approver).dump(2) << "\n";

@@ -190,32 +190,6 @@ nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission
   return {{"type", "FeatureCollection"}, {"features", features}};
 }
 
-nlohmann::json operationalIntentVolumes(const ApprovalReport& report, const maps::PlaneFrame& frame, int level,
-                                        double time_buffer_s) {
-  using nlohmann::json;
-  const geofence::AlertLimits& lim = level == 1 ? report.limits.level1 : report.limits.level2;
-  json volumes = json::array();
-  for (std::size_t i = 1; i < report.route.size(); ++i) {
-    const RoutePoint& a = report.route[i - 1];
-    const RoutePoint& b = report.route[i];
-    json vertices = json::array();
-    for (const Eigen::Vector2d& v : segmentOutline(a.xyz, b.xyz, lim.hal_m)) {
-      const Eigen::Vector2d ll = frame.toLatLon(v);
-      vertices.push_back({{"lat", deg(ll.x())}, {"lng", deg(ll.y())}});
-    }
-    const double lower = std::min(a.h_ell_m, b.h_ell_m) - lim.val_m;
-    const double upper = std::max(a.h_ell_m, b.h_ell_m) + lim.val_m;
-    volumes.push_back(
-        {{"volume",
-          {{"outline_polygon", {{"vertices", vertices}}},
-           {"altitude_lower", {{"value", roundToMm(lower)}, {"reference", "W84"}, {"units", "M"}}},
-           {"altitude_upper", {{"value", roundToMm(upper)}, {"reference", "W84"}, {"units", "M"}}}}},
-         {"time_start", {{"value", maps::formatRfc3339(report.departure.plus(a.eta_s - time_buffer_s), 0)}, {"format", "RFC3339"}}},
-         {"time_end", {{"value", maps::formatRfc3339(report.departure.plus(b.eta_s + time_buffer_s), 0)}, {"format", "RFC3339"}}}});
-  }
-  return volumes;
-}
-
 void from_json(const nlohmann::json& j, ApprovedFlight& f) { f = parseApprovalReport(j, "approval report"); }
 
 ApprovedFlight parseApprovalReport(const nlohmann::json& doc, const std::string& source) {
@@ -271,11 +245,5 @@ ApprovedFlight parseApprovalReport(const nlohmann::json& doc, const std::string&
   return f;
 }
 
-nlohmann::json operationalIntentJson(const ApprovalReport& report, const maps::PlaneFrame& frame) {
-  return {{"operational_intent", {{"volumes", operationalIntentVolumes(report, frame, 2, kIntentTimeBuffer_s)},
-                                  {"state", "Accepted"},
-                                  {"priority", 0}}},
-          {"corridor_volumes", operationalIntentVolumes(report, frame, 1, kIntentTimeBuffer_s)}};
-}
 
 }  // namespace skylane::planner

@@ -1,9 +1,7 @@
 #pragma once
 /// \file
-/// \brief The approval in exchange formats: GeoJSON (RFC 7946) for any GIS, and ASTM F3548-21
-/// operational-intent `Volume4D` objects for a UTM / U-space service (field names as in
-/// ASTM F3548-21 Volume4D: volume.outline_polygon.vertices[{lat, lng}], altitude_lower/upper {value,
-/// reference "W84", units "M"}, time_start/time_end {value, format "RFC3339"}).
+/// \brief The approval in exchange formats: its report (the one JSON form, and the reader of
+/// what tracking acts on) and GeoJSON (RFC 7946) for any GIS.
 
 #include "planner/approval.hpp"
 
@@ -49,17 +47,6 @@ void from_json(const nlohmann::json& j, ApprovedFlight& f);
 [[nodiscard]] nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission,
                                           const maps::PlaneFrame& frame);
 
-/// \brief One Volume4D per route segment of the given level (1 corridor, 2 airspace): the
-/// segment's outline, its heights ± VAL (ellipsoidal, "W84"), and the time from the segment's
-/// start ETA − `time_buffer_s` to its end ETA + `time_buffer_s`.
-[[nodiscard]] nlohmann::json operationalIntentVolumes(const ApprovalReport& report, const maps::PlaneFrame& frame,
-                                                      int level, double time_buffer_s);
-
-/// \brief Seconds an operational intent's volumes reach before and after the route's ETAs.
-constexpr double kIntentTimeBuffer_s = 30.0;
-
-/// \brief The operational intent of an approved route (ASTM F3548-21, state "Accepted"): the
-/// level-2 volumes as `operational_intent.volumes`, and the level-1 volumes as `corridor_volumes`.
-[[nodiscard]] nlohmann::json operationalIntentJson(const ApprovalReport& report, const maps::PlaneFrame& frame);
+/// (The operational intent, ASTM F3548-21 Volume4D objects, is planner/operational_intent.hpp.)
 
 }  // namespace skylane::planner

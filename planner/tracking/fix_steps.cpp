@@ -1,5 +1,7 @@
 #include "planner/tracking/fix_steps.hpp"
 
+#include "planner/operational_intent.hpp"
+
 #include "geofence/verdict_json.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/json_numbers.hpp"
@@ -434,7 +436,7 @@ bool handoffHolds(const TrackerOptions& o, FlightState& st, const maps::GpsTime&
 }
 
 void takeNewRoute(TrackedFlight& f, const ApprovalReport& r, TrackEvent& rp) {
-  json intent = operationalIntentJson(r, f.approver->frame());
+  json intent = operationalIntent(r, f.approver->frame());
   rp["operational_intent"] = std::move(intent["operational_intent"]);
   rp["corridor_volumes"] = std::move(intent["corridor_volumes"]);
   f.plan.route = r.route;

@@ -3,6 +3,8 @@
 // events, and NMEA / JSON-lines agreement.
 #include "planner/tracking/tracker.hpp"
 
+#include "planner/operational_intent.hpp"
+
 #include "maps/parse_error.hpp"
 #include "maps/json_node.hpp"
 #include "maps/text_file.hpp"
@@ -125,6 +127,24 @@ TEST_F(TrackerOnExample, TheReportsJsonFormReadsBackIntoTheFlightTrackingActsOn)
   // A document that is not a report is refused by name.
   const json not_a_report = {{"decision", "maybe"}};
   EXPECT_THROW((void)not_a_report.get<ApprovedFlight>(), maps::ParseError);
+}
+
+TEST_F(TrackerOnExample, TheOperationalIntentReadsBackIntoTheSameVolumes) {
+  const OperationalIntent oi = operationalIntent(example_->report, example_->approver->frame());
+  ASSERT_EQ(oi.volumes.size(), example_->report.route.size() - 1);
+  const json j = oi;
+  const OperationalIntent back = j.get<OperationalIntent>();
+  EXPECT_EQ(json(back), j);  // one form, read and written again
+  ASSERT_EQ(back.volumes.size(), oi.volumes.size());
+  for (std::size_t i = 0; i < oi.volumes.size(); ++i) {
+    EXPECT_NEAR(back.volumes[i].altitude_lower_m, oi.volumes[i].altitude_lower_m, 0.51e-3);
+    EXPECT_NEAR(back.volumes[i].time_end - oi.volumes[i].time_end, 0.0, 0.51);  // whole seconds
+    EXPECT_NEAR(maps::rad2deg(back.volumes[i].outline_rad[0].x()), maps::rad2deg(oi.volumes[i].outline_rad[0].x()), 0.51e-8);
+  }
+  // A volume in feet or above mean sea level is not this form: refused by name.
+  json feet = j;
+  feet["operational_intent"]["volumes"][0]["volume"]["altitude_lower"]["units"] = "FT";
+  EXPECT_THROW((void)feet.get<OperationalIntent>(), maps::ParseError);
 }
 
 TEST_F(TrackerOnExample, FixesOnTheRouteWithSmallPlsAreInsideEveryLevel) {
