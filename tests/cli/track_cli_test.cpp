@@ -302,6 +302,27 @@ TEST_F(TrackCli, AUbxRecordingIsTrackedWithTheReceiversOwnProtectionLevels) {
   EXPECT_NEAR(fixes[0].at("hpl_m").get<double>(), 2.495, 2e-3);
 }
 
+TEST_F(TrackCli, MavlinkTelemetryOnASerialLineIsTracked) {
+  // GIVEN node-mavlink's GPS_RAW_INT frames along the route (the vehicle, recorded to a file)
+  const std::string recorded = *dir_ + "/serial.bin";
+  const std::string vehicle_frames = *dir_ + "/serial_frames.hex";
+  const RunResult made = sh("node " + std::string(SKYLANE_TEST_DATA) + "/../link/js/vehicle.mjs --report " + *dir_ +
+                            "/approve/report.json --port 9 --seconds 10 --pace-ms 0 --record " + recorded);
+  ASSERT_EQ(made.status, 0) << made.out;
+  // WHEN they arrive on a serial line (a pseudo-terminal) that skylane reads in raw mode at 115200 Bd
+  const std::string events = *dir_ + "/serial_events.jsonl";
+  const RunResult r = sh("exec 3< <(/usr/bin/python3 " + std::string(SKYLANE_TEST_DATA) + "/../link/py/pty_serial.py " + recorded +
+                         " 3)\nread -r tty <&3\n" + kBin + " track --approval " + *dir_ + "/approve/report.json --format mavlink --input $tty --baud 115200 "
+                         "--no-handoff > " + events + " 2>/dev/null & pid=$!\n"
+                         "for i in $(seq 1 300); do [ $(grep -c '\"event\":\"fix\"' " + events + ") -ge 51 ] && break; sleep 0.1; done\n"
+                         "kill -TERM $pid; wait $pid; echo status=$?");
+  ASSERT_NE(r.out.find("status=0"), std::string::npos) << r.out;
+  // THEN every GPS_RAW_INT (10 s at 5 Hz) is a fix inside the corridor
+  const auto fixes = ofType(readEvents(events), "fix");
+  EXPECT_EQ(fixes.size(), 51u);
+  for (const json& f : fixes) EXPECT_EQ(f.at("verdict"), "inside") << f.dump();
+}
+
 /// Runs `command` in the background and kills it with SIGKILL (no chance to save) once its
 /// database (with its write-ahead log) has grown past 256 KiB — some hundreds of fixes stored,
 /// however slow the build (a sanitizer's) — or after two minutes.

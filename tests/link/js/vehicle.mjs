@@ -10,6 +10,7 @@
 //        [--gust-from T --gust-until T --gust-m 8]   pushed aside, then steered back
 //        [--refuse]                                   refuses MISSION uploads (MAV_MISSION_DENIED)
 //        [--silent-from T --silent-s 10]              sends nothing for a while (a lost link)
+//        [--record FILE]                              also writes every byte it sends to FILE
 // At the end it prints one JSON line: what it received and did.
 import dgram from 'node:dgram'
 import fs from 'node:fs'
@@ -132,7 +133,12 @@ socket.on('message', msg => input.write(msg))
 
 // --- telemetry --------------------------------------------------------------------------------
 let quiet = false
-const send = buffer => quiet ? Promise.resolve() : new Promise(resolve => socket.send(buffer, port, '127.0.0.1', () => resolve()))
+const record = args.record ? fs.openSync(args.record, 'w') : null
+const send = buffer => {
+  if (quiet) return Promise.resolve()
+  if (record !== null) fs.writeSync(record, buffer)
+  return new Promise(resolve => socket.send(buffer, port, '127.0.0.1', () => resolve()))
+}
 const frame = msg => protocol.serialize(msg, seq++ % 256)
 const sleep = ms => new Promise(resolve => setTimeout(resolve, ms))
 
