@@ -17,6 +17,8 @@ constexpr std::uint64_t kUnixTimeFloor_us = 1000000000ULL * 1000000ULL;
 /// Seconds from the UNIX epoch to the GPS epoch (1980-01-06T00:00:00Z).
 constexpr double kGpsEpochUnix_s = 315964800.0;
 constexpr double kWeek_s = 604800.0;
+/// Mission-protocol frames kept for the hand-off between two ticks.
+constexpr std::size_t kMaxOtherFrames = 256;
 
 /// The GPS time of a UTC instant given in microseconds since the UNIX epoch (leap seconds applied).
 maps::GpsTime gpsFromUnix(std::uint64_t time_usec) {
@@ -110,6 +112,9 @@ std::optional<planner::SourceRecord> MavlinkFixSource::handle(const Frame& fr) {
     case kGps2Raw:
       return fromGps(fr);
     default:
+      // Mission-protocol frames wait for the hand-off's next tick; without one (a recording,
+      // --no-handoff) only the latest few are kept.
+      if (other_.size() >= kMaxOtherFrames) other_.pop_front();
       other_.push_back(fr);
       return std::nullopt;
   }
