@@ -263,10 +263,10 @@ TEST_F(TrackCli, AVehicleThatRefusesTheUploadEndsTheHoldAndSaysWhy) {
 }
 
 TEST_F(TrackCli, ALinkLostForTenSecondsDelaysTheUploadWhichIsSentAgainAndLosesNoFix) {
-  // GIVEN the gust, and the link lost both ways for 10 s of flight (2 s of wall time) just after
-  // the replan has started its upload
+  // GIVEN the gust, and the link lost both ways for 10 s of flight (2 s of wall time) from the
+  // moment the upload begins (its first MISSION_COUNT is lost)
   const MavlinkRun r = flyMavlinkVehicle(*dir_, "lost_link",
-                                         "--seconds 60 --pace-ms 40 --gust-from 20 --gust-until 34 --gust-m 8 --silent-from 20.6 --silent-s 10");
+                                         "--seconds 60 --pace-ms 40 --gust-from 20 --gust-until 34 --gust-m 8 --silent-on-upload 10");
   ASSERT_NE(r.out.find("status=0"), std::string::npos) << r.out;
   // THEN the upload is sent again until the vehicle hears it, and acknowledged
   EXPECT_EQ(handoffStates(r.events, "mission"), (std::vector<std::string>{"sent", "acknowledged"}));

@@ -10,6 +10,7 @@
 //        [--gust-from T --gust-until T --gust-m 8]   pushed aside, then steered back
 //        [--refuse]                                   refuses MISSION uploads (MAV_MISSION_DENIED)
 //        [--silent-from T --silent-s 10]              sends nothing for a while (a lost link)
+//        [--silent-on-upload S]                       the link is lost for S s from the first MISSION_COUNT heard
 //        [--record FILE]                              also writes every byte it sends to FILE
 // At the end it prints one JSON line: what it received and did.
 import dgram from 'node:dgram'
@@ -110,6 +111,11 @@ function takeMission(items) {  // an accepted MISSION becomes the route from her
 async function onPacket(packet) {
   if (quiet) return  // a lost link loses both ways
   const id = packet.header.msgid
+  if (args['silent-on-upload'] && !silentOnce && id === common.MissionCount.MSG_ID) {
+    silentOnce = true  // the link drops just as the upload begins: this message is lost too
+    silent.from = simTime; silent.s = num('silent-on-upload', 10); quiet = true
+    return
+  }
   if (id === common.MissionCount.MSG_ID) {
     const c = packet.protocol.data(packet.payload, common.MissionCount)
     upload = { type: c.missionType, count: c.count, items: [], from: { sysid: packet.header.sysid, compid: packet.header.compid } }
@@ -133,6 +139,8 @@ socket.on('message', msg => input.write(msg))
 
 // --- telemetry --------------------------------------------------------------------------------
 let quiet = false
+let silentOnce = false
+let simTime = 0
 const record = args.record ? fs.openSync(args.record, 'w') : null
 const send = buffer => {
   if (quiet) return Promise.resolve()
@@ -170,6 +178,7 @@ async function telemetry(k, t) {
 await new Promise(resolve => socket.bind(0, '127.0.0.1', resolve))
 for (let k = 0; k * 0.2 <= duration + 1e-9; k++) {
   const t = k * 0.2
+  simTime = t
   if (k > 0) step(t, 0.2)
   quiet = t >= silent.from && t < silent.from + silent.s
   await telemetry(k, t)
