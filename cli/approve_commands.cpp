@@ -173,6 +173,9 @@ void runApprove(const ApproveOptions& o) {
   std::cout << j.dump(2) << "\n";
   std::cerr << "skylane: approve: " << (r.approved ? "APPROVED" : "REJECTED") << " in " << r.elapsed_s << " s";
   if (!r.reasons.empty()) std::cerr << ": " << r.reasons.front().message;
+  if (r.planner.stopped_by_time) {
+    std::cerr << " (the planner's time limit ended a search before its iteration budget: this route is not reproducible)";
+  }
   std::cerr << "\n";
   if (!r.approved) throw ExitStatus(1);
 }

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <memory>
 
@@ -29,6 +30,20 @@ double integrityPenalty(double r) {
   if (!(r < 0.99)) return 1e4;
   const double q = r / (1.0 - r);
   return q * q;
+}
+
+}  // namespace
+
+namespace {
+
+/// Every zone and building file the mission names can be read; else the mission's field is named
+/// with the path it resolved to.
+void requireReadableInputs(const Mission& m) {
+  auto check = [&m](const std::string& path, const std::string& field) {
+    if (!std::ifstream(path)) throw maps::ParseError(m.source, 0, field, path, "a readable file (the path as resolved from the mission)");
+  };
+  for (std::size_t i = 0; i < m.zone_files.size(); ++i) check(m.zone_files[i], "$.zones[" + std::to_string(i) + "]");
+  if (!m.buildings_file.empty()) check(m.buildings_file, "$.buildings");
 }
 
 }  // namespace
@@ -62,6 +77,7 @@ Approver::Impl::Impl(Mission mission)
   } catch (const std::invalid_argument& e) {
     throw maps::ParseError(m.source, 0, "$.k1/$.k2/$.vehicle", "", e.what());
   }
+  requireReadableInputs(m);
   const auto format = airspace::parseZoneFormat(m.zone_format);
   if (!format) throw maps::ParseError(m.source, 0, "$.zone_format", m.zone_format, "auto, ed269, ed318, geojson or qgc");
   geofence::ZonePolicy policy;

@@ -105,6 +105,9 @@ ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, co
   ApprovalReport report;
   report.mission = record;
   report.limits = limits;
+  // The mission's departure until an attempt sets its own: a mission rejected before any route
+  // was timed (an unflyable start or goal) still names when it was to fly.
+  if (!departures.empty()) report.departure = departures.front();
   AttemptHistory history;
   for (const maps::GpsTime& departure : departures) {
     if (tryDeparture(setup, departure, history, report, say)) break;

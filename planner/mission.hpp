@@ -61,7 +61,7 @@ struct Mission {
   double cost_weight = 1.0;    ///< weight of the integrity cost against path length
   double cost_cell_m = 50.0;   ///< grid of the integrity cost field
   PlannerKind planner = PlannerKind::kRrtStar;
-  double time_limit_s = 1.0;
+  double time_limit_s = 30.0;     ///< per leg, a safety net far above the budget's usual time
   std::uint64_t iterations = 3000;  ///< the planner's iteration budget (reproducible), per leg
   std::uint64_t seed = 1;
   double resolution_m = 2.0;

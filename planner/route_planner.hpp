@@ -48,7 +48,7 @@ struct PathProblem {
   std::function<double(const Eigen::Vector3d&)> extra_cost;  ///< ≥ 0 per metre; empty = path length
   double cost_step_m = 25.0;   ///< the cost integral's step along a motion (trapezoid rule)
   double resolution_m = 2.0;   ///< motion checking step
-  double time_limit_s = 1.0;   ///< a safety net: the iteration budget should end the search
+  double time_limit_s = 30.0;  ///< a safety net: the iteration budget should end the search
   /// \brief The search ends after this many checks of the planner's termination condition
   /// (about one per iteration): the same seed then gives the same route whatever the machine's
   /// load. When the time limit ends the search first, the route depends on the speed.

@@ -217,7 +217,7 @@ NmeaEpochAssembler::NmeaEpochAssembler(std::optional<NmeaDate> default_date) : d
 std::optional<NmeaFix> NmeaEpochAssembler::release() {
   std::optional<NmeaFix> out;
   if (gga_ && gga_->lat_rad && gga_->lon_rad && gga_->quality > 0) {
-    if (!date_) throw std::invalid_argument("NMEA: a fix needs a date (an RMC or ZDA sentence, or a default date)");
+    if (!date_) throw std::invalid_argument("NMEA: a fix needs a date: an RMC or ZDA sentence before it, or a default date (skylane track --date YYYY-MM-DD)");
     NmeaFix f;
     // The time of day belongs to the known date; a time of day far before the date's own
     // (past midnight since the RMC/ZDA) moves to the next day.

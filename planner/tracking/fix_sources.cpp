@@ -104,7 +104,14 @@ SourceRecord NmeaFixSource::next(int timeout_ms) {
     if (st == LineInput::Status::kEnd) {
       if (flushed_) return kindRecord(SourceRecord::Kind::kEnd);
       flushed_ = true;
-      const std::optional<integrity::NmeaFix> last = nmea_.flush();
+      std::optional<integrity::NmeaFix> last;
+      try {
+        last = nmea_.flush();
+      } catch (const std::invalid_argument& e) {  // the last epoch cannot be a fix: said, not fatal
+        const std::size_t at = open_epoch_line_ > 0 ? open_epoch_line_ : line_;
+        open_epoch_line_ = 0;
+        return badRecord(name(), at, e.what());
+      }
       open_epoch_line_ = 0;
       if (std::optional<SourceRecord> r = epochRecord(last, epoch_line_)) return std::move(*r);
       continue;

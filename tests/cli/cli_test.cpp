@@ -452,6 +452,20 @@ TEST(Cli, ApproveRejectsAGoalInAProhibitedZoneWithExitOne) {
   EXPECT_EQ(r.status, 1) << r.out;
   EXPECT_NE(r.out.find("\"decision\": \"rejected\""), std::string::npos);
   EXPECT_NE(r.out.find("EX-ZH-HOSPITAL"), std::string::npos);
+  // rejected before any route was timed, the report still names the mission's departure
+  EXPECT_NE(r.out.find("\"departure\": \"2020-01-01T14:00:00Z\""), std::string::npos) << r.out;
+}
+
+TEST(Cli, AMissingZoneFileNamesTheMissionsFieldAndTheResolvedPath) {
+  const std::string mission = writeTemp("mission_missing_zones.json",
+                                        R"({"vehicle":{"lateral_m":1,"longitudinal_m":1,"cruise_speed_mps":10},)"
+                                        R"("start":{"lat":47.37,"lon":8.54},"goal":{"lat":47.38,"lon":8.54},)"
+                                        R"("departure":"2020-01-01T14:00:00Z","zones":["no_such_zones.json"],)"
+                                        R"("orbits":[")" + test::dataPath("gnss/alm01jan2020.txt") + R"("]})");
+  const RunResult r = run("approve " + mission);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("mission_missing_zones.json: field '$.zones[0]'"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("no_such_zones.json"), std::string::npos) << r.out;
 }
 
 TEST(Cli, ApproveRefusesABadMissionWithExitTwo) {

@@ -85,6 +85,16 @@ class TrackCli : public ::testing::Test {
 std::string* TrackCli::dir_ = nullptr;
 json* TrackCli::report_ = nullptr;
 
+TEST_F(TrackCli, NmeaWithoutADateNamesTheDateOptionAndEndsCleanly) {
+  const std::string in = *dir_ + "/nodate.nmea";
+  std::ofstream(in) << test::nmeaSentence("GPGGA,140000.00,4722.2795910,N,00831.9354490,E,4,12,0.8,468.8,M,47.35,M,,") << "\r\n"
+                    << test::nmeaSentence("GPGST,140000.00,0.5,0.060,0.040,30.0,0.050,0.045,0.090") << "\r\n";
+  const RunResult r = sh(kBin + " track --approval " + approval() + " --format nmea --input " + in + " --no-replan 2>&1");
+  EXPECT_EQ(r.status, 0) << r.out;  // a record that cannot be a fix is reported, not fatal
+  EXPECT_NE(r.out.find("--date YYYY-MM-DD"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"line\":1"), std::string::npos) << r.out;
+}
+
 TEST_F(TrackCli, GarbageAndTruncatedLinesAreReportedAndEveryGoodFixIsChecked) {
   const std::string in = *dir_ + "/mixed.jsonl";
   std::ofstream f(in);

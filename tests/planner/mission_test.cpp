@@ -361,7 +361,7 @@ TEST(MissionFile, OmittedFieldsTakeTheirDefaults) {
   EXPECT_EQ(d.cost_weight, 1.0);
   EXPECT_EQ(d.cost_cell_m, 50.0);
   EXPECT_EQ(d.planner, PlannerKind::kRrtStar);
-  EXPECT_EQ(d.time_limit_s, 1.0);
+  EXPECT_EQ(d.time_limit_s, 30.0);  // a safety net far above the iteration budget
   EXPECT_EQ(d.seed, 1u);
   EXPECT_EQ(d.resolution_m, 2.0);
   EXPECT_TRUE(d.simplify);
