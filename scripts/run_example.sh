@@ -51,7 +51,7 @@ echo "    errors_and_pls.svg, stanford_horizontal.svg, stanford_vertical.svg):"
 for s in no_fault accel_fault sat_10sigma sat_20sigma combined; do
   "$SKYLANE" simulate examples/simulate/gnss_ins_$s.json --out "$OUT"/simulate/$s | grep -v '^skylane: simulate: wrote'
 done
-echo "--- preflight approval ("$OUT"/approve/: report.json, route.geojson, operational_intent.json, map.svg, pl.svg):"
+echo "--- preflight approval ("$OUT"/approve/: report.json, route.geojson, operational_intent.json, mission.plan, map.svg, pl.svg):"
 "$SKYLANE" approve examples/approve/mission.json --out "$OUT"/approve > /dev/null
 python3 -c 'import json, os; j=json.load(open(os.environ["OUT"] + "/approve/report.json")); print(j["decision"], "-", round(j["planner"]["length_m"]), "m,", len(j["predicted"]), "samples, max HPL", max(p["hpl_m"] for p in j["predicted"]), "m, zones:", ", ".join("%s %.0f m" % (z["id"], z["min_clearance_m"]) for z in j["zones"]))'
 echo "--- a mission that is rejected ("$OUT"/approve_rejected/):"
