@@ -31,6 +31,7 @@ struct SourceRecord {
   std::string where;     ///< "input:line"
   std::size_t line = 0;  ///< 0: no line
   std::string error;
+  std::string flight;    ///< kBad: the flight the record named, when that much could be read
 };
 
 /// \brief A source of fixes.

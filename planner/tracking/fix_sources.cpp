@@ -12,6 +12,21 @@ namespace skylane::planner {
 
 namespace {
 
+/// The "flight" (or "vehicle") a JSON line names, when the line is a JSON object with that
+/// string member, whatever else is wrong with it; empty otherwise.
+std::string namedFlight(const std::string& text) {
+  try {
+    const nlohmann::json j = maps::parseJsonLine(text, "");
+    if (!j.is_object()) return {};
+    for (const char* key : {"flight", "vehicle"}) {
+      const auto it = j.find(key);
+      if (it != j.end() && it->is_string()) return it->get<std::string>();
+    }
+  } catch (const std::exception&) {  // not even JSON: no flight to name
+  }
+  return {};
+}
+
 SourceRecord badRecord(const std::string& name, std::size_t line, const std::string& error) {
   SourceRecord r;
   r.kind = SourceRecord::Kind::kBad;
@@ -56,7 +71,9 @@ SourceRecord JsonLinesFixSource::next(int timeout_ms) {
       f.line = line_;
       return fixRecord(std::move(f));
     } catch (const std::exception& e) {
-      return badRecord(name(), line_, e.what());
+      SourceRecord bad = badRecord(name(), line_, e.what());
+      bad.flight = namedFlight(text);
+      return bad;
     }
   }
 }

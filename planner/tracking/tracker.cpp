@@ -204,10 +204,12 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   const std::string id = fix.flight.empty() ? onlyFlight() : fix.flight;
   const auto it = flights_.find(id);
   if (it == flights_.end()) {
-    return {rejectedInput(fix.source, fix.line,
-                          fix.flight.empty() ? "the fix names no flight and " + std::to_string(flights_.size()) +
-                                                   " flights are tracked (give \"flight\")"
-                                             : "unknown flight \"" + fix.flight + "\" (no approval loaded for it)")};
+    TrackEvent e = rejectedInput(fix.source, fix.line,
+                                 fix.flight.empty() ? "the fix names no flight and " + std::to_string(flights_.size()) +
+                                                          " flights are tracked (give \"flight\")"
+                                                    : "unknown flight \"" + fix.flight + "\" (no approval loaded for it)");
+    e.flight = fix.flight;  // the flight the line named, known or not
+    return {e};
   }
   TrackedFlight& f = *it->second;
   FixWork w(fix);

@@ -98,9 +98,11 @@ void TrackingSession::submit(const TrackFix& fix) {
   checkpoint(false);
 }
 
-void TrackingSession::reject(const std::string& where, std::size_t line, const std::string& why) {
+void TrackingSession::reject(const std::string& where, std::size_t line, const std::string& why, const std::string& flight) {
   beginBatch();
-  emit({tracker_.rejectedInput(where, line, why)});
+  TrackEvent e = tracker_.rejectedInput(where, line, why);
+  e.flight = flight;
+  emit({e});
   log_("skipped " + where + ": " + why);
   ++pending_;
 }
@@ -151,7 +153,7 @@ SessionSummary TrackingSession::run(FixSource& source) {
     }
     last_wall = std::chrono::steady_clock::now();
     if (r.kind == SourceRecord::Kind::kBad) {
-      reject(r.where, r.line, r.error);
+      reject(r.where, r.line, r.error, r.flight);
     } else {
       submit(r.fix);
     }

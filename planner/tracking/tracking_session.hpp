@@ -69,8 +69,8 @@ class TrackingSession {
 
   /// \brief One fix pushed by the caller (a service); `rejected_input` when it cannot be taken.
   void submit(const TrackFix& fix);
-  /// \brief One record the caller could not read.
-  void reject(const std::string& where, std::size_t line, const std::string& why);
+  /// \brief One record the caller could not read (`flight`: the flight it named, if any).
+  void reject(const std::string& where, std::size_t line, const std::string& why, const std::string& flight = {});
   /// \brief The stale sweep at the stream time and a checkpoint (the end of a run).
   void finish();
 

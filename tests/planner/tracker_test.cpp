@@ -383,6 +383,7 @@ TEST_F(TrackerOnExample, BadOrderUnknownFlightsAndStaleFlightsAreReportedAndSkip
   stranger.flight = "F9";
   auto unknown = tracker.processJson(stranger);
   EXPECT_NE(unknown[0].at("error").get<std::string>().find("unknown flight \"F9\""), std::string::npos);
+  EXPECT_EQ(unknown[0].at("flight"), "F9");  // the flight the line named, though unknown
   // A 6 s gap: the next fix first reports the flight stale (3 s), then is accepted.
   auto late = tracker.processJson(fixAt(a, r.departure.plus(16), along(r, 16), 0.5, 0.5, 6));
   ASSERT_EQ(ofType(late, "stale").size(), 1u);

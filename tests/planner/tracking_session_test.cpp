@@ -114,6 +114,7 @@ TEST(TrackingSession, InMemorySourceAndSinkGiveTheTrackersEventsWithoutAFile) {
   EXPECT_EQ(bad.body.at("line"), 6);
   EXPECT_EQ(bad.body.at("source"), "memory:6");
   EXPECT_NE(bad.body.at("error").get<std::string>().find("time"), std::string::npos) << bad.body.dump();
+  EXPECT_EQ(bad.flight, "F1");  // the line named its flight: the rejection says whose it was
   // AND the events are the ones a tracker alone gives for the same fixes (JSON lines agree too)
   Tracker alone;
   alone.addFlight("F1", parseApprovalReport(nlohmann::json(example().report), "r"),
