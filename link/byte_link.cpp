@@ -1,6 +1,7 @@
 #include "link/byte_link.hpp"
 
 #include "maps/parse_error.hpp"
+#include "planner/tracking/line_input.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -72,21 +73,7 @@ class PosixByteLink final : public ByteLink {
 };
 
 void PosixByteLink::bindUdp(const std::string& hostport) {
-  const auto colon = hostport.rfind(':');
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  const std::string host = colon == std::string::npos ? "" : hostport.substr(0, colon);
-  const std::string port = colon == std::string::npos ? "" : hostport.substr(colon + 1);
-  char* end = nullptr;
-  const long p = std::strtol(port.c_str(), &end, 10);
-  if (host.empty() || port.empty() || *end != '\0' || p < 1 || p > 65535 || inet_pton(AF_INET, host.c_str(), &addr.sin_addr) != 1) {
-    throw ParseError("--input", 0, "--input", name_, "udp://IPv4:PORT, e.g. udp://127.0.0.1:14550");
-  }
-  addr.sin_port = htons(static_cast<std::uint16_t>(p));
-  fd_ = socket(AF_INET, SOCK_DGRAM, 0);
-  if (fd_ < 0 || bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-    throw ParseError("--input", 0, "--input", name_, std::string("a UDP port to listen on (") + std::strerror(errno) + ")");
-  }
+  fd_ = planner::bindUdpSocket(hostport, name_);
   udp_ = live_ = writable_ = true;
 }
 

@@ -138,19 +138,9 @@ const MessageDef* findMessage(std::uint32_t id) {
   return it == known.end() ? nullptr : &it->second;
 }
 
-void FrameParser::push(const std::uint8_t* data, std::size_t n) {
-  if (start_ > 0 && start_ >= buffer_.size() / 2) {
-    buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(start_));
-    start_ = 0;
-  }
-  buffer_.insert(buffer_.end(), data, data + n);
-}
-
-void FrameParser::drop(std::size_t n) { start_ = std::min(buffer_.size(), start_ + n); }
-
 FrameParser::Step FrameParser::tryFrame(std::size_t at, Frame& out) {
-  const std::uint8_t* b = buffer_.data() + at;
-  const std::size_t have = buffer_.size() - at;
+  const std::uint8_t* b = window_.bytes.data() + at;
+  const std::size_t have = window_.bytes.size() - at;
   const bool v2 = b[0] == kStartV2;
   const std::size_t header = v2 ? kHeaderV2 : kHeaderV1;
   if (have < header) return Step::kNeedMore;
@@ -200,14 +190,14 @@ FrameParser::Step FrameParser::tryFrame(std::size_t at, Frame& out) {
 
 std::optional<Frame> FrameParser::next() {
   Frame frame;
-  while (start_ < buffer_.size()) {
-    const auto begin = buffer_.begin() + static_cast<std::ptrdiff_t>(start_);
-    const auto sync = std::find_if(begin, buffer_.end(), [](std::uint8_t c) { return c == kStartV2 || c == kStartV1; });
+  while (window_.start < window_.bytes.size()) {
+    const auto begin = window_.bytes.begin() + static_cast<std::ptrdiff_t>(window_.start);
+    const auto sync = std::find_if(begin, window_.bytes.end(), [](std::uint8_t c) { return c == kStartV2 || c == kStartV1; });
     const std::size_t garbage = static_cast<std::size_t>(sync - begin);
     stats_.skipped_bytes += garbage;
     drop(garbage);
-    if (start_ >= buffer_.size()) break;
-    const Step s = tryFrame(start_, frame);
+    if (window_.start >= window_.bytes.size()) break;
+    const Step s = tryFrame(window_.start, frame);
     if (s == Step::kFrame) return frame;
     if (s == Step::kNeedMore) return std::nullopt;
   }

@@ -12,6 +12,8 @@
 /// when incompat_flags has bit 0. Frame (v1): 0xFE, len, seq, sysid, compid, msgid (1 byte),
 /// payload, checksum. Multi-byte fields are little-endian.
 
+#include "link/byte_window.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -110,19 +112,18 @@ struct ParserStats {
 class FrameParser {
  public:
   /// \brief Appends bytes; frames are taken with next().
-  void push(const std::uint8_t* data, std::size_t n);
+  void push(const std::uint8_t* data, std::size_t n) { window_.push(data, n); }
   /// \brief The next complete, checked frame of a known message, if any.
   [[nodiscard]] std::optional<Frame> next();
   [[nodiscard]] const ParserStats& stats() const { return stats_; }
   /// \brief Bytes waiting for the rest of a frame.
-  [[nodiscard]] std::size_t pending() const { return buffer_.size() - start_; }
+  [[nodiscard]] std::size_t pending() const { return window_.pending(); }
 
  private:
   enum class Step { kFrame, kNeedMore, kDropped };
   Step tryFrame(std::size_t at, Frame& out);
-  void drop(std::size_t n);
-  std::vector<std::uint8_t> buffer_;
-  std::size_t start_ = 0;
+  void drop(std::size_t n) { window_.drop(n); }
+  ByteWindow window_;
   ParserStats stats_;
 };
 

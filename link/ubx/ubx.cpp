@@ -27,26 +27,16 @@ std::array<std::uint8_t, 2> fletcher8(const std::uint8_t* data, std::size_t n) {
   return {a, b};
 }
 
-void FrameParser::push(const std::uint8_t* data, std::size_t n) {
-  if (start_ > 0 && start_ >= buffer_.size() / 2) {
-    buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(start_));
-    start_ = 0;
-  }
-  buffer_.insert(buffer_.end(), data, data + n);
-}
-
-void FrameParser::drop(std::size_t n) { start_ = std::min(buffer_.size(), start_ + n); }
-
 std::optional<Frame> FrameParser::next() {
-  while (start_ < buffer_.size()) {
-    const auto begin = buffer_.begin() + static_cast<std::ptrdiff_t>(start_);
-    const auto sync = std::find(begin, buffer_.end(), kSync1);
+  while (window_.start < window_.bytes.size()) {
+    const auto begin = window_.bytes.begin() + static_cast<std::ptrdiff_t>(window_.start);
+    const auto sync = std::find(begin, window_.bytes.end(), kSync1);
     const std::size_t garbage = static_cast<std::size_t>(sync - begin);
     stats_.skipped_bytes += garbage;
     drop(garbage);
-    const std::size_t have = buffer_.size() - start_;
+    const std::size_t have = window_.bytes.size() - window_.start;
     if (have < 2) return std::nullopt;
-    const std::uint8_t* b = buffer_.data() + start_;
+    const std::uint8_t* b = window_.bytes.data() + window_.start;
     if (b[1] != kSync2) {
       ++stats_.skipped_bytes;
       drop(1);

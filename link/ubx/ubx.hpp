@@ -5,6 +5,8 @@
 /// 8-bit Fletcher checksum (CK_A, CK_B over class, id, length and payload); UBX-NAV-PVT
 /// (0x01 0x07, 92 bytes) and UBX-NAV-PL (0x01 0x62, 52 bytes) decoded.
 
+#include "link/byte_window.hpp"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -37,15 +39,14 @@ constexpr std::size_t kMaxPayload = 8192;
 /// are counted and skipped (the scan goes on at the next sync pair).
 class FrameParser {
  public:
-  void push(const std::uint8_t* data, std::size_t n);
+  void push(const std::uint8_t* data, std::size_t n) { window_.push(data, n); }
   [[nodiscard]] std::optional<Frame> next();
   [[nodiscard]] const ParserStats& stats() const { return stats_; }
-  [[nodiscard]] std::size_t pending() const { return buffer_.size() - start_; }
+  [[nodiscard]] std::size_t pending() const { return window_.pending(); }
 
  private:
-  void drop(std::size_t n);
-  std::vector<std::uint8_t> buffer_;
-  std::size_t start_ = 0;
+  void drop(std::size_t n) { window_.drop(n); }
+  ByteWindow window_;
   ParserStats stats_;
 };
 

@@ -60,21 +60,7 @@ class PosixLineInput final : public LineInput {
 };
 
 void PosixLineInput::bindUdp(const std::string& hostport) {
-  const auto colon = hostport.rfind(':');
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  const std::string host = colon == std::string::npos ? "" : hostport.substr(0, colon);
-  const std::string port = colon == std::string::npos ? "" : hostport.substr(colon + 1);
-  char* end = nullptr;
-  const long p = std::strtol(port.c_str(), &end, 10);
-  if (host.empty() || port.empty() || *end != '\0' || p < 1 || p > 65535 || inet_pton(AF_INET, host.c_str(), &addr.sin_addr) != 1) {
-    throw ParseError("--input", 0, "--input", name_, "udp://IPv4:PORT, e.g. udp://127.0.0.1:5005");
-  }
-  addr.sin_port = htons(static_cast<std::uint16_t>(p));
-  fd_ = socket(AF_INET, SOCK_DGRAM, 0);
-  if (fd_ < 0 || bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-    throw ParseError("--input", 0, "--input", name_, std::string("a UDP port to listen on (") + std::strerror(errno) + ")");
-  }
+  fd_ = bindUdpSocket(hostport, name_);
   udp_ = live_ = true;
 }
 
@@ -146,6 +132,27 @@ LineInput::Status PosixLineInput::next(std::string& line, int timeout_ms) {
 }
 
 }  // namespace
+
+int bindUdpSocket(const std::string& hostport, const std::string& input) {
+  const auto colon = hostport.rfind(':');
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  const std::string host = colon == std::string::npos ? "" : hostport.substr(0, colon);
+  const std::string port = colon == std::string::npos ? "" : hostport.substr(colon + 1);
+  char* end = nullptr;
+  const long p = std::strtol(port.c_str(), &end, 10);
+  if (host.empty() || port.empty() || *end != '\0' || p < 1 || p > 65535 || inet_pton(AF_INET, host.c_str(), &addr.sin_addr) != 1) {
+    throw ParseError("--input", 0, "--input", input, "udp://IPv4:PORT, e.g. udp://127.0.0.1:5005");
+  }
+  addr.sin_port = htons(static_cast<std::uint16_t>(p));
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  if (fd < 0 || bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    const std::string why = std::strerror(errno);
+    if (fd >= 0) close(fd);
+    throw ParseError("--input", 0, "--input", input, "a UDP port to listen on (" + why + ")");
+  }
+  return fd;
+}
 
 std::unique_ptr<LineInput> openLineInput(const std::string& input) { return std::make_unique<PosixLineInput>(input); }
 

@@ -33,6 +33,10 @@ class LineInput {
   [[nodiscard]] virtual const std::string& name() const = 0;
 };
 
+/// \brief A UDP socket bound to `hostport` ("IPv4:PORT"); `input` names it in errors.
+/// \throws maps::ParseError naming --input and what was expected.
+[[nodiscard]] int bindUdpSocket(const std::string& hostport, const std::string& input);
+
 /// \brief Opens "-" (stdin), "udp://IPv4:PORT" (binds the port) or a file path.
 /// \throws maps::ParseError naming --input and what was expected (an address, a readable file).
 [[nodiscard]] std::unique_ptr<LineInput> openLineInput(const std::string& input);

@@ -8,6 +8,8 @@
 #include "maps/text_file.hpp"
 #include "planner/mission.hpp"
 
+#include "tests/test_util.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -51,16 +53,8 @@ double signedArea2(const json& ring) {
   return a;
 }
 
-/// Point in a plane polygon (crossing number).
-bool inside(const std::vector<Eigen::Vector2d>& ring, const Eigen::Vector2d& p) {
-  bool in = false;
-  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
-    const Eigen::Vector2d& a = ring[i];
-    const Eigen::Vector2d& b = ring[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) in = !in;
-  }
-  return in;
-}
+/// Point in a plane polygon: the test utilities' independent crossing test.
+bool inside(const std::vector<Eigen::Vector2d>& ring, const Eigen::Vector2d& p) { return test::insideByCrossings(p, ring); }
 
 TEST(QgcPlan, EveryFieldIsAsThePlanFormatDescribesIt) {
   const Example& e = example();
