@@ -216,7 +216,14 @@ TEST(KeepInTracking, LeavingTheFenceIsAViolationAndReplansBackInside) {
     f.hpl_m = 2.0;
     f.vpl_m = 2.0;
     f.line = line;
-    return tracker.processJson(f);
+    std::vector<json> out;
+    for (const TrackEvent& e : tracker.process(f)) {
+      // The fast line writer, the one JSON form and its reader agree on the keep-in level too.
+      EXPECT_EQ(json::parse(e.jsonLine()), e.toJson()) << e.jsonLine();
+      EXPECT_EQ(e.toJson().get<TrackEvent>().toJson(), e.toJson()) << e.jsonLine();
+      out.push_back(e.toJson());
+    }
+    return out;
   };
   const std::vector<json> inside = fix(10.0, positionAlong(r.route, 10.0), 1);
   ASSERT_FALSE(inside.empty());
