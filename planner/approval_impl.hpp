@@ -187,6 +187,8 @@ struct Approver::Impl {
                                        const std::vector<approval_steps::Penalty>& penalties) const;
   void unflyableCause(const Eigen::Vector3d& p, const maps::GpsTime& from, const maps::GpsTime& until,
                       const std::string& what, Reason& r) const;
+  [[nodiscard]] std::string legBlockers(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const maps::GpsTime& t0,
+                                        const maps::GpsTime& t1) const;
   [[nodiscard]] std::string conflictCause(const geofence::Check& c, const geofence::TimedVolume& point,
                                           const geofence::ProtectionVolume& pv) const;
   [[nodiscard]] Reason planningReason(const approval_steps::ApprovalSetup& setup, const maps::GpsTime& departure,

@@ -295,8 +295,11 @@ Reason Approver::Impl::planningReason(const ApprovalSetup& setup, const maps::Gp
   r.subject = status;
   const PathResult& last = plan.last;
   if (last.status != PathStatus::kInvalidStart && last.status != PathStatus::kInvalidGoal) {
-    r.message = "no route found within " + std::to_string(last.iterations) + " planner iterations (" + status +
-                (last.stopped_by_time ? ", stopped by the time limit)" : ")");
+    r.message = "no route found for leg " + std::to_string(plan.failed_leg) + " within " + std::to_string(last.iterations) +
+                " planner iterations (" + status + (last.stopped_by_time ? ", stopped by the time limit)" : ")") +
+                legBlockers(plan.pts.back(), setup.stops[plan.failed_leg], departure, setup.zones_until) +
+                "; a wider search box (planner.margin_m " + fmtMetres(m.margin_m) + ") or more planner.iterations (" +
+                std::to_string(m.iterations) + ") may find one";
     return r;
   }
   const bool start = last.status == PathStatus::kInvalidStart;
@@ -307,6 +310,25 @@ Reason Approver::Impl::planningReason(const ApprovalSetup& setup, const maps::Gp
   r.lon_rad = g.lon_rad;
   r.h_ell_m = g.h_ell_m;
   return r;
+}
+
+/// What blocks the direct line of a leg: the keep-in zone its planning volume leaves and the zones
+/// and obstacles it meets along it (every resolution_m, at most three, in the order met).
+std::string Approver::Impl::legBlockers(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const maps::GpsTime& t0,
+                                        const maps::GpsTime& t1) const {
+  std::vector<std::string> met;
+  const int n = std::max(1, static_cast<int>(std::ceil((to - from).norm() / std::max(m.resolution_m, 1.0))));
+  for (int k = 0; k <= n && met.size() < 3; ++k) {
+    const Eigen::Vector3d p = from + (to - from) * (static_cast<double>(k) / n);
+    const std::optional<geofence::Check> c = obstructions->firstConflict({t0, t1, planningVolume(p)});
+    if (!c) continue;
+    const std::string what = (c->level == geofence::Level::kKeepIn ? "leaves " : "meets ") + describeCheck(*c);
+    if (std::find(met.begin(), met.end(), what) == met.end()) met.push_back(what);
+  }
+  if (met.empty()) return "";
+  std::string out = ": the direct line ";
+  for (std::size_t i = 0; i < met.size(); ++i) out += (i == 0 ? "" : i + 1 == met.size() ? " and " : ", ") + met[i];
+  return out;
 }
 
 /// Why `p` is not a valid state (Impl::valid), in the order valid() asks: the terrain, the

@@ -153,6 +153,23 @@ TEST(KeepInApproval, TheFenceSendsTheRouteTheLongWayRound) {
   EXPECT_GT(max_y, 60.0);
 }
 
+// A prohibited circle cuts the fence in two: no route, and the reason names what blocks the leg.
+TEST(KeepInApproval, ALegWithNoRouteNamesWhatBlocksItsDirectLine) {
+  const std::vector<Eigen::Vector2d> ring{{-300, -60}, {1800, -60}, {1800, 60}, {-300, 60}};
+  Mission m = missionOver({polygonFeature("SITE", "KEEP_IN", ring), circleFeature("CUT", "PROHIBITED", {750, 0}, 100)},
+                          "keep_in_cut");
+  m.iterations = 300;
+  const ApprovalReport r = Approver(m).approve();
+  EXPECT_FALSE(r.approved);
+  ASSERT_FALSE(r.reasons.empty());
+  const Reason& why = r.reasons.front();
+  EXPECT_EQ(why.kind, "planning");
+  EXPECT_NE(why.message.find("no route found for leg 1 within"), std::string::npos) << why.message;
+  EXPECT_NE(why.message.find("the direct line meets zone CUT (PROHIBITED, \"CUT name\")"), std::string::npos)
+      << why.message;
+  EXPECT_NE(why.message.find("planner.margin_m"), std::string::npos) << why.message;
+}
+
 TEST(KeepInApproval, AStartOutsideTheFenceIsRejectedNamingIt) {
   const std::vector<Eigen::Vector2d> ring{{200, -200}, {1700, -200}, {1700, 200}, {200, 200}};
   Approver a(missionOver({polygonFeature("SITE", "KEEP_IN", ring)}, "keep_in_start_outside"));
