@@ -122,6 +122,10 @@ std::string formatNumber(double v) {
   return s;
 }
 
+/// The largest finite vertical limit [m]: far above any airspace a U-space serves (FL 999 is
+/// 30.4 km) and far below where the geofence's arithmetic would lose metres.
+constexpr double kMaxLimit_m = 100'000.0;
+
 /// A limit given as a number, a numeric string or null (= unlimited).
 VerticalLimit limit(const Node& value, VerticalReference ref, double scale, bool ceiling,
                     double unlimited_value = std::numeric_limits<double>::infinity()) {
@@ -147,6 +151,10 @@ VerticalLimit limit(const Node& value, VerticalReference ref, double scale, bool
     return l;
   }
   l.value_m = v * scale;
+  if (!(std::abs(l.value_m) <= kMaxLimit_m)) {
+    value.fail("a height within ±" + formatNumber(kMaxLimit_m) + " m of its reference (null or no " +
+               (ceiling ? "ceiling for unlimited)" : "floor for none)"));
+  }
   l.as_given = formatNumber(v) + " " + unitName(scale) + " " + std::string(referenceName(ref));
   return l;
 }

@@ -76,12 +76,7 @@ void runFenceCheck(const FenceCheckOptions& o) {
                                                          std::move(policy), options));
 
   if (!o.fix.empty()) {
-    json doc;
-    try {
-      doc = json::parse(o.fix);
-    } catch (const json::parse_error& e) {
-      throw ParseError("--fix", 0, "--fix", o.fix.substr(0, 60), std::string("JSON (") + e.what() + ")");
-    }
+    const json doc = maps::parseJsonLine(o.fix, "--fix");
     json out = checkFix(geofence::parseFix(doc, "--fix"), fence, boxes.frame);
     if (!boxes.limits.warnings.empty()) out["warnings"] = boxes.limits.warnings;
     std::cout << out.dump(2) << "\n";

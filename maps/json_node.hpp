@@ -42,6 +42,9 @@ inline constexpr int kMaxJsonLineDepth = 32;
     return nlohmann::json::parse(text, bounded);
   } catch (const nlohmann::json::parse_error& e) {
     throw ParseError(source, 0, "$", text.substr(0, kJsonQuoteChars), std::string("one JSON object per line (") + e.what() + ")");
+  } catch (const nlohmann::json::out_of_range& e) {
+    throw ParseError(source, 0, "$", text.substr(0, kJsonQuoteChars),
+                     std::string("numbers within a double's range (") + e.what() + ")");
   }
 }
 

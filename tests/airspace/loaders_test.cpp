@@ -5,6 +5,7 @@
 #include "airspace/validation.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/parse_error.hpp"
+#include "maps/text_file.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -241,6 +242,29 @@ TEST(ZoneLoaders, GeoJsonKeepInByRestrictionOrProperty) {
     EXPECT_NE(std::string(e.what()).find("KEEP_IN"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("properties.restriction"), std::string::npos) << e.what();
   }
+}
+
+// Issue 23 items 1, 2, 7: deep nesting, a number beyond a double and a limit the geofence could
+// not hold are file/field errors, not crashes or "internal error".
+TEST(ZoneLoaders, DeepNestingHugeNumbersAndHugeLimitsAreFieldErrors) {
+  auto message = [](const std::string& text) -> std::string {
+    try {
+      (void)parseZones(maps::parseJsonText(text, "mem.json"), "mem.json");
+    } catch (const maps::ParseError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string nested = std::string(100000, '[') + std::string(100000, ']');
+  EXPECT_NE(message(nested).find("nested at most 64 levels"), std::string::npos) << message(nested);
+  const std::string feature = R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{"upper":%,"radius_m":5},
+                                  "geometry":{"type":"Point","coordinates":[8,47]}}]})";
+  auto with = [&](const std::string& v) { std::string t = feature; t.replace(t.find('%'), 1, v); return t; };
+  EXPECT_NE(message(with("1e400")).find("'1e400', expected a number within a double's range"), std::string::npos)
+      << message(with("1e400"));
+  EXPECT_NE(message(with("1e155")).find("properties.upper"), std::string::npos) << message(with("1e155"));
+  EXPECT_NE(message(with("-1e308")).find("a height within"), std::string::npos) << message(with("-1e308"));
+  EXPECT_EQ(message(with("150")), "");
 }
 
 }  // namespace
