@@ -8,7 +8,9 @@
 
 #include <functional>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <stdexcept>
 
@@ -201,6 +203,43 @@ TEST(Corridor, RandomScenesInsideMeansEverySampledPointIsInAPieceAndLargerPlsNev
   EXPECT_GT(inside, 500);
   EXPECT_GT(outside, 500);
   EXPECT_GT(joints, 10);
+}
+
+// --- end caps: the climb counts only where the disk projects inside the segment --------------
+
+TEST(Corridor, VolumeInsideTheEndCapOfAClimbingLastLegIsInside) {
+  // GIVEN a last leg climbing 50 m over 100 m (g = 0.5) to (100, 0, 50), HAL 6, VAL 4
+  const Corridor c({{-50, 0, 0}, {0, 0, 0}, {100, 0, 50}}, {6.0, 4.0});
+  // WHEN a volume (HPL 2, VPL 1) lies wholly beyond the last waypoint, its disk x ∈ [100.5, 104.5]
+  // in the end cap, where the centre line is flat at 50 m, and its top at 53.5 m
+  const Containment in = c.contains({{102.5, 0, 52.5}, 2.0, 1.0});
+  // THEN it is inside by 54 − 53.5 = 0.5 m < g·HPL = 1 m (the climb does not count in the cap)
+  EXPECT_EQ(in.verdict, Verdict::kInside);
+  EXPECT_EQ(in.segment, 1u);
+  EXPECT_FALSE(in.across_joint);
+  EXPECT_NEAR(in.margin_v_m, 0.5, 1e-12);
+  EXPECT_NEAR(in.margin_h_m, 6.0 - 2.5 - 2.0, 1e-12);
+  // AND 1 m higher its top pokes 0.5 m through the cap's ceiling: outside
+  const Containment out = c.contains({{102.5, 0, 53.5}, 2.0, 1.0});
+  EXPECT_EQ(out.verdict, Verdict::kOutside);
+  EXPECT_NEAR(out.margin_v_m, -0.5, 1e-12);
+  // AND below the cap the floor is flat too: bottom at 46.5 m is inside by 0.5 m
+  EXPECT_NEAR(c.contains({{102.5, 0, 47.5}, 2.0, 1.0}).margin_v_m, 0.5, 1e-12);
+}
+
+TEST(Corridor, VolumeStraddlingTheEndSeesTheClimbOnlyAlongTheSegment) {
+  // GIVEN the same climbing leg, and a volume centred on its end waypoint (disk x ∈ [98, 102])
+  const Corridor c({{0, 0, 0}, {100, 0, 50}}, {6.0, 4.0});
+  // WHEN it is 1.5 m below the waypoint, VPL 1
+  const Containment r = c.contains({{100, 0, 48.5}, 2.0, 1.0});
+  // THEN the centre line over the disk spans 49 m (x = 98) to 50 m (the cap): the floor is
+  // 50 − 4 = 46 m under the cap, the bottom 47.5 m → margin 1.5 (a g·HPL bound on both sides
+  // would say 0.5); the ceiling is 49 + 4 = 53 m, the top 49.5 m
+  EXPECT_EQ(r.verdict, Verdict::kInside);
+  EXPECT_NEAR(r.margin_v_m, 1.5, 1e-12);
+  // AND the path's first waypoint has a cap too: before (0, 0, 0) the floor is flat at −4 m
+  EXPECT_NEAR(c.contains({{-2.5, 0, -2.5}, 2.0, 1.0}).margin_v_m, 0.5, 1e-12);
+  EXPECT_EQ(c.contains({{-2.5, 0, -3.5}, 2.0, 1.0}).verdict, Verdict::kOutside);
 }
 
 TEST(Corridor, SegmentBoxCornersFollowTheClimb) {
