@@ -93,6 +93,40 @@ std::pair<double, double> pieceMargins(const PieceAt& p, double reach_m, double 
   return {h, v};
 }
 
+/// One piece seen from a column (or every column of a disk): its horizontal margin h and the
+/// heights [lo, hi] it holds there.
+struct PieceColumn {
+  double h_m, lo_m, hi_m;
+};
+
+/// How far the heights [bottom, top] of a column lie inside the union of the pieces: the
+/// largest δ such that [bottom − δ, top + δ] lies in the union of the height bands of the
+/// pieces with h ≥ δ (negative: by how much the column is not covered). A column may be
+/// covered by two pieces' bands together and by neither alone (at a joint between legs of
+/// different heights). Computed as the max over the sets S of the pieces with the j largest h
+/// of min(smallest h in S, the best component [L, U] of S's bands: min(bottom − L, U − top));
+/// a set of the j largest dominates every other set of its smallest h. With one piece this is
+/// min(h, v) of pieceMargins. Monotone: it never grows when an h shrinks or a band narrows, so
+/// bounds valid over a cell give a lower bound over the cell.
+double columnMargin(std::vector<PieceColumn> pieces, double bottom_m, double top_m) {
+  std::sort(pieces.begin(), pieces.end(), [](const PieceColumn& a, const PieceColumn& b) { return a.h_m > b.h_m; });
+  double best = -std::numeric_limits<double>::infinity();
+  std::vector<std::pair<double, double>> bands;
+  for (const PieceColumn& p : pieces) {
+    if (p.h_m <= best) break;  // every later set has min h ≤ this one's
+    bands.emplace_back(p.lo_m, p.hi_m);
+    std::sort(bands.begin(), bands.end());
+    double cover = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < bands.size();) {
+      double lo = bands[k].first, hi = bands[k].second;
+      for (++k; k < bands.size() && bands[k].first <= hi; ++k) hi = std::max(hi, bands[k].second);
+      cover = std::max(cover, std::min(bottom_m - lo, hi - top_m));
+    }
+    best = std::max(best, std::min(p.h_m, cover));
+  }
+  return best;
+}
+
 /// The margins of one protection volume (height z ± vpl) against the corridor's pieces (alert
 /// limits hal, val), capped by the operating limits' margin.
 struct MarginField {
@@ -109,14 +143,17 @@ struct MarginField {
     auto [h, v] = pieceMargins(p, reach_m, z, vpl, hal, val);
     return std::pair{h, std::min(v, operating_margin_m)};
   }
-  /// f(q) with reach: max over the pieces of min(h, v) for every point within reach_m of q.
+  /// f(q) with reach: a lower bound, for every column within reach_m of q, on how far the
+  /// column's heights [z − vpl, z + vpl] lie inside the union of the pieces (columnMargin);
+  /// exact at reach 0.
   [[nodiscard]] double bound(const Eigen::Vector2d& q, double reach_m) const {
-    double f = -std::numeric_limits<double>::infinity();
+    std::vector<PieceColumn> pieces;
+    pieces.reserve(segmentCount());
     for (std::size_t i = 0; i < segmentCount(); ++i) {
-      const auto [h, v] = marginsOf(piece(i, q, reach_m), reach_m);
-      f = std::max(f, std::min(h, v));
+      const PieceAt p = piece(i, q, reach_m);
+      pieces.push_back({hal - p.distance_m - reach_m, p.floor_centre_m - val, p.ceiling_centre_m + val});
     }
-    return f;
+    return std::min(columnMargin(std::move(pieces), z - vpl, z + vpl), operating_margin_m);
   }
 };
 
@@ -160,10 +197,11 @@ struct BoundCell {
 };
 
 /// Across a joint: no single piece holds the disk (centre c2, radius hpl), but their union may.
-/// The volume's margin in the union is min over the disk of f(x) = max_k min(h_k(x), v_k(x))
-/// (the margins of the point x in piece k); it is bounded on a quadtree cell (centre q,
-/// circumradius ρ) from below by the same maximum with reach ρ (the bounds used above), and
-/// from above by f at any point of the disk. Best-first branch and bound narrows the two to
+/// The volume's margin in the union is min over the disk of f(x), the column margin at x
+/// (columnMargin: how far the column's heights lie inside the union of the pieces' bands); it
+/// is bounded on a quadtree cell (centre q, circumradius ρ) from below by the column margin of
+/// the pieces' bounds with reach ρ (valid for every column of the cell), and from above by f
+/// at any point of the disk. Best-first branch and bound narrows the two to
 /// `accuracy_m`.
 UnionMargin unionMargin(const MarginField& f, const Eigen::Vector2d& c2, double hpl, double accuracy_m) {
   std::priority_queue<BoundCell> cells;
