@@ -490,6 +490,30 @@ TEST(Cli, AMissingZoneFileNamesTheMissionsFieldAndTheResolvedPath) {
   EXPECT_NE(r.out.find("no_such_zones.json"), std::string::npos) << r.out;
 }
 
+TEST(Cli, ApproveChecksTheOrbitFilesAgeAgainstTheDeparture) {
+  const std::string alm = test::dataPath("gnss/alm01jan2020.txt");
+  auto mission = [&](const std::string& name, const std::string& departure) {
+    return writeTemp(name, R"({"vehicle":{"lateral_m":1.2,"longitudinal_m":1,"cruise_speed_mps":12},)"
+                           R"("start":{"lat":47.3712,"lon":8.532},"goal":{"lat":47.3712,"lon":8.545},"ground_amsl_m":408,)"
+                           R"("planner":{"iterations":300,"seed":3},"integrity":{"cost_weight":0},)"
+                           R"("departure":")" + departure + R"(","orbits":[")" + alm + R"("]})");
+  };
+  // GIVEN the almanac of 2020-01-03: WHEN the departure is in 2025 THEN exit 2 naming the file,
+  // its epoch, the departure, the limit and the age
+  const RunResult old = run("approve " + mission("mission_2025.json", "2025-06-01T14:00:00Z"));
+  EXPECT_EQ(old.status, 2) << old.out;
+  EXPECT_NE(old.out.find("skylane: error: " + alm + ": field 'almanac epoch t_oa': got '2020-01-03T19:56:30Z"), std::string::npos)
+      << old.out;
+  EXPECT_NE(old.out.find("within 90.0 days of the departure 2025-06-01T14:00:00Z; it is 1975.8 days from it"), std::string::npos)
+      << old.out;
+  // WHEN the departure is 10.8 days after t_oa THEN the approval runs, with a warning on stderr
+  // and in the report
+  const RunResult stale = run("approve " + mission("mission_stale.json", "2020-01-14T14:00:00Z"));
+  EXPECT_EQ(stale.status, 0) << stale.out;
+  EXPECT_NE(stale.out.find("skylane: warning: " + alm + ": the almanac's t_oa 2020-01-03T19:56:30Z"), std::string::npos) << stale.out;
+  EXPECT_NE(stale.out.find("\"warnings\": ["), std::string::npos) << stale.out;
+}
+
 TEST(Cli, ApproveRefusesABadMissionWithExitTwo) {
   const std::string bad = writeTemp("bad_mission.json", R"({"vehicle":{"lateral_m":1,"longitudinal_m":1,"cruise_speed_mps":10},)"
                                                        R"("start":{"lat":47,"lon":8},"goal":{"lat":47.01,"lon":8},)"
