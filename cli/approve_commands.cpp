@@ -177,6 +177,7 @@ void runApprove(const ApproveOptions& o) {
     }
   }
   std::cout << j.dump(2) << "\n";
+  for (const std::string& w : r.warnings) std::cerr << "skylane: warning: " << w << "\n";
   std::cerr << "skylane: approve: " << (r.approved ? "APPROVED" : "REJECTED") << " in " << r.elapsed_s << " s";
   if (!r.reasons.empty()) std::cerr << ": " << r.reasons.front().message;
   if (r.planner.stopped_by_time) {

@@ -92,8 +92,8 @@ void applyIsmFile(const std::string& path, integrity::ErrorModel& model) {
 /// Loads every almanac and navigation file given on the command line.
 integrity::OrbitSource loadOrbits(const std::vector<std::string>& almanacs, const std::vector<std::string>& navs) {
   integrity::OrbitSource orbits;
-  for (const auto& a : almanacs) orbits.addAlmanac(integrity::loadAlmanac(a));
-  for (const auto& n : navs) orbits.addNavigation(integrity::loadRinexNav(n));
+  for (const auto& a : almanacs) orbits.addAlmanac(integrity::loadAlmanac(a), a);
+  for (const auto& n : navs) orbits.addNavigation(integrity::loadRinexNav(n), n);
   if (orbits.empty()) throw ParseError("--almanac", 0, "--almanac/--nav", "", "at least one almanac or navigation file");
   return orbits;
 }
@@ -239,11 +239,12 @@ integrity::PredictRequest predictRequest(const PredictOptions& o) {
   return req;
 }
 
-void warnIfAlmanacOld(const integrity::OrbitSource& orbits, const integrity::GpsTime& start) {
-  const double age = orbits.almanacAge_s(start);
-  if (age > 4 * integrity::kSecondsPerWeek) {
-    std::cerr << "skylane: warning: the almanac is " << std::lround(age / 86400) << " days from --start; "
-              << "positions are extrapolated (use an almanac of the flight's week for real predictions)\n";
+/// Every orbit file's age at --start (integrity/gnss/orbit_age.hpp): past its warning limit a
+/// warning on stderr, past its error limit a ParseError (exit 2).
+void checkOrbitAges(const integrity::OrbitSource& orbits, const integrity::GpsTime& start) {
+  for (const integrity::OrbitFileAge& age : orbits.fileAges(start)) {
+    const std::string warning = integrity::requireUsableAge(age, "--start");
+    if (!warning.empty()) std::cerr << "skylane: warning: " << warning << "\n";
   }
 }
 
@@ -328,7 +329,7 @@ void runPredict(const PredictOptions& o) {
   const integrity::IntegrityMethod method = parseMethod(o.method);
   const integrity::PredictRequest req = predictRequest(o);
   const integrity::OrbitSource orbits = loadOrbits(o.almanacs, o.navs);
-  warnIfAlmanacOld(orbits, req.start);
+  checkOrbitAges(orbits, req.start);
   Progress bar("predict", o.progress);
   const auto samples = integrity::predictIntegrity(orbits, req, method, std::ref(bar));
   writePredictSamples(samples, o, method, req.sky_mask.has_value());

@@ -44,36 +44,87 @@ void checkFactor(const char* name, double k, double lo, double hi, bool override
   warnings.push_back(s.str() + ": accepted by override");
 }
 
-/// A segment's piece at a horizontal point: distance to the segment and the centre line's
-/// height band there (a vertical segment spans its whole climb), with the slope g that bounds
-/// how fast that band moves as the point moves (the nearest point moves by ≤ the point's move).
+/// A segment's piece seen from a disk of horizontal points (centre x, radius `reach_m`): the
+/// distance from x to the segment, and the range of the centre line's height over the disk.
+/// The nearest point of the segment is a + t·(b − a) with t = clamp(s / L, 0, 1), s the
+/// projection of the point on the segment's direction and L its horizontal length; s sweeps
+/// exactly [s(x) − reach, s(x) + reach] over the disk and t is monotone in s, so the centre
+/// line's heights over the disk are exactly those at the two clamped ends of that interval.
+/// The clamp is the end-cap rule: over a half-disk beyond a waypoint the height is flat at the
+/// waypoint's, so the slope shrinks the band only by the part of the disk that projects inside
+/// the segment. A vertical segment (L = 0) spans its whole climb at every point.
 struct PieceAt {
   double distance_m = 0.0;
-  double z_lo_m = 0.0, z_hi_m = 0.0;
-  double slope = 0.0;
+  /// Every point of the disk has heights [floor_centre − VAL, ceiling_centre + VAL] in the piece
+  /// (and some point no more): the highest and lowest centre-line heights over the disk, or the
+  /// lowest and highest of a vertical segment.
+  double floor_centre_m = 0.0, ceiling_centre_m = 0.0;
 };
 
-PieceAt pieceAt(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector2d& x) {
+PieceAt pieceAt(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector2d& x, double reach_m) {
   const Eigen::Vector2d d = (b - a).head<2>();
-  const double length2 = d.squaredNorm();
-  // Nearest point of the horizontal projection: t = clamp((x − a)·d / |d|², 0, 1).
-  const double t = length2 > 0 ? std::clamp((x - a.head<2>()).dot(d) / length2, 0.0, 1.0) : 0.0;
+  const double length_m = d.norm();
   PieceAt p;
+  if (length_m == 0.0) {
+    p.distance_m = (x - a.head<2>()).norm();
+    p.floor_centre_m = std::min(a.z(), b.z());
+    p.ceiling_centre_m = std::max(a.z(), b.z());
+    return p;
+  }
+  const double s_m = (x - a.head<2>()).dot(d) / length_m;
+  const double t = std::clamp(s_m / length_m, 0.0, 1.0);
   p.distance_m = (x - (a.head<2>() + t * d)).norm();
-  p.z_lo_m = length2 > 0 ? a.z() + t * (b.z() - a.z()) : std::min(a.z(), b.z());
-  p.z_hi_m = length2 > 0 ? p.z_lo_m : std::max(a.z(), b.z());
-  p.slope = length2 > 0 ? std::abs(b.z() - a.z()) / std::sqrt(length2) : 0.0;
+  const double t_back = std::clamp((s_m - reach_m) / length_m, 0.0, 1.0);
+  const double t_ahead = std::clamp((s_m + reach_m) / length_m, 0.0, 1.0);
+  const double z_back = a.z() + t_back * (b.z() - a.z()), z_ahead = a.z() + t_ahead * (b.z() - a.z());
+  p.floor_centre_m = std::max(z_back, z_ahead);
+  p.ceiling_centre_m = std::min(z_back, z_ahead);
   return p;
 }
 
-/// Margins of the piece for every point within `reach_m` of x, for heights z ± vpl:
-/// horizontal HAL − d − reach (exact for one segment: the distance to a convex set grows by
-/// exactly `reach` across a disk of that radius), vertical the band shrunk by g·reach.
+/// Margins of the piece for every point within the reach of x (the disk `p` was taken over),
+/// for heights z ± vpl: horizontal HAL − d − reach (exact: the distance to a convex set grows by
+/// exactly `reach` across a disk of that radius), vertical the band that every point of the disk
+/// allows (exact by pieceAt).
 std::pair<double, double> pieceMargins(const PieceAt& p, double reach_m, double z, double vpl, double hal,
                                        double val) {
   const double h = hal - p.distance_m - reach_m;
-  const double v = std::min((p.z_hi_m + val - p.slope * reach_m) - (z + vpl), (z - vpl) - (p.z_lo_m - val + p.slope * reach_m));
+  const double v = std::min((p.ceiling_centre_m + val) - (z + vpl), (z - vpl) - (p.floor_centre_m - val));
   return {h, v};
+}
+
+/// One piece seen from a column (or every column of a disk): its horizontal margin h and the
+/// heights [lo, hi] it holds there.
+struct PieceColumn {
+  double h_m, lo_m, hi_m;
+};
+
+/// How far the heights [bottom, top] of a column lie inside the union of the pieces: the
+/// largest δ such that [bottom − δ, top + δ] lies in the union of the height bands of the
+/// pieces with h ≥ δ (negative: by how much the column is not covered). A column may be
+/// covered by two pieces' bands together and by neither alone (at a joint between legs of
+/// different heights). Computed as the max over the sets S of the pieces with the j largest h
+/// of min(smallest h in S, the best component [L, U] of S's bands: min(bottom − L, U − top));
+/// a set of the j largest dominates every other set of its smallest h. With one piece this is
+/// min(h, v) of pieceMargins. Monotone: it never grows when an h shrinks or a band narrows, so
+/// bounds valid over a cell give a lower bound over the cell.
+double columnMargin(std::vector<PieceColumn> pieces, double bottom_m, double top_m) {
+  std::sort(pieces.begin(), pieces.end(), [](const PieceColumn& a, const PieceColumn& b) { return a.h_m > b.h_m; });
+  double best = -std::numeric_limits<double>::infinity();
+  std::vector<std::pair<double, double>> bands;
+  for (const PieceColumn& p : pieces) {
+    if (p.h_m <= best) break;  // every later set has min h ≤ this one's
+    bands.emplace_back(p.lo_m, p.hi_m);
+    std::sort(bands.begin(), bands.end());
+    double cover = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < bands.size();) {
+      double lo = bands[k].first, hi = bands[k].second;
+      for (++k; k < bands.size() && bands[k].first <= hi; ++k) hi = std::max(hi, bands[k].second);
+      cover = std::max(cover, std::min(bottom_m - lo, hi - top_m));
+    }
+    best = std::max(best, std::min(p.h_m, cover));
+  }
+  return best;
 }
 
 /// The margins of one protection volume (height z ± vpl) against the corridor's pieces (alert
@@ -84,24 +135,31 @@ struct MarginField {
   double operating_margin_m;
 
   [[nodiscard]] std::size_t segmentCount() const { return path.size() - 1; }
-  [[nodiscard]] PieceAt piece(std::size_t i, const Eigen::Vector2d& x) const { return pieceAt(path[i], path[i + 1], x); }
+  /// Piece i over the disk of radius reach_m round x.
+  [[nodiscard]] PieceAt piece(std::size_t i, const Eigen::Vector2d& x, double reach_m) const {
+    return pieceAt(path[i], path[i + 1], x, reach_m);
+  }
   [[nodiscard]] std::pair<double, double> marginsOf(const PieceAt& p, double reach_m) const {
     auto [h, v] = pieceMargins(p, reach_m, z, vpl, hal, val);
     return std::pair{h, std::min(v, operating_margin_m)};
   }
-  /// f(q) with reach: max over the pieces of min(h, v) for every point within reach_m of q.
+  /// f(q) with reach: a lower bound, for every column within reach_m of q, on how far the
+  /// column's heights [z − vpl, z + vpl] lie inside the union of the pieces (columnMargin);
+  /// exact at reach 0.
   [[nodiscard]] double bound(const Eigen::Vector2d& q, double reach_m) const {
-    double f = -std::numeric_limits<double>::infinity();
+    std::vector<PieceColumn> pieces;
+    pieces.reserve(segmentCount());
     for (std::size_t i = 0; i < segmentCount(); ++i) {
-      const auto [h, v] = marginsOf(piece(i, q), reach_m);
-      f = std::max(f, std::min(h, v));
+      const PieceAt p = piece(i, q, reach_m);
+      pieces.push_back({hal - p.distance_m - reach_m, p.floor_centre_m - val, p.ceiling_centre_m + val});
     }
-    return f;
+    return std::min(columnMargin(std::move(pieces), z - vpl, z + vpl), operating_margin_m);
   }
 };
 
-/// One piece holding the whole volume: exact in the horizontal, the slope term in the
-/// vertical. Sets the best piece's segment and margins in `out`.
+/// One piece holding the whole volume: both margins exact (pieceAt, pieceMargins), so when the
+/// volume reaches a single piece its verdict is exact. Sets the best piece's segment and
+/// margins in `out`.
 struct BestPiece {
   double margin_m = -std::numeric_limits<double>::infinity();  ///< min(h, v) of the best piece
   std::size_t reached = 0;  ///< pieces whose alert limit the volume reaches
@@ -111,7 +169,7 @@ BestPiece bestSinglePiece(const MarginField& f, const Eigen::Vector2d& c2, doubl
   BestPiece best;
   std::size_t segment = 0;
   for (std::size_t i = 0; i < f.segmentCount(); ++i) {
-    const PieceAt p = f.piece(i, c2);
+    const PieceAt p = f.piece(i, c2, hpl);
     const auto [h, v] = f.marginsOf(p, hpl);
     if (std::min(h, v) > best.margin_m) {
       best.margin_m = std::min(h, v);
@@ -139,10 +197,11 @@ struct BoundCell {
 };
 
 /// Across a joint: no single piece holds the disk (centre c2, radius hpl), but their union may.
-/// The volume's margin in the union is min over the disk of f(x) = max_k min(h_k(x), v_k(x))
-/// (the margins of the point x in piece k); it is bounded on a quadtree cell (centre q,
-/// circumradius ρ) from below by the same maximum with reach ρ (the bounds used above), and
-/// from above by f at any point of the disk. Best-first branch and bound narrows the two to
+/// The volume's margin in the union is min over the disk of f(x), the column margin at x
+/// (columnMargin: how far the column's heights lie inside the union of the pieces' bands); it
+/// is bounded on a quadtree cell (centre q, circumradius ρ) from below by the column margin of
+/// the pieces' bounds with reach ρ (valid for every column of the cell), and from above by f
+/// at any point of the disk. Best-first branch and bound narrows the two to
 /// `accuracy_m`.
 UnionMargin unionMargin(const MarginField& f, const Eigen::Vector2d& c2, double hpl, double accuracy_m) {
   std::priority_queue<BoundCell> cells;

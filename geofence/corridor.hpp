@@ -88,12 +88,21 @@ struct Containment {
   std::size_t segment = 0;
   bool across_joint = false;  ///< held by the union of neighbouring pieces, by no single one
   /// How much HPL (resp. VPL) could still grow and the volume stay inside; negative: by how
-  /// much it sticks out. For one piece the horizontal margin is exact and the vertical one a
-  /// lower bound on a sloping segment. Across a joint both fields hold the one combined
-  /// margin, min over the volume's points of their best piece's margin, certified from below
-  /// to within max(tolerance, HAL/1000) by branch and bound; it is a lower bound on how much
-  /// either PL could grow (the margins are 1-Lipschitz in the point). A larger PL never turns
-  /// a verdict into "inside" except, across a joint, within that accuracy.
+  /// much it sticks out. For one piece both are exact: the horizontal one HAL − d − HPL (d the
+  /// centre's distance to the segment), the vertical one over the whole disk, the centre line's
+  /// height taken at each point's nearest point of the segment — so the climb counts only over
+  /// the part of the disk that projects inside the segment, and over the end caps (the
+  /// half-disks beyond a waypoint) the height is the waypoint's (docs/method.md §6, end caps).
+  /// (On a sloping segment a larger HPL also moves the vertical band: margin_h is the horizontal
+  /// room alone.) Hence a volume that reaches one piece only — a path's ends among them — is
+  /// decided exactly, up to the tolerance. Across a joint (the volume reaches several pieces and
+  /// none holds it) both fields hold the one combined margin: min over the volume's columns
+  /// (the vertical segments through its disk) of how far the column lies inside the union of
+  /// the pieces — the largest δ such that the column grown by δ up and down lies in the height
+  /// bands of pieces whose horizontal margin there is ≥ δ (two pieces' bands may cover a column
+  /// together) — certified from below to within max(tolerance, HAL/1000) by branch and bound.
+  /// It is a lower bound on how much VPL could grow, and indicates HPL's room. A larger PL
+  /// never turns a verdict into "inside" except, across a joint, within that accuracy.
   double margin_h_m = 0.0;
   double margin_v_m = 0.0;
 };

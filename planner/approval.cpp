@@ -46,6 +46,22 @@ void requireReadableInputs(const Mission& m) {
   if (!m.buildings_file.empty()) check(m.buildings_file, "$.buildings");
 }
 
+/// The orbit files' ages at the departure — at whichever end of the window is farther from each
+/// file's epoch. Throws past an error limit; returns the warnings.
+std::vector<std::string> checkOrbitAges(const integrity::OrbitSource& orbits, const Mission& m) {
+  std::vector<integrity::OrbitFileAge> worst = orbits.fileAges(m.departure_earliest);
+  const std::vector<integrity::OrbitFileAge> at_latest = orbits.fileAges(m.departure_latest);
+  for (std::size_t i = 0; i < worst.size(); ++i) {
+    if (at_latest[i].age_s > worst[i].age_s) worst[i] = at_latest[i];
+  }
+  std::vector<std::string> warnings;
+  for (const integrity::OrbitFileAge& age : worst) {
+    std::string w = integrity::requireUsableAge(age, "the departure");
+    if (!w.empty()) warnings.push_back(std::move(w));
+  }
+  return warnings;
+}
+
 }  // namespace
 
 MissionRecord missionRecord(const Mission& m) {
@@ -272,7 +288,10 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
   for (double dt = 0.0; dt <= (m.departure_latest - m.departure_earliest) + 1e-6; dt += m.departure_step_s) {
     departures.push_back(m.departure_earliest.plus(dt));
   }
-  return impl_->run(missionStops(), departures, false, progress);
+  std::vector<std::string> warnings = checkOrbitAges(impl_->orbits, m);
+  ApprovalReport report = impl_->run(missionStops(), departures, false, progress);
+  report.warnings.insert(report.warnings.begin(), warnings.begin(), warnings.end());
+  return report;
 }
 
 ApprovalReport Approver::replanFrom(const Eigen::Vector3d& p_map, const maps::GpsTime& now, std::size_t next_stop,

@@ -134,6 +134,9 @@ struct ApprovalReport {
   int level1_exceedances = 0;  ///< samples with HPL > HAL₁ or VPL > VAL₁
   std::optional<maps::GpsTime> earliest_passing_departure;
   double elapsed_s = 0.0;
+  /// Findings that do not decide the approval but that its reader must see: an orbit file
+  /// older than its warning limit at the departure (integrity/gnss/orbit_age.hpp).
+  std::vector<std::string> warnings;
 };
 
 /// \brief Loads the mission's files once and approves (or rejects) it.
@@ -145,7 +148,11 @@ class Approver {
   Approver(const Approver&) = delete;
   Approver& operator=(const Approver&) = delete;
 
-  /// \brief Runs the whole approval; `progress(message)` is called at each step.
+  /// \brief Runs the whole approval; `progress(message)` is called at each step. First checks
+  /// the orbit files' ages at the departure (each end of a window): past the warning limit the
+  /// report carries a warning; past the error limit nothing is planned.
+  /// \throws maps::ParseError naming the orbit file, its epoch, the departure, the age and the
+  /// limit when a file is older than its error limit (integrity/gnss/orbit_age.hpp).
   [[nodiscard]] ApprovalReport approve(const std::function<void(const std::string&)>& progress = {});
 
   /// \brief A new route from where the vehicle is (map frame: x, y, ellipsoidal height) through

@@ -110,6 +110,7 @@ void to_json(nlohmann::json& j, const ApprovalReport& r) {
   j["decision"] = r.approved ? "approved" : "rejected";
   j["reasons"] = json::array();
   for (const Reason& x : r.reasons) j["reasons"].push_back(reasonJson(x, r.departure));
+  if (!r.warnings.empty()) j["warnings"] = r.warnings;  // absent when none
   j["departure"] = maps::formatRfc3339(r.departure);
   if (r.earliest_passing_departure) j["earliest_passing_departure"] = maps::formatRfc3339(*r.earliest_passing_departure);
   j["route"] = routeJson(r);

@@ -194,15 +194,12 @@ std::vector<AlmanacRecord> loadAlmanac(const std::string& path, AlmanacSystem sy
 }
 
 GpsTime resolveAlmanacEpoch(int week_field, double toa_s, const GpsTime& near) {
-  int modulus = 0;
-  if (week_field < 256) modulus = 256;
-  else if (week_field < 1024) modulus = 1024;
-  if (modulus == 0) return GpsTime{week_field, toa_s};
-  // The rollover count that brings t_oa nearest to `near` (never before week_field itself).
+  if (week_field >= kAlmanacWeekModulus) return GpsTime{week_field, toa_s};
+  // The roll-over count that brings t_oa nearest to `near` (never before week_field itself).
   const double rollovers = std::round((near.totalSeconds() - GpsTime{week_field, toa_s}.totalSeconds()) /
-                                      (modulus * kSecondsPerWeek));
+                                      (kAlmanacWeekModulus * kSecondsPerWeek));
   const int k = static_cast<int>(std::clamp(rollovers, 0.0, 1e6));
-  return GpsTime{week_field + k * modulus, toa_s};
+  return GpsTime{week_field + k * kAlmanacWeekModulus, toa_s};
 }
 
 SatelliteState almanacState(const AlmanacRecord& rec, const GpsTime& t) {

@@ -11,7 +11,8 @@
 
 namespace skylane::integrity {
 
-/// \brief One almanac entry. `week_field` is the week as written (often modulo 1024 or 256).
+/// \brief One almanac entry. `week_field` is the week as written: modulo 1024 in both formats
+/// (see resolveAlmanacEpoch), or a full week from producers that write one.
 struct AlmanacRecord {
   SatId sat;
   int health = 0;
@@ -39,8 +40,24 @@ enum class AlmanacSystem {
 [[nodiscard]] std::vector<AlmanacRecord> loadAlmanac(const std::string& path,
                                                      AlmanacSystem system = AlmanacSystem::kAuto);
 
-/// \brief Resolves a truncated almanac week (modulo 256 when < 256, modulo 1024 when < 1024,
-/// full otherwise) to the full week that puts t_oa closest to `near`.
+/// \brief Weeks of a GPS week-number roll-over: SEM and YUMA write the week modulo 1024.
+inline constexpr int kAlmanacWeekModulus = 1024;
+
+/// \brief The full GPS week of an almanac's t_oa: the week as written plus the number of
+/// 1024-week roll-overs that puts t_oa nearest to `near` (the mission's time: the departure, or
+/// --start), never before the week as written.
+///
+/// Both almanac formats define the week modulo 1024: the SEM "GPS Week Number" (the almanac
+/// reference week, range 0 to 1023) and the YUMA "week" (0000–1023), as in the US Coast Guard
+/// Navigation Center's format descriptions. A week of 1024 or more is taken as a full week:
+/// some producers write one (the Navigation Center's own SEM files in late 1999, receiver
+/// vendors' almanacs). No format skylane reads writes the broadcast 8-bit WN_a (modulo 256,
+/// IS-GPS-200 §20.3.3.5.1.2), so a small week is never taken as one: SEM week 38 near 2020 is
+/// week 2086, and near 2025 still 2086 (5 years away), not 2342.
+///
+/// The roll-over is 1024 weeks (19.6 years); for `near` more than 512 weeks from every candidate
+/// epoch the choice is ambiguous, but any such epoch is far beyond the age limits
+/// (integrity/gnss/orbit_age.hpp), so the ambiguity never changes a decision.
 [[nodiscard]] GpsTime resolveAlmanacEpoch(int week_field, double toa_s, const GpsTime& near);
 
 /// \brief Satellite position and clock from an almanac at time t; t_oa's week is resolved

@@ -32,11 +32,15 @@ VisibleSatellite locate(const SatId& sat, const Eigen::Vector3d& p_user, const G
 
 }  // namespace
 
-void OrbitSource::addAlmanac(const std::vector<AlmanacRecord>& records) {
+void OrbitSource::addAlmanac(const std::vector<AlmanacRecord>& records, const std::string& file) {
   almanac_.insert(almanac_.end(), records.begin(), records.end());
+  files_.push_back(almanacEpochs(file.empty() ? "almanac" : file, records));
 }
 
-void OrbitSource::addNavigation(const NavigationData& nav) { nav_.merge(nav); }
+void OrbitSource::addNavigation(const NavigationData& nav, const std::string& file) {
+  nav_.merge(nav);
+  files_.push_back(ephemerisEpochs(file.empty() ? "navigation data" : file, nav));
+}
 
 void OrbitSource::forEachUsable(const GpsTime& t,
                                 const std::function<void(const SatId&, const StateAt&)>& fn) const {
@@ -77,12 +81,10 @@ std::vector<std::pair<SatId, Eigen::Vector3d>> OrbitSource::positionsForAllUsers
   return out;
 }
 
-double OrbitSource::almanacAge_s(const GpsTime& t) const {
-  double age = 0.0;
-  for (const AlmanacRecord& a : almanac_) {
-    age = std::max(age, std::abs(t - resolveAlmanacEpoch(a.week_field, a.orbit.toe.sow, t)));
-  }
-  return age;
+std::vector<OrbitFileAge> OrbitSource::fileAges(const GpsTime& t) const {
+  std::vector<OrbitFileAge> out;
+  for (const OrbitFileEpochs& f : files_) out.push_back(orbitFileAge(f, t));
+  return out;
 }
 
 OrbitSource loadOrbitFiles(const std::vector<std::string>& files, const std::string& source, const std::string& field) {
@@ -97,9 +99,9 @@ OrbitSource loadOrbitFiles(const std::vector<std::string>& files, const std::str
     std::string first;
     std::getline(in, first);
     if (first.find("RINEX VERSION") != std::string::npos) {
-      orbits.addNavigation(loadRinexNav(f));
+      orbits.addNavigation(loadRinexNav(f), f);
     } else {
-      orbits.addAlmanac(loadAlmanac(f));
+      orbits.addAlmanac(loadAlmanac(f), f);
     }
   }
   if (orbits.empty()) throw maps::ParseError(source, 0, field, "", "files that hold at least one satellite");

@@ -3,6 +3,7 @@
 /// \brief Where satellite positions come from for prediction: almanacs or broadcast ephemerides.
 
 #include "integrity/gnss/almanac.hpp"
+#include "integrity/gnss/orbit_age.hpp"
 #include "integrity/gnss/rinex_nav.hpp"
 
 #include "maps/geodesy.hpp"
@@ -27,10 +28,12 @@ class OrbitSource {
   /// \brief A satellite's state as a function of GPS time.
   using StateAt = std::function<SatelliteState(const GpsTime&)>;
 
-  /// \brief Adds almanac records (unhealthy ones are kept and skipped at use).
-  void addAlmanac(const std::vector<AlmanacRecord>& records);
-  /// \brief Adds a navigation file's ephemerides.
-  void addNavigation(const NavigationData& nav);
+  /// \brief Adds almanac records (unhealthy ones are kept and skipped at use); `file` names
+  /// them in fileAges() ("almanac" when empty).
+  void addAlmanac(const std::vector<AlmanacRecord>& records, const std::string& file = {});
+  /// \brief Adds a navigation file's ephemerides; `file` names them in fileAges()
+  /// ("navigation data" when empty).
+  void addNavigation(const NavigationData& nav, const std::string& file = {});
 
   /// \brief All satellites above `mask_rad` seen from `p_user_ecef` at reception time t, with the
   /// light-time iteration and Earth-rotation correction applied. Ephemerides win over almanac
@@ -42,8 +45,8 @@ class OrbitSource {
   /// those 75 ms. Against the per-user light-time solution of visible() the direction differs by
   /// < 2e-5 rad (≈ 1 mdeg of elevation) — for worldwide availability maps.
   [[nodiscard]] std::vector<std::pair<SatId, Eigen::Vector3d>> positionsForAllUsers(const GpsTime& t) const;
-  /// \brief Largest |t − t_oa| over the almanac records [s] (extrapolation warning).
-  [[nodiscard]] double almanacAge_s(const GpsTime& t) const;
+  /// \brief Each added file's age at the mission's time t (orbit_age.hpp), in the order added.
+  [[nodiscard]] std::vector<OrbitFileAge> fileAges(const GpsTime& t) const;
   [[nodiscard]] bool empty() const { return almanac_.empty() && nav_.ephemerides.empty(); }
   [[nodiscard]] std::size_t size() const { return almanac_.size() + nav_.ephemerides.size(); }
 
@@ -53,6 +56,7 @@ class OrbitSource {
 
   std::vector<AlmanacRecord> almanac_;
   NavigationData nav_;
+  std::vector<OrbitFileEpochs> files_;
 };
 
 /// \brief Loads almanacs (YUMA/SEM) and RINEX navigation files, told apart by the RINEX header

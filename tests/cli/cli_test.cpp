@@ -100,6 +100,28 @@ TEST(Cli, PredictWritesCsvAndSvg) {
   EXPECT_NE(text.find("HPL"), std::string::npos);
 }
 
+TEST(Cli, PredictChecksTheAlmanacsAgeAgainstStart) {
+  const std::string alm = test::dataPath("gnss/alm01jan2020.txt");
+  const std::string where = " --lat 35.13 --lon 139.62 --duration 1h --step 30m";
+  // GIVEN the almanac of 2020-01-03: WHEN --start is in 2025 THEN exit 2 naming the file, its
+  // epoch, --start, the limit and the age
+  const RunResult old = run("integrity predict --almanac " + alm + where + " --start 2025-06-01T00:00:00Z");
+  EXPECT_EQ(old.status, 2) << old.out;
+  EXPECT_NE(old.out.find("skylane: error: " + alm + ": field 'almanac epoch t_oa': got '2020-01-03T19:56:30Z (GPS week 2086"),
+            std::string::npos) << old.out;
+  EXPECT_NE(old.out.find("within 90.0 days of --start 2025-06-01T00:00:00Z; it is 1975.2 days from it"), std::string::npos) << old.out;
+  // WHEN --start is 10 days after its t_oa THEN a warning on stderr, and the prediction runs
+  const RunResult stale = run("integrity predict --almanac " + alm + where + " --start 2020-01-14T00:00:00Z");
+  EXPECT_EQ(stale.status, 0) << stale.out;
+  EXPECT_NE(stale.out.find("skylane: warning: " + alm + ": the almanac's t_oa"), std::string::npos) << stale.out;
+  EXPECT_NE(stale.out.find("10.2 days from --start 2020-01-14T00:00:00Z, beyond the 7.0 days warning limit"), std::string::npos)
+      << stale.out;
+  // AND within the week nothing is said
+  const RunResult fresh = run("integrity predict --almanac " + alm + where + " --start 2020-01-01T00:00:00Z");
+  EXPECT_EQ(fresh.status, 0) << fresh.out;
+  EXPECT_EQ(fresh.out.find("warning"), std::string::npos) << fresh.out;
+}
+
 TEST(Cli, PredictAraimWithGpsAndGalileoAlmanacs) {
   const RunResult r = run("integrity predict --almanac " + test::dataPath("gnss/alm_gps_ed259.txt") + " --almanac " +
                           test::dataPath("gnss/alm_gal_ed259.txt") +
@@ -466,6 +488,30 @@ TEST(Cli, AMissingZoneFileNamesTheMissionsFieldAndTheResolvedPath) {
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("mission_missing_zones.json: field '$.zones[0]'"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("no_such_zones.json"), std::string::npos) << r.out;
+}
+
+TEST(Cli, ApproveChecksTheOrbitFilesAgeAgainstTheDeparture) {
+  const std::string alm = test::dataPath("gnss/alm01jan2020.txt");
+  auto mission = [&](const std::string& name, const std::string& departure) {
+    return writeTemp(name, R"({"vehicle":{"lateral_m":1.2,"longitudinal_m":1,"cruise_speed_mps":12},)"
+                           R"("start":{"lat":47.3712,"lon":8.532},"goal":{"lat":47.3712,"lon":8.545},"ground_amsl_m":408,)"
+                           R"("planner":{"iterations":300,"seed":3},"integrity":{"cost_weight":0},)"
+                           R"("departure":")" + departure + R"(","orbits":[")" + alm + R"("]})");
+  };
+  // GIVEN the almanac of 2020-01-03: WHEN the departure is in 2025 THEN exit 2 naming the file,
+  // its epoch, the departure, the limit and the age
+  const RunResult old = run("approve " + mission("mission_2025.json", "2025-06-01T14:00:00Z"));
+  EXPECT_EQ(old.status, 2) << old.out;
+  EXPECT_NE(old.out.find("skylane: error: " + alm + ": field 'almanac epoch t_oa': got '2020-01-03T19:56:30Z"), std::string::npos)
+      << old.out;
+  EXPECT_NE(old.out.find("within 90.0 days of the departure 2025-06-01T14:00:00Z; it is 1975.8 days from it"), std::string::npos)
+      << old.out;
+  // WHEN the departure is 10.8 days after t_oa THEN the approval runs, with a warning on stderr
+  // and in the report
+  const RunResult stale = run("approve " + mission("mission_stale.json", "2020-01-14T14:00:00Z"));
+  EXPECT_EQ(stale.status, 0) << stale.out;
+  EXPECT_NE(stale.out.find("skylane: warning: " + alm + ": the almanac's t_oa 2020-01-03T19:56:30Z"), std::string::npos) << stale.out;
+  EXPECT_NE(stale.out.find("\"warnings\": ["), std::string::npos) << stale.out;
 }
 
 TEST(Cli, ApproveRefusesABadMissionWithExitTwo) {

@@ -8,7 +8,9 @@
 
 #include <functional>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <stdexcept>
 
@@ -201,6 +203,179 @@ TEST(Corridor, RandomScenesInsideMeansEverySampledPointIsInAPieceAndLargerPlsNev
   EXPECT_GT(inside, 500);
   EXPECT_GT(outside, 500);
   EXPECT_GT(joints, 10);
+}
+
+// --- end caps: the climb counts only where the disk projects inside the segment --------------
+
+TEST(Corridor, VolumeInsideTheEndCapOfAClimbingLastLegIsInside) {
+  // GIVEN a last leg climbing 50 m over 100 m (g = 0.5) to (100, 0, 50), HAL 6, VAL 4
+  const Corridor c({{-50, 0, 0}, {0, 0, 0}, {100, 0, 50}}, {6.0, 4.0});
+  // WHEN a volume (HPL 2, VPL 1) lies wholly beyond the last waypoint, its disk x ∈ [100.5, 104.5]
+  // in the end cap, where the centre line is flat at 50 m, and its top at 53.5 m
+  const Containment in = c.contains({{102.5, 0, 52.5}, 2.0, 1.0});
+  // THEN it is inside by 54 − 53.5 = 0.5 m < g·HPL = 1 m (the climb does not count in the cap)
+  EXPECT_EQ(in.verdict, Verdict::kInside);
+  EXPECT_EQ(in.segment, 1u);
+  EXPECT_FALSE(in.across_joint);
+  EXPECT_NEAR(in.margin_v_m, 0.5, 1e-12);
+  EXPECT_NEAR(in.margin_h_m, 6.0 - 2.5 - 2.0, 1e-12);
+  // AND 1 m higher its top pokes 0.5 m through the cap's ceiling: outside
+  const Containment out = c.contains({{102.5, 0, 53.5}, 2.0, 1.0});
+  EXPECT_EQ(out.verdict, Verdict::kOutside);
+  EXPECT_NEAR(out.margin_v_m, -0.5, 1e-12);
+  // AND below the cap the floor is flat too: bottom at 46.5 m is inside by 0.5 m
+  EXPECT_NEAR(c.contains({{102.5, 0, 47.5}, 2.0, 1.0}).margin_v_m, 0.5, 1e-12);
+}
+
+TEST(Corridor, VolumeStraddlingTheEndSeesTheClimbOnlyAlongTheSegment) {
+  // GIVEN the same climbing leg, and a volume centred on its end waypoint (disk x ∈ [98, 102])
+  const Corridor c({{0, 0, 0}, {100, 0, 50}}, {6.0, 4.0});
+  // WHEN it is 1.5 m below the waypoint, VPL 1
+  const Containment r = c.contains({{100, 0, 48.5}, 2.0, 1.0});
+  // THEN the centre line over the disk spans 49 m (x = 98) to 50 m (the cap): the floor is
+  // 50 − 4 = 46 m under the cap, the bottom 47.5 m → margin 1.5 (a g·HPL bound on both sides
+  // would say 0.5); the ceiling is 49 + 4 = 53 m, the top 49.5 m
+  EXPECT_EQ(r.verdict, Verdict::kInside);
+  EXPECT_NEAR(r.margin_v_m, 1.5, 1e-12);
+  // AND the path's first waypoint has a cap too: before (0, 0, 0) the floor is flat at −4 m
+  EXPECT_NEAR(c.contains({{-2.5, 0, -2.5}, 2.0, 1.0}).margin_v_m, 0.5, 1e-12);
+  EXPECT_EQ(c.contains({{-2.5, 0, -3.5}, 2.0, 1.0}).verdict, Verdict::kOutside);
+}
+
+TEST(Corridor, AColumnCoveredByTwoLegsTogetherIsInside) {
+  // GIVEN a hairpin: a leg climbing from (0, 0, 0) to (100, 0, 50), then a level leg back to
+  // (0, 4, 50), HAL 6, VAL 15 — at x = 50 the first leg holds heights [10, 40], the second
+  // [35, 65]
+  const Corridor c({{0, 0, 0}, {100, 0, 50}, {0, 4, 50}}, {6.0, 15.0});
+  // WHEN a volume between the legs spans 27.5 … 47.5 m (HPL 1, VPL 10)
+  const Containment r = c.contains({{50, 2, 37.5}, 1.0, 10.0});
+  // THEN neither leg holds its columns alone but both together do, with room 17 m up and down;
+  // the margin is the horizontal one, 6 − (2 + 1) = 3 m, certified to HAL/1000
+  EXPECT_EQ(r.verdict, Verdict::kInside);
+  EXPECT_TRUE(r.across_joint);
+  EXPECT_LE(r.margin_v_m, 3.0 + 1e-12);
+  EXPECT_GE(r.margin_v_m, 3.0 - 6e-3);
+  // AND when the legs' bands leave a gap (VAL 10: [15, 35] and [40, 60]) the volume is outside
+  const Corridor gap({{0, 0, 0}, {100, 0, 50}, {0, 4, 50}}, {6.0, 10.0});
+  EXPECT_EQ(gap.contains({{50, 2, 37.5}, 1.0, 5.0}).verdict, Verdict::kOutside);
+}
+
+/// The oracle's margin of one point: max over the pieces of min(HAL − distance, VAL − |height −
+/// centre line at the nearest point|), straight from the piece definition (positive inside).
+double pointMarginInSomePiece(const std::vector<Eigen::Vector3d>& path, const Eigen::Vector3d& x, double hal,
+                              double val) {
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    const Eigen::Vector2d a = path[i].head<2>(), b = path[i + 1].head<2>();
+    const double t = std::clamp((x.head<2>() - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+    const double z = path[i].z() + t * (path[i + 1].z() - path[i].z());
+    best = std::max(best, std::min(hal - (x.head<2>() - (a + t * (b - a))).norm(), val - std::abs(x.z() - z)));
+  }
+  return best;
+}
+
+/// The oracle's margin of a volume: min of the point margin over a grid of its points — a
+/// polar grid of its disk, each column sampled from bottom to top (the pieces' union need not
+/// hold a column's heights as one interval). Sampling can only miss the minimum, so the true
+/// minimum lies in [oracle − slack, oracle], slack = the point margin's Lipschitz constants
+/// times the grid's spacing. The point margin's minimum is ≤ the corridor's column margin and
+/// has its sign (a column grown by the smallest depth of its points still lies in the union).
+struct OracleMargin {
+  double margin_m;
+  double slack_m;
+};
+
+OracleMargin sampledMargin(const std::vector<Eigen::Vector3d>& path, const ProtectionVolume& v, double hal, double val,
+                           double max_slope) {
+  constexpr int kRings = 20, kAngles = 96, kLevels = 12;
+  double m = std::numeric_limits<double>::infinity();
+  for (int j = 0; j <= kRings; ++j) {
+    const double r = v.hpl_m * j / kRings;
+    for (int k = 0; k < (j == 0 ? 1 : kAngles); ++k) {
+      const double a = 2 * kPi * k / kAngles;
+      const Eigen::Vector3d x = v.p_map + Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 0.0);
+      for (int l = 0; l <= kLevels; ++l) {
+        const double dz = v.vpl_m * (2.0 * l / kLevels - 1.0);
+        m = std::min(m, pointMarginInSomePiece(path, x + Eigen::Vector3d(0, 0, dz), hal, val));
+      }
+    }
+  }
+  // Every point of the volume is within half a ring step plus half an arc step of a sampled
+  // column, and within half a level step of a sample on it; the point margin is
+  // max(1, g)-Lipschitz horizontally and 1-Lipschitz vertically.
+  const double spacing_m = v.hpl_m / (2.0 * kRings) + kPi * v.hpl_m / kAngles;
+  return {m, std::max(1.0, max_slope) * spacing_m + v.vpl_m / kLevels};
+}
+
+TEST(Corridor, RandomClimbingEndLegsAgreeWithADenseSamplingOracle) {
+  // GIVEN random two-leg paths whose legs climb or descend at up to g = 1.5, and volumes near
+  // either end of the path (the caps) or straddling it
+  std::mt19937 rng(2024);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  constexpr double kTolerance_m = 1e-6;
+  int inside = 0, outside = 0, cap_cases_a_slope_bound_misses = 0, compared = 0;
+  for (int scene = 0; scene < 400; ++scene) {
+    std::vector<Eigen::Vector3d> path{{0, 0, 100}};
+    double max_slope = 0.0;
+    for (int k = 0; k < 2; ++k) {
+      const double heading = 2 * kPi * u(rng), length = 20 + 80 * u(rng), g = -1.5 + 3.0 * u(rng);
+      path.push_back(path.back() + Eigen::Vector3d(length * std::cos(heading), length * std::sin(heading), g * length));
+      max_slope = std::max(max_slope, std::abs(g));
+    }
+    const double hal = 3 + 10 * u(rng), val = 2 + 6 * u(rng);
+    const Corridor c(path, {hal, val});
+    for (int k = 0; k < 5; ++k) {
+      const Eigen::Vector3d& end = (k % 2 == 0) ? path.back() : path.front();
+      const double a = 2 * kPi * u(rng), r = hal * u(rng);
+      const Eigen::Vector3d p = end + Eigen::Vector3d(r * std::cos(a), r * std::sin(a), val * (2 * u(rng) - 1));
+      const ProtectionVolume v{p, hal * u(rng), val * u(rng)};
+      // WHEN the corridor and the oracle judge the volume
+      const Containment got = c.contains(v, kTolerance_m);
+      const OracleMargin oracle = sampledMargin(path, v, hal, val, max_slope);
+      // THEN the verdicts agree wherever the oracle's margin is clear of the tolerance and of its
+      // sampling slack, and a single-piece margin lies within the oracle's bracket
+      // Across a joint the corridor certifies its margin to within max(tolerance, HAL/1000).
+      const double accuracy_m = std::max(kTolerance_m, 1e-3 * hal);
+      if (oracle.margin_m > kTolerance_m + accuracy_m + oracle.slack_m) {
+        ++inside;
+        EXPECT_EQ(got.verdict, Verdict::kInside) << "scene " << scene << " volume " << k << " oracle " << oracle.margin_m
+                                                 << " got " << got.margin_h_m << " " << got.margin_v_m << " joint " << got.across_joint
+                                                 << " seg " << got.segment << " p " << p.transpose() << " hpl " << v.hpl_m << " vpl "
+                                                 << v.vpl_m << " hal " << hal << " val " << val << " path " << path[0].transpose() << " | "
+                                                 << path[1].transpose() << " | " << path[2].transpose();
+      } else if (oracle.margin_m < -kTolerance_m) {
+        ++outside;
+        EXPECT_NE(got.verdict, Verdict::kInside) << "scene " << scene << " volume " << k << " oracle " << oracle.margin_m;
+        if (!got.across_joint) {
+          EXPECT_EQ(got.verdict, Verdict::kOutside) << "scene " << scene << " volume " << k;
+        }
+      }
+      if (got.verdict == Verdict::kInside) {
+        // AND the corridor's margin is at least the oracle's (less its slack and, across a joint,
+        // the accuracy), and for one piece at most the oracle's (where its columns are one piece's)
+        ++compared;
+        const double m = std::min(got.margin_h_m, got.margin_v_m);
+        EXPECT_GE(m, oracle.margin_m - oracle.slack_m - (got.across_joint ? accuracy_m : 0.0) - 1e-9)
+            << "scene " << scene << " volume " << k;
+        if (!got.across_joint) {
+          EXPECT_LE(m, oracle.margin_m + 1e-9) << "scene " << scene << " volume " << k;
+        }
+      }
+      // A bound subtracting g·HPL over the whole disk (the centre's nearest point) would call
+      // this volume outside: count the cases that exercise the end-cap rule.
+      const Eigen::Vector2d c2 = p.head<2>();
+      const std::size_t seg = (k % 2 == 0) ? 1 : 0;
+      const Eigen::Vector2d s0 = path[seg].head<2>(), s1 = path[seg + 1].head<2>();
+      const double t = std::clamp((c2 - s0).dot(s1 - s0) / (s1 - s0).squaredNorm(), 0.0, 1.0);
+      const double g = std::abs(path[seg + 1].z() - path[seg].z()) / (s1 - s0).norm();
+      const double old_v = val - v.vpl_m - std::abs(p.z() - (path[seg].z() + t * (path[seg + 1].z() - path[seg].z()))) - g * v.hpl_m;
+      if (oracle.margin_m > kTolerance_m + oracle.slack_m && old_v < 0) ++cap_cases_a_slope_bound_misses;
+    }
+  }
+  EXPECT_GT(inside, 300);
+  EXPECT_GT(outside, 300);
+  EXPECT_GT(compared, 300);
+  EXPECT_GT(cap_cases_a_slope_bound_misses, 20);
 }
 
 TEST(Corridor, SegmentBoxCornersFollowTheClimb) {

@@ -1,5 +1,6 @@
 #include "integrity/gnss/almanac.hpp"
 
+#include "integrity/gnss/orbit_age.hpp"
 #include "integrity/gnss/parse_error.hpp"
 #include "tests/test_util.hpp"
 
@@ -80,9 +81,37 @@ TEST(Almanac, AfterOneOrbitalPeriodOnlyTheEarthHasTurned) {
 }
 
 TEST(Almanac, WeekIsResolvedNearTheRequestedTime) {
-  EXPECT_EQ(resolveAlmanacEpoch(38, 0.0, GpsTime{2086, 0}).week, 2086);   // 8-bit week of Jan 2020
+  EXPECT_EQ(resolveAlmanacEpoch(38, 0.0, GpsTime{2086, 0}).week, 2086);   // 10-bit week of Jan 2020
   EXPECT_EQ(resolveAlmanacEpoch(1930, 0.0, GpsTime{2446, 0}).week, 1930);  // full week kept
   EXPECT_EQ(resolveAlmanacEpoch(316, 0.0, GpsTime{1316, 0}).week, 1340);   // 316 + 1024 nearest 1316
+}
+
+TEST(Almanac, WeekIsModulo1024EvenWhenItIsBelow256) {
+  // GIVEN week 38 as SEM and YUMA write it (modulo 1024: week 2086, 2020-01-04)
+  // WHEN resolved near 2025-06-01 (week 2369)
+  // THEN it stays week 2086 (5 years old), never 38 + 9·256 = 2342 (26 weeks, as a modulo-256
+  // reading would have it)
+  const GpsTime june_2025 = *parseRfc3339("2025-06-01T00:00:00Z");
+  EXPECT_EQ(june_2025.week, 2369);
+  EXPECT_EQ(resolveAlmanacEpoch(38, 503808.0, june_2025).week, 2086);
+  // AND week 0 itself is 1024 or 2048, whichever is nearer
+  EXPECT_EQ(resolveAlmanacEpoch(0, 0.0, GpsTime{1500, 0}).week, 1024);
+  EXPECT_EQ(resolveAlmanacEpoch(0, 0.0, GpsTime{1600, 0}).week, 2048);
+}
+
+TEST(Almanac, WeekResolutionAtTheRollOverBoundaries) {
+  // Week 1023 near the second roll-over (week 2048 = 2019-04-07) is week 2047, the last week
+  // before it, seen from either side of the boundary.
+  EXPECT_EQ(resolveAlmanacEpoch(1023, 604000.0, GpsTime{2047, 603000.0}).week, 2047);
+  EXPECT_EQ(resolveAlmanacEpoch(1023, 604000.0, GpsTime{2048, 100.0}).week, 2047);
+  // Week 0 seen from just before the roll-over is the week after it.
+  EXPECT_EQ(resolveAlmanacEpoch(0, 100.0, GpsTime{2047, 604000.0}).week, 2048);
+  EXPECT_EQ(resolveAlmanacEpoch(0, 100.0, GpsTime{2048, 200.0}).week, 2048);
+  // Before the first roll-over a small week is the week as written (never negative).
+  EXPECT_EQ(resolveAlmanacEpoch(703, 344063.0, GpsTime{700, 0}).week, 703);
+  EXPECT_EQ(resolveAlmanacEpoch(1023, 0.0, GpsTime{0, 0}).week, 1023);
+  // A written week of 1024 or more is a full week, wherever `near` is.
+  EXPECT_EQ(resolveAlmanacEpoch(1024, 0.0, GpsTime{2100, 0}).week, 1024);
 }
 
 /// Writes one YUMA record as SEM (semicircles), so both parsers can be compared.
@@ -110,6 +139,28 @@ TEST(Almanac, SemAndYumaOfTheSameConstellationGiveTheSamePositions) {
   for (std::size_t i = 0; i < sem.size(); ++i) {
     EXPECT_EQ(sem[i].sat, yuma[i].sat);
     EXPECT_LT((almanacState(sem[i], t).p_ecef - almanacState(yuma[i], t).p_ecef).norm(), 1e-3) << yuma[i].sat.str();
+  }
+}
+
+TEST(Almanac, SemWeek38OfJanuary2020IsWeek2086AndTooOldFor2025) {
+  // GIVEN the almanac of 2020-01-03 as SEM (week 38, t_oa 503808 s)
+  const auto sem = parseSem(semFromYuma(loadAlmanac(test::dataPath("gnss/alm01jan2020.txt"))), "alm01jan2020.al3");
+  ASSERT_EQ(sem.front().week_field, 38);
+  const OrbitFileEpochs epochs = almanacEpochs("alm01jan2020.al3", sem);
+  // WHEN its age is taken at a 2020-01-01 start THEN t_oa is in week 2086, 2.8 days later: current
+  const OrbitFileAge in_2020 = orbitFileAge(epochs, *parseRfc3339("2020-01-01T00:00:00Z"));
+  EXPECT_EQ(in_2020.epoch.week, 2086);
+  EXPECT_NEAR(in_2020.age_s, 2 * 86400.0 + 19 * 3600.0 + 56 * 60.0 + 30.0, 1e-6);  // to 2020-01-03T19:56:30Z
+  EXPECT_EQ(in_2020.verdict, AgeVerdict::kCurrent);
+  // AND at a 2025 departure it is an error naming the file, the epoch, the departure, the age
+  // and the limit
+  const OrbitFileAge in_2025 = orbitFileAge(epochs, *parseRfc3339("2025-06-01T00:00:00Z"));
+  EXPECT_EQ(in_2025.epoch.week, 2086);
+  EXPECT_EQ(in_2025.verdict, AgeVerdict::kError);
+  const std::string msg = test::messageOf<ParseError>([&] { (void)requireUsableAge(in_2025, "the departure"); });
+  for (const char* part : {"alm01jan2020.al3", "GPS week 2086, 503808 s", "2020-01-03T19:56:30Z", "the departure 2025-06-01T00:00:00Z",
+                           "within 90.0 days", "1975.2 days"}) {
+    EXPECT_NE(msg.find(part), std::string::npos) << part << " in: " << msg;
   }
 }
 

@@ -2,6 +2,7 @@
 // space and time, rejections with reasons, reproducibility, and corridors that never meet an
 // active prohibited zone (checked independently of the geofence).
 #include "planner/approval.hpp"
+#include "planner/report_formats.hpp"
 #include "planner/route_planner.hpp"
 
 #include "geofence/fence.hpp"
@@ -334,6 +335,36 @@ TEST(Approval, DepartureWindowFindsTheFirstDepartureThatPasses) {
   ASSERT_TRUE(r.approved) << (r.reasons.empty() ? "" : r.reasons.front().message);
   EXPECT_EQ(maps::formatRfc3339(r.departure), "2020-01-01T14:20:00Z");
   EXPECT_EQ(r.planner.departures_tried, 3);
+}
+
+TEST(Approval, AnAlmanacYearsFromTheDepartureIsRefusedBeforePlanning) {
+  // GIVEN the 2020 almanac and a departure in 2025
+  Mission m = missionWith({}, "old_almanac");
+  m.departure_earliest = m.departure_latest = *maps::parseRfc3339("2025-06-01T14:00:00Z");
+  Approver a(m);
+  // WHEN approving THEN a ParseError names the file, its epoch, the departure, the limit and the age
+  const std::string msg = test::messageOf<maps::ParseError>([&] { (void)a.approve(); });
+  for (const char* part : {"alm01jan2020.txt: field 'almanac epoch t_oa'", "GPS week 2086, 503808 s",
+                           "within 90.0 days of the departure 2025-06-01T14:00:00Z", "1975.", "days from it"}) {
+    EXPECT_NE(msg.find(part), std::string::npos) << part << " in: " << msg;
+  }
+}
+
+TEST(Approval, AnAlmanacTenDaysFromTheDepartureIsAWarningOfTheReport) {
+  // GIVEN the almanac of 2020-01-03 and a departure on 2020-01-14 (10.8 days later)
+  Mission m = missionWith({}, "week_old_almanac");
+  m.departure_earliest = m.departure_latest = *maps::parseRfc3339("2020-01-14T14:00:00Z");
+  Approver a(m);
+  // WHEN approving THEN the route is judged as usual and the report carries one warning
+  const ApprovalReport r = a.approve();
+  EXPECT_TRUE(r.approved) << (r.reasons.empty() ? "" : r.reasons.front().message);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("alm01jan2020.txt: the almanac's t_oa 2020-01-03T19:56:30Z"), std::string::npos) << r.warnings[0];
+  EXPECT_NE(r.warnings[0].find("beyond the 7.0 days warning limit"), std::string::npos) << r.warnings[0];
+  const json j = r;
+  EXPECT_EQ(j.at("warnings"), json(r.warnings));
+  // AND a report without warnings has no "warnings" member (older reports stay as they were)
+  EXPECT_FALSE(json(Approver(missionWith({}, "current_almanac")).approve()).contains("warnings"));
 }
 
 TEST(Mission, ErrorsNameTheField) {
