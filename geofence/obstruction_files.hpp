@@ -8,6 +8,7 @@
 #include "geofence/fence.hpp"
 #include "maps/terrain.hpp"
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,9 @@ struct ObstructionFiles {
   std::vector<std::string> zones;
   airspace::ZoneFormat format = airspace::ZoneFormat::kAuto;
   std::string buildings;  ///< empty: none
+  /// Zone files read as QGroundControl plans whatever `format` says: a mission's .plan, whose
+  /// geoFence joins zones of another format.
+  std::set<std::string> qgc_plans;
 };
 
 /// \brief Loads the zones and buildings, resolves their heights with `terrain` and the EGM96
