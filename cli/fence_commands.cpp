@@ -72,7 +72,7 @@ void runFenceCheck(const FenceCheckOptions& o) {
   options.tolerance_m = o.tolerance_m;
   for (const std::string& w : boxes.limits.warnings) std::cerr << "skylane: warning: " << o.corridor << ": " << w << "\n";
   const geofence::Fence fence(std::move(boxes.level1), std::move(boxes.level2),
-                              geofence::loadObstructions({o.zones, *format, o.buildings, {}}, boxes.frame, terrain,
+                              geofence::loadObstructions({o.zones, *format, o.buildings}, boxes.frame, terrain,
                                                          std::move(policy), options));
 
   if (!o.fix.empty()) {

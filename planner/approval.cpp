@@ -19,6 +19,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -106,13 +107,10 @@ Approver::Impl::Impl(Mission mission)
   policy.authorisations = m.authorisations;
   geofence::FenceOptions options;
   options.horizon_m = 500.0;  // zones within 500 m are reported with their clearance
-  geofence::ObstructionFiles files;
-  files.zones = m.zone_files;
-  files.format = *format;
-  files.buildings = m.buildings_file;
-  if (!m.qgc_plan_file.empty()) files.qgc_plans.insert(m.qgc_plan_file);
-  obstructions = std::make_unique<geofence::Obstructions>(
-      geofence::loadObstructions(files, frame, terrain, policy, options));
+  std::set<std::string> qgc_plans;  // the .plan's geoFence: QGroundControl whatever zone_format says
+  if (!m.qgc_plan_file.empty()) qgc_plans.insert(m.qgc_plan_file);
+  obstructions = std::make_unique<geofence::Obstructions>(geofence::loadObstructions(
+      {m.zone_files, *format, m.buildings_file}, frame, terrain, policy, options, qgc_plans));
   if (!obstructions->buildings().empty()) {
     const maps::Geodetic origin{m.points.front().lat_rad, m.points.front().lon_rad, 0.0};
     index = std::make_unique<maps::BuildingIndex>(obstructions->buildings(), origin);
