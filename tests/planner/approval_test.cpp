@@ -2,6 +2,8 @@
 // space and time, rejections with reasons, reproducibility, and corridors that never meet an
 // active prohibited zone (checked independently of the geofence).
 #include "planner/approval.hpp"
+#include "planner/operational_intent.hpp"
+#include "planner/report_formats.hpp"
 #include "planner/route_planner.hpp"
 
 #include "geofence/fence.hpp"
@@ -452,6 +454,15 @@ TEST(Approval, QgcPlanSpeedChangeHoverHeightsAndGeofenceAreFollowed) {
   ASSERT_NE(circle, r.zones.end());
   EXPECT_TRUE(circle->counted);
   EXPECT_GT(circle->min_clearance_m, 50.0);
+  // AND the report's JSON form carries the hover for tracking, and the operational intent's
+  // volume of the leg into the loiter point lasts through the hover
+  const ApprovedFlight back = parseApprovalReport(json(r), "report.json");
+  ASSERT_EQ(back.route.size(), r.route.size());
+  EXPECT_NEAR(back.route[2].hover_s, 30.0, 1e-3);
+  EXPECT_NEAR(back.route[3].eta_s, r.route[3].eta_s, 1e-3);
+  const OperationalIntent intent = operationalIntent(r, a.frame());
+  ASSERT_EQ(intent.volumes.size(), 3u);
+  EXPECT_NEAR(intent.volumes[1].time_end - r.departure, r.route[2].eta_s + 30.0 + kIntentTimeBuffer_s, 1e-6);
 }
 
 TEST(Approval, QgcPlanHeightOutsideTheLimitsIsRefusedNamingTheItemAndTheLimit) {
