@@ -6,24 +6,29 @@
 /// A mission's `qgc_plan` is not read from disk (a fuzzed name could be /dev/zero): the reader
 /// hands back one of a few fixed plans chosen by the name's ending — "rtl.plan" a return to
 /// launch with mixed heights, "survey.plan" a plan with a ComplexItem (refused), "gone.plan" the
-/// error of an unreadable file, anything else three waypoints at 70 m relative to home — so the
+/// error of an unreadable file, "timed.plan" a speed change, a delay, a timed loiter and a
+/// geofence, anything else three waypoints at 70 m relative to home — so the
 /// mission's own checks around the plan (either route, the cruise height against the limits,
 /// an unreadable plan) are reached. A ParseError must name the mission ("fuzz.json") or, for
 /// an error inside the plan, the plan's resolved path.
 ///
 /// A route that parses has ≥ 2 points, finite, within ±89° latitude and ±180° longitude (in
-/// radians), no two consecutive ones equal, and a finite cruise height with its field named
-/// exactly when there is one. A mission that parses has all that, plus: positive speeds and
+/// radians), no two consecutive ones equal in place and height, one flight per point (a finite
+/// height with its field named; a leg speed 0 < v ≤ kMaxPlanSpeed_mps with its field named; a
+/// hover ≥ 0 and finite), and a finite cruise height with its field named exactly when there is
+/// one. A mission that parses has all that, plus: positive speeds and
 /// vehicle sizes, min_agl ≤ cruise_agl ≤ max_agl with cruise_agl > 0, every number finite, the
 /// latest departure not before the earliest, a positive departure step, sample step, cost
 /// cell, time limit, resolution and margin, a cost weight ≥ 0, 0–20 replans and at least one
-/// orbit file; its plan file is the one the reader was asked for.
+/// orbit file; its plan file is the one the reader was asked for, its point flights are the
+/// plan's (none without a plan), and the plan is among the zone files at most once.
 
 #include "fuzz/fuzz_common.hpp"
 #include "planner/mission.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -56,6 +61,19 @@ json planFor(const std::string& path) {
     return planWith({simpleItem(22, 3, 47.3715, 8.5325, 30), simpleItem(16, 3, 47.375, 8.54, 50),
                      simpleItem(16, 0, 47.38, 8.548, 470), simpleItem(20, 2, 0, 0, 0)});
   }
+  if (endsWith("timed.plan")) {
+    json plan = planWith({simpleItem(22, 3, 47.3715, 8.5325, 40), simpleItem(178, 2, 0, 0, 0),
+                          simpleItem(16, 3, 47.375, 8.54, 60), simpleItem(93, 2, 0, 0, 0),
+                          simpleItem(19, 10, 47.38, 8.548, 80), simpleItem(21, 3, 0, 0, 0)});
+    json& items = plan["mission"]["items"];
+    items[1]["params"][0] = 1;   // DO_CHANGE_SPEED: ground speed
+    items[1]["params"][1] = 6;   // 6 m/s
+    items[3]["params"][0] = 20;  // NAV_DELAY 20 s
+    items[4]["params"][0] = 30;  // NAV_LOITER_TIME 30 s
+    const json circle = {{"inclusion", false}, {"circle", {{"center", {47.376, 8.545}}, {"radius", 50}}}};
+    plan["geoFence"] = {{"circles", json::array({circle})}};
+    return plan;
+  }
   if (endsWith("survey.plan")) {
     return planWith({simpleItem(16, 3, 47.375, 8.54, 70), {{"type", "ComplexItem"}, {"complexItemType", "survey"}}});
   }
@@ -71,10 +89,26 @@ void checkPoints(const std::vector<planner::MissionPoint>& points, const std::st
   }
 }
 
+void checkFlight(const planner::PointFlight& f, const std::string& source) {
+  SKYLANE_FUZZ_CHECK(!f.height || (std::isfinite(f.height->value_m) && !f.height->field.empty()), source);
+  SKYLANE_FUZZ_CHECK(!f.speed_mps || (*f.speed_mps > 0 && *f.speed_mps <= planner::kMaxPlanSpeed_mps), source);
+  SKYLANE_FUZZ_CHECK(f.speed_mps.has_value() == !f.speed_field.empty(), source);
+  SKYLANE_FUZZ_CHECK(f.hover_s >= 0 && std::isfinite(f.hover_s), source);
+}
+
+bool sameHeight(const std::optional<planner::PointHeight>& a, const std::optional<planner::PointHeight>& b) {
+  if (!a || !b) return !a && !b;
+  return a->reference == b->reference && a->value_m == b->value_m;
+}
+
 void checkRoute(const planner::QgcPlanRoute& r, const std::string& source) {
   checkPoints(r.points, source);
+  SKYLANE_FUZZ_CHECK(r.flights.size() == r.points.size(), source);
+  for (const planner::PointFlight& f : r.flights) checkFlight(f, source);
   for (std::size_t i = 1; i < r.points.size(); ++i) {
-    SKYLANE_FUZZ_CHECK(r.points[i].lat_rad != r.points[i - 1].lat_rad || r.points[i].lon_rad != r.points[i - 1].lon_rad,
+    const bool same_place =
+        r.points[i].lat_rad == r.points[i - 1].lat_rad && r.points[i].lon_rad == r.points[i - 1].lon_rad;
+    SKYLANE_FUZZ_CHECK(!same_place || !sameHeight(r.flights[i].height, r.flights[i - 1].height),
                        source + ": point " + std::to_string(i) + " repeats the one before");
   }
   SKYLANE_FUZZ_CHECK(!r.cruise_agl_m || std::isfinite(*r.cruise_agl_m), source);
@@ -84,6 +118,8 @@ void checkRoute(const planner::QgcPlanRoute& r, const std::string& source) {
 void checkMission(const planner::Mission& m, const std::string& source, const std::string& plan_path) {
   checkPoints(m.points, source);
   SKYLANE_FUZZ_CHECK(m.qgc_plan_file == plan_path, source + ": plan file '" + m.qgc_plan_file + "'");
+  SKYLANE_FUZZ_CHECK(m.point_flights.size() == (plan_path.empty() ? 0u : m.points.size()), source);
+  SKYLANE_FUZZ_CHECK(plan_path.empty() || std::count(m.zone_files.begin(), m.zone_files.end(), plan_path) <= 1, source);
   SKYLANE_FUZZ_CHECK(m.vehicle.lateral_m > 0 && m.vehicle.longitudinal_m > 0 && m.vehicle.height_m >= 0, source);
   SKYLANE_FUZZ_CHECK(std::isfinite(m.vehicle.lateral_m) && std::isfinite(m.vehicle.longitudinal_m) &&
                          std::isfinite(m.vehicle.height_m),

@@ -9,11 +9,12 @@
 namespace skylane::geofence {
 
 Obstructions loadObstructions(const ObstructionFiles& files, const maps::PlaneFrame& frame, const maps::Terrain& terrain,
-                              ZonePolicy policy, FenceOptions options) {
+                              ZonePolicy policy, FenceOptions options, const std::set<std::string>& qgc_plans) {
   const airspace::VerticalModel model{terrain, maps::Geoid::egm96()};
   std::vector<airspace::Zone> zones;
   for (const std::string& path : files.zones) {
-    std::vector<airspace::Zone> z = airspace::loadZones(path, files.format);
+    const airspace::ZoneFormat format = qgc_plans.count(path) ? airspace::ZoneFormat::kQgcPlan : files.format;
+    std::vector<airspace::Zone> z = airspace::loadZones(path, format);
     zones.insert(zones.end(), std::make_move_iterator(z.begin()), std::make_move_iterator(z.end()));
   }
   std::vector<maps::Building> buildings;

@@ -8,6 +8,7 @@
 #include "geofence/fence.hpp"
 #include "maps/terrain.hpp"
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -21,10 +22,13 @@ struct ObstructionFiles {
 };
 
 /// \brief Loads the zones and buildings, resolves their heights with `terrain` and the EGM96
-/// geoid, and builds the scene in `frame`.
+/// geoid, and builds the scene in `frame`. The zone files named in `qgc_plans` are read as
+/// QGroundControl plans whatever `files.format` says (a mission's .plan, whose geoFence joins
+/// zones of another format).
 /// \throws maps::ParseError naming the file and field of a bad input; std::invalid_argument
 /// naming a zone whose limits cannot be resolved.
 [[nodiscard]] Obstructions loadObstructions(const ObstructionFiles& files, const maps::PlaneFrame& frame,
-                                            const maps::Terrain& terrain, ZonePolicy policy, FenceOptions options);
+                                            const maps::Terrain& terrain, ZonePolicy policy, FenceOptions options,
+                                            const std::set<std::string>& qgc_plans = {});
 
 }  // namespace skylane::geofence

@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 namespace skylane::link {
@@ -47,10 +48,12 @@ json simpleItem(int command, int jump_id, const std::array<double, 4>& p1to4, do
           {"params", params}, {"type", "SimpleItem"}};
 }
 
-/// The ground's AMSL height under a mission stop: the stop is at cruise height above the ground
-/// (ellipsoidal); the geoid undulation is the route point's own h_ell − alt_amsl.
-double groundAmsl(const Eigen::Vector3d& stop, double cruise_agl_m, const planner::RoutePoint& near) {
-  return stop.z() - cruise_agl_m - (near.h_ell_m - near.alt_amsl_m);
+/// The ground's AMSL height under a mission stop (the approver's terrain, ellipsoidal); the geoid
+/// undulation is the route point's own h_ell − alt_amsl.
+double groundAmsl(const planner::Approver& a, const Eigen::Vector3d& stop, const planner::RoutePoint& near) {
+  const std::optional<double> ground_m = a.groundHeight(stop.head<2>());
+  if (!ground_m) throw std::logic_error("qgcPlan: a mission stop outside the terrain model");  // placed on it
+  return *ground_m - (near.h_ell_m - near.alt_amsl_m);
 }
 
 json missionItems(const planner::ApprovedFlight& r, const planner::Approver& a) {
@@ -61,10 +64,11 @@ json missionItems(const planner::ApprovedFlight& r, const planner::Approver& a) 
   items.push_back(simpleItem(kNavTakeoff, ++id, {0.0, 0.0, 0.0, nan}, route.front().lat_rad, route.front().lon_rad,
                              route.front().alt_amsl_m));
   for (std::size_t i = 1; i < route.size(); ++i) {
-    items.push_back(simpleItem(kNavWaypoint, ++id, {0.0, r.level1.hal_m, 0.0, nan}, route[i].lat_rad, route[i].lon_rad,
-                               route[i].alt_amsl_m));
+    // params[0]: the hold time, the route point's hover (a multirotor stays that long).
+    items.push_back(simpleItem(kNavWaypoint, ++id, {route[i].hover_s, r.level1.hal_m, 0.0, nan}, route[i].lat_rad,
+                               route[i].lon_rad, route[i].alt_amsl_m));
   }
-  const double land_m = groundAmsl(a.missionStops().back(), a.mission().cruise_agl_m, route.back());
+  const double land_m = groundAmsl(a, a.missionStops().back(), route.back());
   items.push_back(simpleItem(kNavLand, ++id, {0.0, 0.0, 0.0, nan}, route.back().lat_rad, route.back().lon_rad, land_m));
   return items;
 }
@@ -148,7 +152,7 @@ nlohmann::json qgcPlan(planner::ApprovedFlight report, const planner::Approver& 
     p.xyz = Eigen::Vector3d(xy.x(), xy.y(), p.h_ell_m);
   }
   const planner::Mission& m = approver.mission();
-  const double home_m = groundAmsl(approver.missionStops().front(), m.cruise_agl_m, report.route.front());
+  const double home_m = groundAmsl(approver, approver.missionStops().front(), report.route.front());
   const planner::MissionPoint& start = m.points.front();
   json mission = {{"cruiseSpeed", m.cruise_speed_mps},
                   {"firmwareType", vehicle.firmware_type},

@@ -8,6 +8,7 @@
 #include "integrity/predict.hpp"
 #include "maps/file_digest.hpp"
 #include "maps/geoid.hpp"
+#include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/plane_frame.hpp"
 #include "maps/sky_mask.hpp"
@@ -18,12 +19,30 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <set>
+#include <sstream>
+#include <string>
 
 namespace skylane::planner {
 
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// A number as a person would write it: whole numbers without a fraction.
+std::string numberText(double v) {
+  if (std::floor(v) == v && std::abs(v) < 1e15) return std::to_string(static_cast<long long>(v));
+  return maps::quoteJson(nlohmann::json(v));
+}
+
+/// A computed height, to a decimetre.
+std::string decimetres(double v) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(1);
+  s << v;
+  return s.str();
+}
 
 /// φ(r) of the file comment: grows without bound as PL approaches the alert limit.
 double integrityPenalty(double r) {
@@ -42,7 +61,10 @@ void requireReadableInputs(const Mission& m) {
   auto check = [&m](const std::string& path, const std::string& field) {
     if (!std::ifstream(path)) throw maps::ParseError(m.source, 0, field, path, "a readable file (the path as resolved from the mission)");
   };
-  for (std::size_t i = 0; i < m.zone_files.size(); ++i) check(m.zone_files[i], "$.zones[" + std::to_string(i) + "]");
+  for (std::size_t i = 0; i < m.zone_files.size(); ++i) {
+    // The .plan's geoFence joins the zones without being listed (planner/mission.hpp).
+    check(m.zone_files[i], m.zone_files[i] == m.qgc_plan_file ? "$.qgc_plan" : "$.zones[" + std::to_string(i) + "]");
+  }
   if (!m.buildings_file.empty()) check(m.buildings_file, "$.buildings");
 }
 
@@ -93,6 +115,7 @@ Approver::Impl::Impl(Mission mission)
   } catch (const std::invalid_argument& e) {
     throw maps::ParseError(m.source, 0, "$.k1/$.k2/$.vehicle", "", e.what());
   }
+  placeStops();
   requireReadableInputs(m);
   const auto format = airspace::parseZoneFormat(m.zone_format);
   if (!format) throw maps::ParseError(m.source, 0, "$.zone_format", m.zone_format, "auto, ed269, ed318, geojson or qgc");
@@ -100,8 +123,10 @@ Approver::Impl::Impl(Mission mission)
   policy.authorisations = m.authorisations;
   geofence::FenceOptions options;
   options.horizon_m = 500.0;  // zones within 500 m are reported with their clearance
-  obstructions = std::make_unique<geofence::Obstructions>(
-      geofence::loadObstructions({m.zone_files, *format, m.buildings_file}, frame, terrain, policy, options));
+  std::set<std::string> qgc_plans;  // the .plan's geoFence: QGroundControl whatever zone_format says
+  if (!m.qgc_plan_file.empty()) qgc_plans.insert(m.qgc_plan_file);
+  obstructions = std::make_unique<geofence::Obstructions>(geofence::loadObstructions(
+      {m.zone_files, *format, m.buildings_file}, frame, terrain, policy, options, qgc_plans));
   if (!obstructions->buildings().empty()) {
     const maps::Geodetic origin{m.points.front().lat_rad, m.points.front().lon_rad, 0.0};
     index = std::make_unique<maps::BuildingIndex>(obstructions->buildings(), origin);
@@ -226,13 +251,82 @@ geofence::ProtectionVolume Approver::Impl::planningVolume(const Eigen::Vector3d&
 
 double Approver::Impl::extraCost(const Eigen::Vector3d& p) const { return cost[cellOf(p)]; }
 
-std::vector<RoutePoint> Approver::Impl::timeRoute(const std::vector<Eigen::Vector3d>& pts) const {
+void Approver::Impl::placeStops() {
+  if (!m.point_flights.empty() && m.point_flights.size() != m.points.size()) {
+    throw std::logic_error("Approver: " + std::to_string(m.point_flights.size()) + " point flights for " +
+                           std::to_string(m.points.size()) + " mission points");
+  }
+  mission_stops.clear();
+  mission_timing.clear();
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    const Eigen::Vector2d xy = frame.toPlane(m.points[i].lat_rad, m.points[i].lon_rad);
+    const auto g = ground(xy);
+    if (!g) {
+      throw maps::ParseError(m.source, 0, m.qgc_plan_file.empty() ? "$.start/$.waypoints/$.goal" : "$.qgc_plan", "",
+                             "route points the terrain model covers");
+    }
+    const Eigen::Vector3d p(xy.x(), xy.y(), stopHeight(i, *g));
+    checkStopHeight(i, p, *g);
+    mission_stops.push_back(p);
+    approval_steps::StopTiming st{m.cruise_speed_mps, 0.0};
+    if (!m.point_flights.empty()) {
+      st.speed_mps = m.point_flights[i].speed_mps.value_or(m.cruise_speed_mps);
+      st.hover_s = m.point_flights[i].hover_s;
+    }
+    mission_timing.push_back(st);
+  }
+}
+
+double Approver::Impl::stopHeight(std::size_t i, double ground_m) const {
+  if (m.point_flights.empty() || !m.point_flights[i].height) return ground_m + m.cruise_agl_m;
+  const PointHeight& h = *m.point_flights[i].height;
+  switch (h.reference) {
+    case HeightReference::kAboveGround: return ground_m + h.value_m;
+    case HeightReference::kAmsl:
+      return maps::Geoid::egm96().ellipsoidalFromAmsl_m(m.points[i].lat_rad, m.points[i].lon_rad, h.value_m);
+    case HeightReference::kAboveHome: break;
+  }
+  // Relative to home: above the ground at the home, where the autopilot's altitude is zeroed.
+  const MissionPoint home = m.qgc_home.value_or(m.points.front());
+  const auto home_ground = ground(frame.toPlane(home.lat_rad, home.lon_rad));
+  if (!home_ground) {
+    throw maps::ParseError(m.qgc_plan_file, 0, "$.mission.plannedHomePosition", "",
+                           "a home the terrain model covers (heights relative to home, e.g. " + h.field + ", need it)");
+  }
+  return *home_ground + h.value_m;
+}
+
+void Approver::Impl::checkStopHeight(std::size_t i, const Eigen::Vector3d& p, double ground_m) const {
+  if (m.point_flights.empty() || !m.point_flights[i].height) return;  // cruise AGL: checked with the mission
+  const PointHeight& h = *m.point_flights[i].height;
+  const double agl = p.z() - ground_m;
+  std::string broken;
+  if (agl < m.min_agl_m) broken = "below altitude.min_agl_m " + numberText(m.min_agl_m) + " m";
+  if (agl > m.max_agl_m) broken = "above altitude.max_agl_m " + numberText(m.max_agl_m) + " m";
+  std::string here = decimetres(agl) + " m above the ground";
+  if (m.max_amsl_m) {
+    const double amsl = maps::Geoid::egm96().amslFromEllipsoidal_m(m.points[i].lat_rad, m.points[i].lon_rad, p.z());
+    if (broken.empty() && amsl > *m.max_amsl_m) {
+      broken = "above altitude.max_amsl_m " + numberText(*m.max_amsl_m) + " m";
+      here = decimetres(amsl) + " m above mean sea level";
+    }
+  }
+  if (broken.empty()) return;
+  throw maps::ParseError(m.qgc_plan_file, 0, h.field, numberText(h.value_m),
+                         "a height within the mission's altitude limits (this one is " + here + " there, " + broken +
+                             ")");
+}
+
+std::vector<RoutePoint> Approver::Impl::timeRoute(const std::vector<Eigen::Vector3d>& pts,
+                                                  const std::vector<approval_steps::StopTiming>& per_point) const {
+  if (per_point.size() != pts.size()) throw std::logic_error("timeRoute: one timing per point expected");
   std::vector<RoutePoint> out;
   double t = 0.0;
   for (std::size_t i = 0; i < pts.size(); ++i) {
     if (i > 0) {
       const Eigen::Vector3d d = pts[i] - pts[i - 1];
-      t += std::max(d.head<2>().norm() / m.cruise_speed_mps, std::abs(d.z()) / m.climb_speed_mps);
+      t += out.back().hover_s;
+      t += std::max(d.head<2>().norm() / per_point[i].speed_mps, std::abs(d.z()) / m.climb_speed_mps);
     }
     RoutePoint rp;
     rp.xyz = pts[i];
@@ -242,6 +336,7 @@ std::vector<RoutePoint> Approver::Impl::timeRoute(const std::vector<Eigen::Vecto
     rp.h_ell_m = g.h_ell_m;
     rp.alt_amsl_m = maps::Geoid::egm96().amslFromEllipsoidal_m(g.lat_rad, g.lon_rad, g.h_ell_m);
     rp.eta_s = t;
+    rp.hover_s = per_point[i].hover_s;
     out.push_back(rp);
   }
   return out;
@@ -249,13 +344,15 @@ std::vector<RoutePoint> Approver::Impl::timeRoute(const std::vector<Eigen::Vecto
 
 Eigen::Vector3d positionAlong(const std::vector<RoutePoint>& route, double t_s) {
   if (route.empty()) throw std::invalid_argument("positionAlong: an empty route");
-  if (t_s <= route.front().eta_s) return route.front().xyz;
+  if (t_s <= route.front().eta_s + route.front().hover_s) return route.front().xyz;
   for (std::size_t i = 1; i < route.size(); ++i) {
     if (t_s <= route[i].eta_s) {
-      const double span = route[i].eta_s - route[i - 1].eta_s;
-      const double f = span > 0 ? (t_s - route[i - 1].eta_s) / span : 1.0;
+      const double leaves_s = route[i - 1].eta_s + route[i - 1].hover_s;
+      const double span = route[i].eta_s - leaves_s;
+      const double f = span > 0 ? std::max(0.0, t_s - leaves_s) / span : 1.0;
       return route[i - 1].xyz + f * (route[i].xyz - route[i - 1].xyz);
     }
+    if (t_s <= route[i].eta_s + route[i].hover_s) return route[i].xyz;  // hovering there
   }
   return route.back().xyz;
 }
@@ -267,20 +364,9 @@ const maps::PlaneFrame& Approver::frame() const { return impl_->frame; }
 const geofence::Obstructions& Approver::obstructions() const { return *impl_->obstructions; }
 const integrity::OrbitSource& Approver::orbits() const { return impl_->orbits; }
 
-std::vector<Eigen::Vector3d> Approver::missionStops() const {
-  const Mission& m = impl_->m;
-  std::vector<Eigen::Vector3d> stops;
-  for (const MissionPoint& p : m.points) {
-    const Eigen::Vector2d xy = impl_->frame.toPlane(p.lat_rad, p.lon_rad);
-    const auto g = impl_->ground(xy);
-    if (!g) {
-      throw maps::ParseError(m.source, 0, m.qgc_plan_file.empty() ? "$.start/$.waypoints/$.goal" : "$.qgc_plan", "",
-                             "route points the terrain model covers");
-    }
-    stops.emplace_back(xy.x(), xy.y(), *g + m.cruise_agl_m);
-  }
-  return stops;
-}
+std::vector<Eigen::Vector3d> Approver::missionStops() const { return impl_->mission_stops; }
+
+std::optional<double> Approver::groundHeight(const Eigen::Vector2d& xy_map) const { return impl_->ground(xy_map); }
 
 ApprovalReport Approver::approve(const std::function<void(const std::string&)>& progress) {
   const Mission& m = impl_->m;
@@ -289,7 +375,7 @@ ApprovalReport Approver::approve(const std::function<void(const std::string&)>& 
     departures.push_back(m.departure_earliest.plus(dt));
   }
   std::vector<std::string> warnings = checkOrbitAges(impl_->orbits, m);
-  ApprovalReport report = impl_->run(missionStops(), departures, false, progress);
+  ApprovalReport report = impl_->run(impl_->mission_stops, impl_->mission_timing, departures, false, progress);
   report.warnings.insert(report.warnings.begin(), warnings.begin(), warnings.end());
   return report;
 }
@@ -304,7 +390,11 @@ ApprovalReport Approver::replanFrom(const Eigen::Vector3d& p_map, const maps::Gp
   }
   std::vector<Eigen::Vector3d> stops{p_map};
   stops.insert(stops.end(), all.begin() + static_cast<std::ptrdiff_t>(next_stop), all.end());
-  return impl_->run(stops, {now}, true, progress);
+  // From the vehicle: no hover where it is now (one under way there is over when it replans).
+  std::vector<approval_steps::StopTiming> timing{{impl_->m.cruise_speed_mps, 0.0}};
+  timing.insert(timing.end(), impl_->mission_timing.begin() + static_cast<std::ptrdiff_t>(next_stop),
+                impl_->mission_timing.end());
+  return impl_->run(stops, timing, {now}, true, progress);
 }
 
 }  // namespace skylane::planner

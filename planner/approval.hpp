@@ -19,10 +19,13 @@
 ///    w·φ(r), r = max(HPL/HAL₂, VPL/VAL₂) predicted on a grid at cruise height (sky mask from
 ///    buildings and terrain at each cell), φ(r) = (r/(1 − r))² for r < 0.99 and 10⁴ beyond
 ///    (an unavailable PL counts as r = ∞).
-/// 2. Time the route (ETA per point: horizontal distance at cruise speed, height change at
-///    climb speed, whichever takes longer) and build both box levels along it.
-/// 3. Every `sample_s` seconds of flight: the position, its sky mask, the predicted PLs with the
-///    mission's method, and the fence check of the protection volume at that time.
+/// 2. Time the route (ETA per point: horizontal distance at the leg's speed — cruise, or a
+///    plan's DO_CHANGE_SPEED — height change at climb speed, whichever takes longer; a stop's
+///    hover delays every later ETA) and build both box levels along it. The stops are at their
+///    own heights (a plan's items), else at cruise height; legs climb or descend between them.
+/// 3. Every `sample_s` seconds of flight, and where each hover starts and ends: the position
+///    (held at a stop while it hovers), its sky mask, the predicted PLs with the mission's
+///    method, and the fence check of the protection volume at that time.
 /// 4. Approved when every sample has a PL and its protection volume is inside level 2 and clear
 ///    of the zones and the obstacles. Level-1 exceedances (HPL > HAL₁ or VPL > VAL₁) are counted
 ///    and reported: in flight they trigger a monitoring rerun, not a rejection.
@@ -49,11 +52,12 @@ namespace skylane::planner {
 struct RoutePoint {
   Eigen::Vector3d xyz = Eigen::Vector3d::Zero();  ///< map frame x, y [m] and ellipsoidal height [m]
   double lat_rad = 0.0, lon_rad = 0.0, h_ell_m = 0.0, alt_amsl_m = 0.0;
-  double eta_s = 0.0;  ///< seconds after departure
+  double eta_s = 0.0;    ///< arrival, seconds after departure
+  double hover_s = 0.0;  ///< the vehicle stays here this long after arriving, then leaves
 };
 
-/// \brief Where a timed route is t seconds after departure (map frame): linear between points
-/// by ETA, held at the ends.
+/// \brief Where a timed route is t seconds after departure (map frame): held at a point from its
+/// ETA until its hover ends, linear from there to the next point's ETA, held at the ends.
 [[nodiscard]] Eigen::Vector3d positionAlong(const std::vector<RoutePoint>& route, double t_s);
 
 /// \brief One prediction sample along the route.
@@ -142,7 +146,8 @@ struct ApprovalReport {
 /// \brief Loads the mission's files once and approves (or rejects) it.
 class Approver {
  public:
-  /// \throws maps::ParseError naming the file and field of a bad input.
+  /// \throws maps::ParseError naming the file and field of a bad input, or a route point the
+  /// terrain does not cover, or a plan item whose height breaks the altitude limits.
   explicit Approver(Mission mission);
   ~Approver();
   Approver(const Approver&) = delete;
@@ -164,9 +169,12 @@ class Approver {
   /// \throws std::invalid_argument for a non-finite position or a next_stop out of range.
   [[nodiscard]] ApprovalReport replanFrom(const Eigen::Vector3d& p_map, const maps::GpsTime& now, std::size_t next_stop,
                                           const std::function<void(const std::string&)>& progress = {});
-  /// \brief The mission's points at cruise height above the terrain (map frame).
-  /// \throws maps::ParseError when the terrain does not cover one.
+  /// \brief The mission's points (map frame) at their heights: a plan item's own (converted
+  /// with the terrain and the geoid, checked against the altitude limits when the Approver was
+  /// made), else cruise height above the terrain.
   [[nodiscard]] std::vector<Eigen::Vector3d> missionStops() const;
+  /// \brief The terrain's ellipsoidal height under a map point; none outside the terrain model.
+  [[nodiscard]] std::optional<double> groundHeight(const Eigen::Vector2d& xy_map) const;
 
   [[nodiscard]] const Mission& mission() const;
   /// \brief The mission's map frame (origin at the start).

@@ -43,12 +43,20 @@ struct Say {
 /// radius [m].
 using Penalty = std::pair<Eigen::Vector3d, double>;
 
+/// \brief How the vehicle flies the leg to a stop and how long it stays there.
+struct StopTiming {
+  double speed_mps = 0.0;  ///< ground speed of the leg arriving at the stop (unused for the first)
+  double hover_s = 0.0;    ///< time at the stop after arriving
+};
+
 /// \brief What every attempt of one approval shares.
 struct ApprovalSetup {
   std::vector<Eigen::Vector3d> stops;     ///< map frame: the start (or the vehicle), waypoints, goal
+  std::vector<StopTiming> timing;         ///< per stop
+  double fastest_mps = 0.0;               ///< the fastest leg speed: the earliest the vehicle can be anywhere
   std::vector<maps::GpsTime> departures;  ///< tried in turn
   bool from_vehicle = false;              ///< a replan from where the vehicle is
-  double direct_s = 0.0;                  ///< the straight legs at cruise speed
+  double direct_s = 0.0;                  ///< the straight legs at their speeds, and the hovers
   /// The end of the zones' activity window: the latest departure plus twice the direct flight
   /// time plus 2 min (a zone starting later cannot meet the vehicle).
   maps::GpsTime zones_until;
@@ -61,6 +69,7 @@ struct ApprovalSetup {
 /// \brief One attempt's route through the stops, planned leg by leg.
 struct LegPlan {
   std::vector<Eigen::Vector3d> pts;  ///< start … goal when every leg is exact
+  std::vector<std::size_t> stop_at;  ///< per stop reached: its index in pts
   PathResult last;                   ///< the last leg planned: the one that failed, if one did
   bool ok = true;                    ///< every leg exact
   std::size_t failed_leg = 0;        ///< when not ok: index into the stops of that leg's goal
@@ -127,6 +136,8 @@ struct Approver::Impl {
   std::unique_ptr<geofence::Obstructions> obstructions;
   std::unique_ptr<maps::BuildingIndex> index;
   integrity::OrbitSource orbits;
+  std::vector<Eigen::Vector3d> mission_stops;              ///< the mission's points at their heights (map frame)
+  std::vector<approval_steps::StopTiming> mission_timing;  ///< per mission stop: leg speed and hover
   Eigen::Vector3d lower = Eigen::Vector3d::Zero(), upper = Eigen::Vector3d::Zero();
   // The predicted-PL grid at cruise height (mid-flight time) and the integrity cost from it.
   double cell_m = 50.0;
@@ -159,19 +170,35 @@ struct Approver::Impl {
   /// 20 % allowance for its change over the flight (the samples are checked exactly afterwards).
   [[nodiscard]] geofence::ProtectionVolume planningVolume(const Eigen::Vector3d& p) const;
   [[nodiscard]] double extraCost(const Eigen::Vector3d& p) const;
-  /// ETA per point: horizontal at cruise speed, vertical at climb speed, whichever is slower.
-  [[nodiscard]] std::vector<RoutePoint> timeRoute(const std::vector<Eigen::Vector3d>& pts) const;
+  /// The mission's points at their heights, with their legs' speeds and hovers (`mission_stops`,
+  /// `mission_timing`); a plan item's height breaking the altitude limits is an error naming it.
+  void placeStops();
+  /// The ellipsoidal height of mission point `i` above ground `ground_m` (ellipsoidal).
+  [[nodiscard]] double stopHeight(std::size_t i, double ground_m) const;
+  /// A plan item's height against min_agl/max_agl/max_amsl at map point `xy`.
+  void checkStopHeight(std::size_t i, const Eigen::Vector3d& p, double ground_m) const;
+  /// ETA per point: horizontal at its leg's speed (`per_point[i].speed_mps` for the segment
+  /// arriving at i), vertical at climb speed, whichever is slower; each point's hover after it.
+  [[nodiscard]] std::vector<RoutePoint> timeRoute(const std::vector<Eigen::Vector3d>& pts,
+                                                  const std::vector<approval_steps::StopTiming>& per_point) const;
 
   // --- the approval (approval_steps.cpp) ---
 
-  /// The approval steps of approval.hpp from `stops` (map frame) for each departure in turn;
+  /// The approval steps of approval.hpp from `stops` (map frame; `stop_timing`: per stop, the
+  /// speed of the leg to it and its hover) for each departure in turn;
   /// `from_vehicle`: a replan from where the vehicle is (no later-departure search).
-  ApprovalReport run(const std::vector<Eigen::Vector3d>& stops, const std::vector<maps::GpsTime>& departures,
-                     bool from_vehicle, const std::function<void(const std::string&)>& progress);
+  ApprovalReport run(const std::vector<Eigen::Vector3d>& stops,
+                     const std::vector<approval_steps::StopTiming>& stop_timing,
+                     const std::vector<maps::GpsTime>& departures, bool from_vehicle,
+                     const std::function<void(const std::string&)>& progress);
 
   [[nodiscard]] approval_steps::ApprovalSetup boundFlightTime(const std::vector<Eigen::Vector3d>& stops,
+                                                              const std::vector<approval_steps::StopTiming>& stop_timing,
                                                               const std::vector<maps::GpsTime>& departures,
                                                               bool from_vehicle) const;
+  /// Per point of a leg plan: the speed of the segment arriving there and, at a stop, its hover.
+  [[nodiscard]] std::vector<approval_steps::StopTiming> pointTiming(const approval_steps::ApprovalSetup& setup,
+                                                                    const approval_steps::LegPlan& plan) const;
   void ensureCostField(const approval_steps::ApprovalSetup& setup, const approval_steps::Say& say);
   void fitSearchBox(approval_steps::ApprovalSetup& setup) const;
   bool tryDeparture(const approval_steps::ApprovalSetup& setup, const maps::GpsTime& departure,

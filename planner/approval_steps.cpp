@@ -21,6 +21,7 @@ using approval_steps::RouteCorridors;
 using approval_steps::RouteSamples;
 using approval_steps::SampleChecks;
 using approval_steps::Say;
+using approval_steps::StopTiming;
 
 namespace {
 
@@ -55,6 +56,20 @@ std::string fmtTime(double t_s) {
   s.precision(0);
   s << "t+" << t_s << " s";
   return s.str();
+}
+
+/// Adds the instants each hover starts and ends to sorted sample times (so a hover shorter than
+/// the sample step is still checked), keeping them sorted and distinct.
+void addHoverEdges(const std::vector<RoutePoint>& route, std::vector<double>& t_s) {
+  const std::size_t regular = t_s.size();
+  for (const RoutePoint& p : route) {
+    if (p.hover_s <= 0.0) continue;
+    t_s.push_back(p.eta_s);
+    t_s.push_back(p.eta_s + p.hover_s);
+  }
+  if (t_s.size() == regular) return;
+  std::sort(t_s.begin(), t_s.end());
+  t_s.erase(std::unique(t_s.begin(), t_s.end()), t_s.end());
 }
 
 /// The penalty round a sample whose protection volume broke a rule.
@@ -116,11 +131,12 @@ std::string liftedBy(const geofence::Check& c) {
 
 }  // namespace
 
-ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, const std::vector<maps::GpsTime>& departures,
-                                   bool from_vehicle, const std::function<void(const std::string&)>& progress) {
+ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, const std::vector<StopTiming>& stop_timing,
+                                   const std::vector<maps::GpsTime>& departures, bool from_vehicle,
+                                   const std::function<void(const std::string&)>& progress) {
   const auto started = std::chrono::steady_clock::now();
   const Say say{progress};
-  ApprovalSetup setup = boundFlightTime(stops, departures, from_vehicle);
+  ApprovalSetup setup = boundFlightTime(stops, stop_timing, departures, from_vehicle);
   ensureCostField(setup, say);
   fitSearchBox(setup);  // after the cost field: a replan's exemption grows with the PL predicted there
   ApprovalReport report;
@@ -147,14 +163,22 @@ ApprovalReport Approver::Impl::run(const std::vector<Eigen::Vector3d>& stops, co
 }
 
 ApprovalSetup Approver::Impl::boundFlightTime(const std::vector<Eigen::Vector3d>& stops,
+                                              const std::vector<StopTiming>& stop_timing,
                                               const std::vector<maps::GpsTime>& departures, bool from_vehicle) const {
   ApprovalSetup setup;
   setup.stops = stops;
+  setup.timing = stop_timing;
   setup.departures = departures;
   setup.from_vehicle = from_vehicle;
-  double direct_m = 0.0;
-  for (std::size_t i = 1; i < stops.size(); ++i) direct_m += (stops[i] - stops[i - 1]).head<2>().norm();
-  setup.direct_s = direct_m / m.cruise_speed_mps;
+  // The straight legs at their speeds, and every hover; the fastest leg bounds how early the
+  // vehicle can be anywhere.
+  setup.fastest_mps = m.cruise_speed_mps;
+  for (std::size_t i = 0; i < stops.size(); ++i) {
+    setup.direct_s += stop_timing[i].hover_s;
+    if (i == 0) continue;
+    setup.direct_s += (stops[i] - stops[i - 1]).head<2>().norm() / stop_timing[i].speed_mps;
+    setup.fastest_mps = std::max(setup.fastest_mps, stop_timing[i].speed_mps);
+  }
   const double flight_bound_s = 2.0 * setup.direct_s + kFlightAllowance_s;
   // The zones' activity window reaches the mission's latest departure (a window whose length
   // is not a multiple of its step has its last departure before it); a replan's is `now`.
@@ -208,7 +232,7 @@ AttemptOutcome Approver::Impl::attemptRoute(const ApprovalSetup& setup, const ma
     history.last_route.clear();
     return AttemptOutcome::kNoRoute;  // replanning cannot help; next departure
   }
-  const std::vector<RoutePoint> route = timeRoute(plan.pts);
+  const std::vector<RoutePoint> route = timeRoute(plan.pts, pointTiming(setup, plan));
   report.planner.length_m = polylineLength(plan.pts);
   const RouteSamples samples = sampleRoute(route, say);
   SampleChecks checks = checkSamples(setup, departure, plan.pts, samples, report.zones);
@@ -233,6 +257,7 @@ LegPlan Approver::Impl::planLegs(const ApprovalSetup& setup, const maps::GpsTime
                                  const std::vector<Penalty>& penalties, PlannerStats& stats) const {
   LegPlan plan;
   plan.pts = {setup.stops.front()};
+  plan.stop_at = {0};
   for (std::size_t leg = 1; leg < setup.stops.size(); ++leg) {
     plan.last = planPath(legProblem(setup, departure, attempt, leg, plan.pts.back(), penalties));
     stats.planning_time_s += plan.last.planning_time_s + plan.last.simplify_time_s;
@@ -244,6 +269,7 @@ LegPlan Approver::Impl::planLegs(const ApprovalSetup& setup, const maps::GpsTime
       break;
     }
     plan.pts.insert(plan.pts.end(), plan.last.points.begin() + 1, plan.last.points.end());
+    plan.stop_at.push_back(plan.pts.size() - 1);
   }
   stats.algorithm = std::string(plannerName(m.planner));
   stats.status = std::string(pathStatusName(plan.last.status));
@@ -264,9 +290,9 @@ PathProblem Approver::Impl::legProblem(const ApprovalSetup& setup, const maps::G
   const Eigen::Vector2d start_xy = setup.stops.front().head<2>();
   const maps::GpsTime latest = setup.zones_until;
   const Eigen::Vector3d vehicle = setup.stops.front();
-  const double exempt_m = setup.exempt_m;
-  prob.is_valid = [this, &penalties, start_xy, departure, latest, vehicle, exempt_m](const Eigen::Vector3d& p) {
-    const maps::GpsTime earliest = departure.plus((p.head<2>() - start_xy).norm() / m.cruise_speed_mps);
+  const double exempt_m = setup.exempt_m, fastest_mps = setup.fastest_mps;
+  prob.is_valid = [this, &penalties, start_xy, departure, latest, vehicle, exempt_m, fastest_mps](const Eigen::Vector3d& p) {
+    const maps::GpsTime earliest = departure.plus((p.head<2>() - start_xy).norm() / fastest_mps);
     if (exempt_m > 0.0 && (p - vehicle).norm() <= exempt_m) {
       // Round the vehicle only its own point must be clear; outside a keep-in zone it may fly back in.
       return !obstructions->firstConflict({earliest, latest, {p, 0.0, 0.0}}, /*with_keep_in=*/false);
@@ -336,7 +362,7 @@ std::string Approver::Impl::legBlockers(const Eigen::Vector3d& from, const Eigen
 /// reaches — the keep-in zone it leaves, the zone or obstacle it meets, and what would lift it.
 void Approver::Impl::unflyableCause(const Eigen::Vector3d& p, const maps::GpsTime& from, const maps::GpsTime& until,
                                     const std::string& what, Reason& r) const {
-  r.message = what + " is not flyable at cruise height: ";
+  r.message = what + " is not flyable at its height: ";
   const auto g = ground(p.head<2>());
   if (!g) {
     r.message += "it lies outside the terrain model";
@@ -385,15 +411,17 @@ std::string Approver::Impl::conflictCause(const geofence::Check& c, const geofen
   return ": " + box + " reaches " + describeCheck(c);
 }
 
-/// Sample times every sample_s and the route's end; the place and sky mask at each.
+/// Sample times every sample_s, where each hover starts and ends, and the route's end; the
+/// place and sky mask at each.
 RouteSamples Approver::Impl::sampleRoute(const std::vector<RoutePoint>& route, const Say& say) const {
-  const double total_s = route.back().eta_s;
+  const double total_s = route.back().eta_s + route.back().hover_s;
   RouteSamples samples;
   for (double t = 0.0;; t += m.sample_s) {
     const double tt = std::min(t, total_s);
     samples.t_s.push_back(tt);
     if (tt >= total_s) break;
   }
+  addHoverEdges(route, samples.t_s);
   say("predicting " + std::to_string(samples.t_s.size()) + " samples");
   const bool with_masks = masked();
   for (double t : samples.t_s) {
@@ -403,6 +431,19 @@ RouteSamples Approver::Impl::sampleRoute(const std::vector<RoutePoint>& route, c
     samples.masks.push_back(with_masks ? std::optional(skyMaskAt(samples.geo.back())) : std::nullopt);
   }
   return samples;
+}
+
+/// Per point of the plan: the speed of its stop's leg (the segment arriving there) and, at a
+/// stop, the stop's hover.
+std::vector<StopTiming> Approver::Impl::pointTiming(const ApprovalSetup& setup, const LegPlan& plan) const {
+  std::vector<StopTiming> out(plan.pts.size());
+  std::size_t from = 0;
+  for (std::size_t s = 0; s < plan.stop_at.size(); ++s) {
+    for (std::size_t i = from; i <= plan.stop_at[s]; ++i) out[i].speed_mps = setup.timing[s].speed_mps;
+    out[plan.stop_at[s]].hover_s = setup.timing[s].hover_s;
+    from = plan.stop_at[s] + 1;
+  }
+  return out;
 }
 
 RouteCorridors Approver::Impl::corridorsAlong(const std::vector<Eigen::Vector3d>& pts) const {

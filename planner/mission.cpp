@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <iterator>
 #include <optional>
+#include <system_error>
+#include <utility>
 
 namespace skylane::planner {
 
@@ -58,9 +60,34 @@ std::vector<std::string> files(const JsonNode& n, const std::string& base_dir) {
 /// MAVLink MAV_CMD values of the mission items a route is made of.
 enum QgcCommand : int {
   kNavWaypoint = 16,
+  kNavLoiterTime = 19,
   kNavReturnToLaunch = 20,
   kNavLand = 21,
   kNavTakeoff = 22,
+  kNavDelay = 93,
+  kDoChangeSpeed = 178,
+};
+
+/// \brief A command the route cannot honour, with why (the refusal names it).
+struct RefusedCommand {
+  int command;
+  const char* name;
+  const char* why;
+};
+
+/// Commands met in real plans that change the route or its timing in ways a planned route cannot
+/// follow: refused with the reason. Any other unknown command gets the general refusal.
+constexpr RefusedCommand kRefusedCommands[] = {
+    {17, "NAV_LOITER_UNLIM", "it loiters without end, so the goal is never reached"},
+    {18, "NAV_LOITER_TURNS", "its duration depends on the vehicle's turn radius: use NAV_LOITER_TIME"},
+    {31, "NAV_LOITER_TO_ALT", "its duration depends on the vehicle's climb: use NAV_LOITER_TIME"},
+    {84, "NAV_VTOL_TAKEOFF", "VTOL transitions are not planned"},
+    {85, "NAV_VTOL_LAND", "VTOL transitions are not planned"},
+    {112, "CONDITION_DELAY", "conditions are not planned: use NAV_DELAY"},
+    {114, "CONDITION_DISTANCE", "conditions are not planned"},
+    {177, "DO_JUMP", "it repeats part of the mission: unroll the loop into waypoints"},
+    {179, "DO_SET_HOME", "it moves the home that relative heights and RETURN_TO_LAUNCH refer to"},
+    {189, "DO_LAND_START", "landing sequences are not planned: end with NAV_LAND"},
 };
 
 /// Commands that only work a payload (camera, gimbal, region of interest, servo, relay) and
@@ -84,6 +111,9 @@ constexpr double kSameAltitudeTolerance_m = 1e-3;
 const char* commandName(int command) {
   switch (command) {
     case kNavWaypoint: return "NAV_WAYPOINT";
+    case kNavLoiterTime: return "NAV_LOITER_TIME";
+    case kNavDelay: return "NAV_DELAY";
+    case kDoChangeSpeed: return "DO_CHANGE_SPEED";
     case kNavReturnToLaunch: return "RETURN_TO_LAUNCH";
     case kNavLand: return "NAV_LAND";
     case kNavTakeoff: return "NAV_TAKEOFF";
@@ -131,6 +161,51 @@ std::optional<MissionPoint> optionalPosition(const JsonNode& params) {
 
 bool samePlace(const MissionPoint& a, const MissionPoint& b) { return a.lat_rad == b.lat_rad && a.lon_rad == b.lon_rad; }
 
+bool sameHeight(const std::optional<PointHeight>& a, const std::optional<PointHeight>& b) {
+  if (!a || !b) return !a && !b;
+  return a->reference == b->reference && std::abs(a->value_m - b->value_m) <= kSameAltitudeTolerance_m;
+}
+
+HeightReference heightReference(QgcAltitudeReference r) {
+  switch (r) {
+    case QgcAltitudeReference::kAmsl: return HeightReference::kAmsl;
+    case QgcAltitudeReference::kRelativeToHome: return HeightReference::kAboveHome;
+    case QgcAltitudeReference::kTerrain: return HeightReference::kAboveGround;
+  }
+  return HeightReference::kAboveGround;
+}
+
+/// \brief A positional item's own height: params[6] in its frame.
+PointHeight itemHeight(const JsonNode& params, QgcAltitudeReference reference) {
+  return {heightReference(reference), param(params, 6, "an altitude in metres"), params.path + "[6]"};
+}
+
+/// \brief A hover time in seconds at params[k]: 0 … kMaxPlanHover_s (null counts as 0 when
+/// `null_is_zero`, as QGroundControl writes an unset hold time).
+double hoverSeconds(const JsonNode& params, std::size_t k, bool null_is_zero) {
+  const JsonNode p = params.item(k);
+  if (null_is_zero && p.j.is_null()) return 0.0;
+  const std::string what = "a time in seconds, 0 … " + maps::quoteJson(nlohmann::json(kMaxPlanHover_s));
+  if (!p.j.is_number()) p.fail(what);
+  const double s = p.number();
+  if (!(s >= 0.0 && s <= kMaxPlanHover_s)) p.fail(what);
+  return s;
+}
+
+/// \brief Whether the plan has fences to read as zones: a `geoFence` with polygons or circles
+/// (or one that is not as expected: the zone loader then names what is wrong).
+bool hasGeofence(const nlohmann::json& doc) {
+  if (!doc.is_object()) return false;
+  const auto fence = doc.find("geoFence");
+  if (fence == doc.end()) return false;
+  if (!fence->is_object()) return true;
+  for (const char* key : {"polygons", "circles"}) {
+    const auto list = fence->find(key);
+    if (list != fence->end() && !(list->is_array() && list->empty())) return true;
+  }
+  return false;
+}
+
 /// \brief The walk through a plan's items: the route so far and what it has seen.
 struct PlanWalk {
   QgcPlanRoute route;
@@ -140,6 +215,9 @@ struct PlanWalk {
   bool returned = false;  ///< a RETURN_TO_LAUNCH was seen: the mission ends there
   std::optional<double> common_height_m;
   bool heights_agree = true;
+  std::optional<double> speed_mps;  ///< the last DO_CHANGE_SPEED's, for the legs after it
+  std::string speed_field;
+  double pending_hover_s = 0.0;  ///< NAV_DELAY before the route has a point: the start's hover
 };
 
 /// \brief The `mission` object of a QGroundControl plan document.
@@ -167,9 +245,33 @@ MissionPoint needHome(const PlanWalk& w, const JsonNode& item, const char* why) 
                          std::string("[lat, lon, alt] in degrees and metres (") + why + " at " + item.path + ")");
 }
 
-/// \brief Appends a point unless it is where the route already is.
-void addPoint(PlanWalk& w, const MissionPoint& p) {
-  if (w.route.points.empty() || !samePlace(w.route.points.back(), p)) w.route.points.push_back(p);
+/// \brief Appends a point at `height`, reached at the walk's current speed, unless it is where
+/// (and as high as) the route already is.
+void addPoint(PlanWalk& w, const MissionPoint& p, const std::optional<PointHeight>& height) {
+  if (!w.route.points.empty() && samePlace(w.route.points.back(), p) && sameHeight(w.route.flights.back().height, height)) {
+    return;
+  }
+  PointFlight f;
+  f.height = height;
+  f.speed_mps = w.speed_mps;
+  f.speed_field = w.speed_field;
+  if (w.route.points.empty()) std::swap(f.hover_s, w.pending_hover_s);
+  w.route.points.push_back(p);
+  w.route.flights.push_back(std::move(f));
+}
+
+/// \brief The height of the route's last point (a land or return item keeps it).
+std::optional<PointHeight> lastHeight(const PlanWalk& w) {
+  return w.route.flights.empty() ? std::nullopt : w.route.flights.back().height;
+}
+
+/// \brief The vehicle stays where it is for `hover_s` (before the first point: at the start).
+void addHover(PlanWalk& w, double hover_s) {
+  if (w.route.flights.empty()) {
+    w.pending_hover_s += hover_s;
+  } else {
+    w.route.flights.back().hover_s += hover_s;
+  }
 }
 
 /// \brief The MAVLink command of a SimpleItem that makes the route; none for a payload command
@@ -193,37 +295,90 @@ std::optional<int> routeCommand(const JsonNode& item) {
   if (std::find(std::begin(kPayloadCommands), std::end(kPayloadCommands), command) != std::end(kPayloadCommands)) {
     return std::nullopt;
   }
-  if (command != kNavWaypoint && command != kNavTakeoff && command != kNavLand && command != kNavReturnToLaunch) {
-    command_node.fail("16 NAV_WAYPOINT, 22 NAV_TAKEOFF, 21 NAV_LAND or 20 RETURN_TO_LAUNCH (or a camera, gimbal, "
-                      "ROI, servo or relay command, which is skipped); other commands change the route or its "
-                      "timing and are not supported");
+  const std::string supported =
+      "16 NAV_WAYPOINT, 19 NAV_LOITER_TIME, 22 NAV_TAKEOFF, 21 NAV_LAND, 20 RETURN_TO_LAUNCH, 93 NAV_DELAY or "
+      "178 DO_CHANGE_SPEED (or a camera, gimbal, ROI, servo or relay command, which is skipped)";
+  for (const RefusedCommand& r : kRefusedCommands) {
+    if (r.command == command) command_node.fail(supported + "; " + r.name + " is not supported: " + r.why);
+  }
+  if (command != kNavWaypoint && command != kNavTakeoff && command != kNavLand && command != kNavReturnToLaunch &&
+      command != kNavLoiterTime && command != kNavDelay && command != kDoChangeSpeed) {
+    command_node.fail(supported + "; other commands change the route or its timing and are not supported");
   }
   return command;
 }
 
 void addReturnToLaunch(PlanWalk& w, const JsonNode& item) {
   if (!w.start) w.start = needHome(w, item, "RETURN_TO_LAUNCH flies to it");
-  if (w.route.points.empty()) addPoint(w, *w.start);
-  addPoint(w, needHome(w, item, "RETURN_TO_LAUNCH flies to it"));
+  if (w.route.points.empty()) addPoint(w, *w.start, std::nullopt);
+  addPoint(w, needHome(w, item, "RETURN_TO_LAUNCH flies to it"), lastHeight(w));
   w.returned = true;
 }
 
 void addTakeoff(PlanWalk& w, const JsonNode& item, const JsonNode& params) {
   if (w.start) item.fail("a NAV_TAKEOFF before every other positional item");
-  (void)altitudeReference(item.at("frame"));
+  const QgcAltitudeReference reference = altitudeReference(item.at("frame"));
   const auto p = optionalPosition(params);
   w.start = p ? *p : needHome(w, item, "the start when NAV_TAKEOFF gives no position");
-  addPoint(w, *w.start);
+  addPoint(w, *w.start, itemHeight(params, reference));
 }
 
-/// \brief A NAV_WAYPOINT: its place, and its height towards the route's common height.
+/// \brief Without a takeoff item the route starts at the planned home (at cruise AGL).
+void requireStart(PlanWalk& w, const JsonNode& item) {
+  if (w.start) return;
+  w.start = needHome(w, item, "the start when no NAV_TAKEOFF gives a position");
+  addPoint(w, *w.start, std::nullopt);
+}
+
+/// \brief A DO_CHANGE_SPEED: params[1] (m/s, -1 = no change) for the legs after it; params[0]
+/// airspeed (0) or ground speed (1), both taken as ground speed.
+void changeSpeed(PlanWalk& w, const JsonNode& params) {
+  const JsonNode type = params.item(0), speed = params.item(1);
+  if (!type.j.is_number() || (type.number() != 0.0 && type.number() != 1.0)) {
+    type.fail("a speed type 0 (airspeed) or 1 (ground speed); climb and descent speed changes (2, 3) are not "
+              "supported");
+  }
+  const std::string what = "a speed in m/s, > 0 and ≤ " + maps::quoteJson(nlohmann::json(kMaxPlanSpeed_mps)) +
+                           " (or -1: no change)";
+  if (!speed.j.is_number()) speed.fail(what);
+  const double v = speed.number();
+  if (v == -1.0) return;
+  if (!(v > 0.0 && v <= kMaxPlanSpeed_mps)) speed.fail(what);
+  w.speed_mps = v;
+  w.speed_field = speed.path;
+}
+
+/// \brief A NAV_DELAY: params[0] seconds of hover where the vehicle is. The time-of-day form
+/// (params[0] = -1, then hour, minute, second) depends on the departure: refused.
+void addDelay(PlanWalk& w, const JsonNode& params) {
+  const JsonNode delay = params.item(0);
+  if (delay.j.is_number() && delay.j.get<double>() == -1.0) {
+    delay.fail("a delay in seconds (the time-of-day form, params[0] = -1 with hour, minute and second, is not "
+               "supported: give the wait in seconds)");
+  }
+  addHover(w, hoverSeconds(params, 0, false));
+}
+
+/// \brief A NAV_LOITER_TIME: a point at its place and height (none: where the vehicle is) and a
+/// hover of params[0] seconds there.
+void addLoiterTime(PlanWalk& w, const JsonNode& params, QgcAltitudeReference reference) {
+  const double hover_s = hoverSeconds(params, 0, false);
+  if (const auto p = optionalPosition(params)) addPoint(w, *p, itemHeight(params, reference));
+  addHover(w, hover_s);
+}
+
+/// \brief A NAV_WAYPOINT: its place at its height, its hold time (params[0]) as a hover, and its
+/// height towards the route's common height.
 void addWaypoint(PlanWalk& w, const JsonNode& params, QgcAltitudeReference reference) {
   const JsonNode lat = params.item(4), lon = params.item(5);
   if (lat.j.is_number() && lon.j.is_number() && lat.j.get<double>() == 0.0 && lon.j.get<double>() == 0.0) {
     lat.fail("a waypoint position (0, 0 means \"here\" to some autopilots: give the place)");
   }
-  addPoint(w, qgcPosition(lat, lon));
-  const double height_m = param(params, 6, "an altitude in metres");
+  const MissionPoint place = qgcPosition(lat, lon);
+  const PointHeight height = itemHeight(params, reference);
+  addPoint(w, place, height);
+  addHover(w, hoverSeconds(params, 0, true));
+  const double height_m = height.value_m;
   if (reference == QgcAltitudeReference::kAmsl) {
     w.heights_agree = false;
   } else if (!w.common_height_m) {
@@ -234,7 +389,20 @@ void addWaypoint(PlanWalk& w, const JsonNode& params, QgcAltitudeReference refer
   }
 }
 
-/// \brief One route item (a supported command) added to the walk.
+/// \brief A waypoint, a timed loiter or a land item, after the start.
+void addPositionalItem(PlanWalk& w, const JsonNode& item, const JsonNode& params, int command) {
+  requireStart(w, item);
+  const QgcAltitudeReference reference = altitudeReference(item.at("frame"));
+  if (command == kNavLand) {
+    if (const auto p = optionalPosition(params)) addPoint(w, *p, lastHeight(w));
+  } else if (command == kNavLoiterTime) {
+    addLoiterTime(w, params, reference);
+  } else {
+    addWaypoint(w, params, reference);
+  }
+}
+
+/// \brief One route or timing item (a supported command) added to the walk.
 void addRouteItem(PlanWalk& w, const JsonNode& item, int command) {
   if (w.returned) {
     item.fail(std::string("no ") + commandName(command) + " after RETURN_TO_LAUNCH (the vehicle has gone home)");
@@ -249,18 +417,13 @@ void addRouteItem(PlanWalk& w, const JsonNode& item, int command) {
   }
   if (command == kNavTakeoff) {
     addTakeoff(w, item, params);
-    return;
+  } else if (command == kDoChangeSpeed) {
+    changeSpeed(w, params);
+  } else if (command == kNavDelay) {
+    addDelay(w, params);
+  } else {
+    addPositionalItem(w, item, params, command);
   }
-  if (!w.start) {
-    w.start = needHome(w, item, "the start when no NAV_TAKEOFF gives a position");
-    addPoint(w, *w.start);
-  }
-  const QgcAltitudeReference reference = altitudeReference(item.at("frame"));
-  if (command == kNavLand) {
-    if (const auto p = optionalPosition(params)) addPoint(w, *p);
-    return;
-  }
-  addWaypoint(w, params, reference);
 }
 
 /// \brief The mission's top-level fields, checked against the known ones.
@@ -311,6 +474,8 @@ QgcPlanRoute readQgcPlan(const JsonNode& q, const std::string& base_dir, const J
   }
   QgcPlanRoute plan_route = parseQgcPlanRoute(plan, m.qgc_plan_file);
   m.points = plan_route.points;
+  m.point_flights = plan_route.flights;
+  m.qgc_home = plan_route.home;
   return plan_route;
 }
 
@@ -328,6 +493,16 @@ std::optional<QgcPlanRoute> readRoute(const JsonNode& root, const std::string& b
   return std::nullopt;
 }
 
+/// \brief The .plan joins the zone files when its geoFence has fences, unless `zones` names it.
+void addPlanFence(const std::optional<QgcPlanRoute>& plan_route, Mission& m) {
+  if (!plan_route || !plan_route->has_geofence) return;
+  for (const std::string& f : m.zone_files) {
+    std::error_code ec;
+    if (f == m.qgc_plan_file || std::filesystem::equivalent(f, m.qgc_plan_file, ec)) return;
+  }
+  m.zone_files.push_back(m.qgc_plan_file);
+}
+
 /// \brief The altitude block; a .plan's common waypoint height is the cruise height unless the
 /// mission gives one.
 void readAltitudes(const JsonNode& root, const std::optional<QgcPlanRoute>& plan_route, Mission& m) {
@@ -341,16 +516,11 @@ void readAltitudes(const JsonNode& root, const std::optional<QgcPlanRoute>& plan
     if (a.has("max_agl_m")) m.max_agl_m = positive(a.at("max_agl_m"));
     if (a.has("max_amsl_m")) m.max_amsl_m = a.at("max_amsl_m").number();
   }
+  // The plan's common height is the cruise height when it lies within the limits; each point's
+  // own height is checked against them by the approval (which knows the ground).
   if (plan_route && plan_route->cruise_agl_m && !cruise_given) {
     const double h = *plan_route->cruise_agl_m;
-    if (!(h > 0.0 && m.min_agl_m <= h && h <= m.max_agl_m)) {
-      throw maps::ParseError(m.qgc_plan_file, 0, plan_route->cruise_agl_field, maps::quoteJson(nlohmann::json(h)),
-                             "a waypoint height above ground > 0 and within the mission's min_agl_m … max_agl_m (" +
-                                 maps::quoteJson(nlohmann::json(m.min_agl_m)) + " … " +
-                                 maps::quoteJson(nlohmann::json(m.max_agl_m)) +
-                                 " m), or altitude.cruise_agl_m in the mission file");
-    }
-    m.cruise_agl_m = h;
+    if (h > 0.0 && m.min_agl_m <= h && h <= m.max_agl_m) m.cruise_agl_m = h;
   }
   if (root.has("altitude") && !(m.min_agl_m <= m.cruise_agl_m && m.cruise_agl_m <= m.max_agl_m)) {
     root.at("altitude").fail("min_agl_m ≤ cruise_agl_m ≤ max_agl_m");
@@ -458,6 +628,8 @@ QgcPlanRoute parseQgcPlanRoute(const nlohmann::json& doc, const std::string& sou
   } else {
     w.route.cruise_agl_field.clear();
   }
+  w.route.home = w.home ? *w.home : w.route.points.front();
+  w.route.has_geofence = hasGeofence(doc);
   return w.route;
 }
 
@@ -475,6 +647,7 @@ Mission parseMission(const nlohmann::json& doc, const std::string& source, const
   readAltitudes(root, plan_route, m);
   readDeparture(root, m);
   readDataFiles(root, base_dir, m);
+  addPlanFence(plan_route, m);
   if (root.has("integrity")) readIntegrity(root.at("integrity"), m);
   if (root.has("planner")) readPlannerSettings(root.at("planner"), m);
   return m;

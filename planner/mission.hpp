@@ -29,6 +29,30 @@ struct MissionPoint {
   double lon_rad = 0.0;
 };
 
+/// \brief What a route point's height is measured from (a QGroundControl item's MAV_FRAME).
+enum class HeightReference {
+  kAboveGround,  ///< frame 10 (11): above the terrain under the point
+  kAboveHome,    ///< frame 3 (6): above the ground at the home (Mission::qgc_home)
+  kAmsl,         ///< frame 0 (5): above mean sea level (EGM96)
+};
+
+/// \brief A route point's own height, as a plan item writes it.
+struct PointHeight {
+  HeightReference reference = HeightReference::kAboveGround;
+  double value_m = 0.0;
+  std::string field;  ///< where it is written, e.g. "$.mission.items[3].params[6]"
+};
+
+/// \brief How the vehicle reaches a route point and what it does there (a QGroundControl plan's
+/// items; a mission-file route has none: cruise AGL, cruise speed, no hover).
+struct PointFlight {
+  std::optional<PointHeight> height;  ///< none: the mission's cruise AGL
+  /// Ground speed of the leg arriving at the point; none: the vehicle's cruise speed.
+  std::optional<double> speed_mps;
+  std::string speed_field;  ///< where that speed was set (a DO_CHANGE_SPEED's params[1])
+  double hover_s = 0.0;     ///< time the vehicle stays at the point after arriving
+};
+
 /// \brief Everything a mission file says (paths resolved against the file's folder).
 struct Mission {
   std::string source;
@@ -40,6 +64,12 @@ struct Mission {
   /// \brief Start, the waypoints to visit in order, and the goal.
   std::vector<MissionPoint> points;
   std::string qgc_plan_file;  ///< the QGroundControl .plan the points came from; empty: the mission file
+  /// \brief Per point of `points`: its height, the speed of the leg to it and its hover (from the
+  /// .plan); empty for a mission-file route (every point at cruise AGL and speed, no hover).
+  std::vector<PointFlight> point_flights;
+  /// \brief The place the plan's heights relative to home are measured from (its planned home,
+  /// else the start); none for a mission-file route.
+  std::optional<MissionPoint> qgc_home;
   double cruise_agl_m = 60.0;
   double min_agl_m = 30.0;
   double max_agl_m = 120.0;
@@ -47,8 +77,10 @@ struct Mission {
   maps::GpsTime departure_earliest;
   maps::GpsTime departure_latest;  ///< = earliest for a fixed departure
   double departure_step_s = 600.0;
+  /// \brief The `zones` files, then the .plan when its geoFence has fences and `zones` does not
+  /// already name it (its fences are zones: exclusions prohibited, inclusions keep-in).
   std::vector<std::string> zone_files;
-  std::string zone_format = "auto";
+  std::string zone_format = "auto";  ///< of the `zones` files; the .plan is always read as one
   std::string terrain_file;  ///< empty: flat ground at ground_amsl_m
   double ground_amsl_m = 0.0;
   std::string buildings_file;
@@ -70,26 +102,52 @@ struct Mission {
   int max_replans = 2;         ///< per departure, after a violation
 };
 
+/// \brief The fastest ground speed a plan's DO_CHANGE_SPEED may set [m/s] (144 km/h: beyond the
+/// small drones this planner is for; a larger value is taken for a typing error).
+constexpr double kMaxPlanSpeed_mps = 40.0;
+/// \brief The longest hover one plan item may ask for [s]: one hour, beyond any multirotor's
+/// endurance.
+constexpr double kMaxPlanHover_s = 3600.0;
+
 /// \brief The route of a QGroundControl `.plan` mission.
 struct QgcPlanRoute {
   /// \brief Start (the takeoff item's position, else the planned home), every later
   /// positional item in order (home for RETURN_TO_LAUNCH); the last one is the goal. Consecutive
-  /// items at the same place count once.
+  /// items at the same place and height count once.
   std::vector<MissionPoint> points;
+  std::vector<PointFlight> flights;  ///< per point: height, speed of the leg to it, hover there
+  MissionPoint home;                 ///< the planned home, else the start: frame-3 heights' reference
+  bool has_geofence = false;         ///< `geoFence` holds polygons or circles (read as zones)
   /// \brief The NAV_WAYPOINT items' common height when every one is relative to home (frame 3)
-  /// or to the terrain (frame 10) and they agree; taken as height above ground.
+  /// or to the terrain (frame 10) and they agree; taken as height above ground (the mission's
+  /// cruise height when within its limits).
   std::optional<double> cruise_agl_m;
   std::string cruise_agl_field;  ///< where that height is written (first waypoint's params[6])
 };
 
-/// \brief The route of a QGroundControl `.plan` document (`mission.items`, SimpleItems with
-/// command 16 NAV_WAYPOINT, 22 NAV_TAKEOFF, 21 NAV_LAND or 20 RETURN_TO_LAUNCH;
-/// params[4], params[5] = latitude, longitude in degrees, params[6] = altitude in the item's
-/// `frame`: 0 AMSL, 3 relative to home, 10 above terrain; the 5, 6, 11 integer variants too).
-/// A takeoff or land item without a position (null, or 0, 0) means "here". Camera, gimbal,
-/// region-of-interest, servo and relay commands are skipped; every other command, and
-/// ComplexItems (surveys, corridor and structure scans), is refused naming the item.
-/// Per-waypoint altitudes are not followed: the planner flies at the mission's cruise AGL.
+/// \brief The route of a QGroundControl `.plan` document: `mission.items` in order.
+///
+/// Positional SimpleItems (params[4], params[5] = latitude, longitude in degrees, params[6] =
+/// altitude in the item's `frame`: 0 AMSL, 3 relative to home, 10 above terrain; the 5, 6, 11
+/// integer variants too) make the route's points, each at its own height:
+/// - 22 NAV_TAKEOFF: the start, at its altitude (without a position, null or 0, 0: the planned
+///   home). Without a takeoff item the start is the planned home at the mission's cruise AGL.
+/// - 16 NAV_WAYPOINT: a point at its altitude; params[0] (hold time, s) > 0 hovers there.
+/// - 19 NAV_LOITER_TIME: a point at its altitude (none: where the vehicle is) and a hover of
+///   params[0] seconds there.
+/// - 21 NAV_LAND (position optional) and 20 RETURN_TO_LAUNCH (to the planned home): the goal, at
+///   the height of the point before (the descent to the ground is not planned, as the climb from
+///   it is not).
+/// Timing items: 178 DO_CHANGE_SPEED (params[1] m/s, -1 = no change; params[0] 0 airspeed or
+/// 1 ground speed, both taken as the ground speed of the legs after it; 0 < speed ≤
+/// kMaxPlanSpeed_mps) and 93 NAV_DELAY (params[0] seconds, a hover where the vehicle is; the
+/// time-of-day form, params[0] = -1, is refused). Hovers are 0 … kMaxPlanHover_s seconds.
+/// Camera, gimbal, region-of-interest, servo and relay commands are skipped; every other command
+/// (DO_JUMP, unlimited or turn loiters, VTOL items, conditions …) and ComplexItems (surveys,
+/// corridor and structure scans) are refused naming the item. The heights are checked against
+/// the mission's limits by the approval (it knows the terrain). `cruise_agl_m` is the
+/// waypoints' common height when they agree (then the mission's cruise height, for the integrity
+/// cost field and a start without takeoff item).
 /// \throws maps::ParseError naming `source`, the JSON path (e.g. "$.mission.items[3].params[4]"),
 /// the value and what was expected.
 [[nodiscard]] QgcPlanRoute parseQgcPlanRoute(const nlohmann::json& doc, const std::string& source);

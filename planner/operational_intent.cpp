@@ -96,7 +96,7 @@ std::vector<Volume4D> routeVolumes(const ApprovalReport& report, const maps::Pla
     v.altitude_lower_m = std::min(a.h_ell_m, b.h_ell_m) - lim.val_m;
     v.altitude_upper_m = std::max(a.h_ell_m, b.h_ell_m) + lim.val_m;
     v.time_start = report.departure.plus(a.eta_s - time_buffer_s);
-    v.time_end = report.departure.plus(b.eta_s + time_buffer_s);
+    v.time_end = report.departure.plus(b.eta_s + b.hover_s + time_buffer_s);  // a hover at b is in this volume
     out.push_back(std::move(v));
   }
   return out;

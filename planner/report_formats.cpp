@@ -45,6 +45,7 @@ json routeJson(const ApprovalReport& r) {
                      {"alt_amsl_m", roundToMm(p.alt_amsl_m)},
                      {"eta", maps::formatRfc3339(r.departure.plus(p.eta_s), 1)},
                      {"eta_s", roundToMm(p.eta_s)}});
+    if (p.hover_s > 0.0) route.back()["hover_s"] = roundToMm(p.hover_s);  // written only where it hovers
   }
   return route;
 }
@@ -223,7 +224,11 @@ ApprovedFlight parseApprovalReport(const nlohmann::json& doc, const std::string&
     rp.h_ell_m = p.at("h_ell_m").number();
     rp.alt_amsl_m = p.has("alt_amsl_m") ? p.at("alt_amsl_m").number() : rp.h_ell_m;
     rp.eta_s = p.at("eta_s").number();
-    if (!f.route.empty() && rp.eta_s < f.route.back().eta_s) p.at("eta_s").fail("an ETA not before the previous point's");
+    if (!f.route.empty() && rp.eta_s < f.route.back().eta_s + f.route.back().hover_s) {
+      p.at("eta_s").fail("an ETA not before the previous point's departure (its ETA plus its hover)");
+    }
+    rp.hover_s = p.has("hover_s") ? p.at("hover_s").number() : 0.0;
+    if (!(rp.hover_s >= 0.0)) p.at("hover_s").fail("a hover time ≥ 0 s");
     f.route.push_back(rp);
   }
   const auto limits = [](const maps::JsonNode& n) {

@@ -88,7 +88,8 @@ std::optional<double> timeJump(const TrackerOptions& o, const TrackedFlight& f, 
     return std::nullopt;
   }
   const double from_departure = fix.time - f.plan.departure;
-  if (from_departure < -o.max_time_jump_s || from_departure > f.plan.route.back().eta_s + o.max_time_jump_s) {
+  const double flight_s = f.plan.route.back().eta_s + f.plan.route.back().hover_s;
+  if (from_departure < -o.max_time_jump_s || from_departure > flight_s + o.max_time_jump_s) {
     from = "the approved departure " + maps::formatRfc3339(f.plan.departure);
     return from_departure;
   }

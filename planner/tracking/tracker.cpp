@@ -124,6 +124,7 @@ json Tracker::routeJson(const std::string& id) const {
   for (const RoutePoint& p : f.plan.route) {
     route.push_back({{"lat", roundToDeg8(p.lat_rad)}, {"lon", roundToDeg8(p.lon_rad)}, {"h_ell_m", roundToMm(p.h_ell_m)},
                      {"alt_amsl_m", roundToMm(p.alt_amsl_m)}, {"eta_s", roundToMm(p.eta_s)}});
+    if (p.hover_s > 0.0) route.back()["hover_s"] = roundToMm(p.hover_s);
   }
   return {{"departure", maps::formatRfc3339(f.plan.departure, 3)}, {"route", route}};
 }
@@ -146,6 +147,7 @@ void Tracker::restore(const std::string& id, const FlightState& state, const jso
       rp.h_ell_m = p.at("h_ell_m").number();
       rp.alt_amsl_m = p.at("alt_amsl_m").number();
       rp.eta_s = p.at("eta_s").number();
+      if (p.has("hover_s")) rp.hover_s = p.at("hover_s").number();  // absent in databases written before hovers
       pts.push_back(rp);
     }
     if (pts.size() < 2) list.fail("a route of at least 2 points");

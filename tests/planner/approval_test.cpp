@@ -2,6 +2,7 @@
 // space and time, rejections with reasons, reproducibility, and corridors that never meet an
 // active prohibited zone (checked independently of the geofence).
 #include "planner/approval.hpp"
+#include "planner/operational_intent.hpp"
 #include "planner/report_formats.hpp"
 #include "planner/route_planner.hpp"
 
@@ -16,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -365,6 +367,155 @@ TEST(Approval, AnAlmanacTenDaysFromTheDepartureIsAWarningOfTheReport) {
   EXPECT_EQ(j.at("warnings"), json(r.warnings));
   // AND a report without warnings has no "warnings" member (older reports stay as they were)
   EXPECT_FALSE(json(Approver(missionWith({}, "current_almanac")).approve()).contains("warnings"));
+}
+
+// --- a QGroundControl plan: speeds, hovers, heights and its geofence -----------------------------
+
+/// A SimpleItem of a .plan: command, frame, the seven parameters.
+json planItem(int command, int frame, const json& params) {
+  return {{"type", "SimpleItem"}, {"command", command}, {"frame", frame}, {"autoContinue", true}, {"params", params}};
+}
+json planWaypoint(int command, int frame, double hover_s, double lat, double lon, double alt) {
+  return planItem(command, frame, {hover_s, 0, 0, nullptr, lat, lon, alt});
+}
+
+/// A plan east of (kLat0, kLon0) with these items and fence, and a mission naming it (ground at
+/// 408 m AMSL, cruise 12 m/s).
+Mission missionWithPlan(const std::string& name, const std::vector<json>& items, const json& fence,
+                        const json& altitude = json::object(), double sample_s = 1.0) {
+  const json plan_doc{{"fileType", "Plan"},
+                      {"geoFence", fence},
+                      {"mission", {{"items", items}, {"plannedHomePosition", {kLat0, kLon0, 408}}}}};
+  const std::string plan_file = test::scratchPath(name + ".plan");
+  std::ofstream(plan_file) << plan_doc.dump();
+  json m{{"name", name},
+         {"vehicle", {{"lateral_m", 1.2}, {"longitudinal_m", 1.0}, {"cruise_speed_mps", 12}}},
+         {"k1", 1.2},
+         {"k2", 150},
+         {"qgc_plan", plan_file},
+         {"departure", "2020-01-01T14:00:00Z"},
+         {"ground_amsl_m", 408},
+         {"orbits", {test::dataPath("gnss/alm01jan2020.txt")}},
+         {"integrity", {{"cost_weight", 0.0}, {"sample_s", sample_s}}},
+         {"planner", {{"time_limit_s", 10.0}, {"iterations", 600}, {"seed", 3}}}};
+  if (!altitude.empty()) m["altitude"] = altitude;
+  return parseMission(m, name + ".json", ".");
+}
+
+json emptyFence() { return {{"circles", json::array()}, {"polygons", json::array()}, {"version", 2}}; }
+
+/// The index of the route point at `p` (map frame); the route's size when none is.
+std::size_t routeIndexAt(const ApprovalReport& r, const Eigen::Vector3d& p) {
+  for (std::size_t i = 0; i < r.route.size(); ++i) {
+    if ((r.route[i].xyz - p).norm() < 1e-6) return i;
+  }
+  return r.route.size();
+}
+
+TEST(Approval, QgcPlanSpeedChangeHoverHeightsAndGeofenceAreFollowed) {
+  // GIVEN a plan: takeoff at home to 40 m (relative), a waypoint at 60 m (relative), a speed
+  // change to 6 m/s, a 30 s timed loiter at 80 m above terrain, a waypoint at 458 m AMSL (50 m
+  // above the 408 m ground), a land there; its fence: an exclusion circle 200 m north of the
+  // first waypoint and an inclusion polygon round the route
+  const double lon1 = kLon0 + 0.004, lon2 = kLon0 + 0.008, lon3 = kLon0 + 0.012;
+  const std::vector<json> items{
+      planWaypoint(22, 3, 0, kLat0, kLon0, 40),   planWaypoint(16, 3, 0, kLat0, lon1, 60),
+      planItem(178, 2, {1, 6, -1, 0, 0, 0, 0}),   planWaypoint(19, 10, 30, kLat0, lon2, 80),
+      planWaypoint(16, 0, 0, kLat0, lon3, 458),   planWaypoint(21, 3, 0, kLat0, lon3, 0)};
+  json fence = emptyFence();
+  fence["circles"] = {{{"inclusion", false}, {"circle", {{"center", {kLat0 + 0.0018, lon1}}, {"radius", 60}}}, {"version", 1}}};
+  fence["polygons"] = {{{"inclusion", true},
+                        {"polygon", {{kLat0 + 0.003, kLon0 - 0.002}, {kLat0 + 0.003, lon3 + 0.002},
+                                     {kLat0 - 0.003, lon3 + 0.002}, {kLat0 - 0.003, kLon0 - 0.002}}},
+                        {"version", 1}}};
+  // (Samples every 10 s: a sample at a joint where the height's slope changes costs the level-1
+  // corridor's branch and bound most; a hover at one repeats it.)
+  const Mission mission = missionWithPlan("qgc_follow", items, fence, json::object(), 10.0);
+  // WHEN it is approved
+  Approver a(mission);
+  const ApprovalReport r = a.approve();
+  ASSERT_TRUE(r.approved) << (r.reasons.empty() ? "" : r.reasons.front().message);
+  // THEN the route passes through every stop, each at its own height above the 408 m ground
+  const std::vector<Eigen::Vector3d> stops = a.missionStops();
+  ASSERT_EQ(stops.size(), 4u);  // the land item is on the last waypoint
+  // (relative to home: above the ground at home; above terrain: the ground below; AMSL as written)
+  const double home_ground_m = *a.groundHeight(stops[0].head<2>());
+  const std::vector<double> h_ell_m{home_ground_m + 40, home_ground_m + 60, *a.groundHeight(stops[2].head<2>()) + 80};
+  for (std::size_t s = 0; s < stops.size(); ++s) {
+    const std::size_t k = routeIndexAt(r, stops[s]);
+    ASSERT_LT(k, r.route.size()) << "stop " << s;
+    if (s < h_ell_m.size()) {
+      EXPECT_NEAR(r.route[k].h_ell_m, h_ell_m[s], 1e-9) << "stop " << s;
+    }
+  }
+  EXPECT_NEAR(r.route[routeIndexAt(r, stops[3])].alt_amsl_m, 458.0, 1e-3);
+  EXPECT_NEAR(r.route[routeIndexAt(r, stops[2])].alt_amsl_m, 408.0 + 80.0, 1e-3);  // flat ground at 408 m AMSL
+  // AND the ETAs: the first leg at the 12 m/s cruise, the later ones at 6 m/s, the 30 s loiter
+  // delaying the last; climbs at 3 m/s where they take longer
+  ASSERT_EQ(r.route.size(), 4u);  // nothing in the way: straight legs
+  const auto leg_s = [&](std::size_t i, double speed_mps) {
+    const Eigen::Vector3d d = r.route[i].xyz - r.route[i - 1].xyz;
+    return std::max(d.head<2>().norm() / speed_mps, std::abs(d.z()) / 3.0);
+  };
+  EXPECT_NEAR(r.route[1].eta_s, leg_s(1, 12.0), 1e-9);
+  EXPECT_NEAR(r.route[2].eta_s - r.route[1].eta_s, leg_s(2, 6.0), 1e-9);
+  EXPECT_NEAR(r.route[2].hover_s, 30.0, 1e-12);
+  EXPECT_NEAR(r.route[3].eta_s - r.route[2].eta_s, 30.0 + leg_s(3, 6.0), 1e-9);
+  EXPECT_GT(leg_s(2, 6.0), 2.0 * leg_s(1, 12.0) - 1.0);  // the legs are alike: 6 m/s takes twice as long
+  // AND the samples hold the vehicle at the loiter point through the hover, from its start to
+  // its end (both sampled, whatever the sample step)
+  std::vector<double> hovering_t_s;
+  for (const PredictedSample& s : r.predicted) {
+    if (s.t_s < r.route[2].eta_s || s.t_s > r.route[2].eta_s + 30.0) continue;
+    hovering_t_s.push_back(s.t_s);
+    EXPECT_LT((s.xyz - r.route[2].xyz).norm(), 1e-9) << "t " << s.t_s;
+    EXPECT_TRUE(s.pl_available) << "t " << s.t_s;
+  }
+  ASSERT_GE(hovering_t_s.size(), 4u);  // 30 s at a 10 s step, and its ends
+  EXPECT_DOUBLE_EQ(hovering_t_s.front(), r.route[2].eta_s);
+  EXPECT_DOUBLE_EQ(hovering_t_s.back(), r.route[2].eta_s + 30.0);
+  EXPECT_NEAR(r.predicted.back().t_s, r.route[3].eta_s, 1e-9);
+  // AND the plan's fences are zones of the approval, named by the plan, the exclusion reported
+  // with its clearance
+  int from_plan = 0;
+  for (const airspace::Zone& z : a.obstructions().zones()) from_plan += z.source == mission.qgc_plan_file;
+  EXPECT_EQ(from_plan, 2);
+  const auto circle = std::find_if(r.zones.begin(), r.zones.end(), [](const ZoneApproach& z) { return z.identifier == "circle-1"; });
+  ASSERT_NE(circle, r.zones.end());
+  EXPECT_TRUE(circle->counted);
+  EXPECT_GT(circle->min_clearance_m, 50.0);
+  // AND the report's JSON form carries the hover for tracking, and the operational intent's
+  // volume of the leg into the loiter point lasts through the hover
+  const ApprovedFlight back = parseApprovalReport(json(r), "report.json");
+  ASSERT_EQ(back.route.size(), r.route.size());
+  EXPECT_NEAR(back.route[2].hover_s, 30.0, 1e-3);
+  EXPECT_NEAR(back.route[3].eta_s, r.route[3].eta_s, 1e-3);
+  const OperationalIntent intent = operationalIntent(r, a.frame());
+  ASSERT_EQ(intent.volumes.size(), 3u);
+  EXPECT_NEAR(intent.volumes[1].time_end - r.departure, r.route[2].eta_s + 30.0 + kIntentTimeBuffer_s, 1e-6);
+}
+
+TEST(Approval, QgcPlanHeightOutsideTheLimitsIsRefusedNamingTheItemAndTheLimit) {
+  struct Case {
+    std::string name;
+    json item;  ///< the plan's second item, after a takeoff to 40 m
+    json altitude;
+    std::vector<std::string> expected;
+  };
+  const std::vector<Case> cases{
+      {"above max_agl", planWaypoint(16, 3, 0, kLat0, kLon0 + 0.004, 150), json::object(),
+       {"'$.mission.items[1].params[6]'", "got '150'", "150.0 m above the ground", "above altitude.max_agl_m 120"}},
+      {"below min_agl", planWaypoint(16, 10, 0, kLat0, kLon0 + 0.004, 12), json::object(),
+       {"'$.mission.items[1].params[6]'", "got '12'", "below altitude.min_agl_m 30"}},
+      {"above max_amsl", planWaypoint(16, 0, 0, kLat0, kLon0 + 0.004, 500), {{"max_amsl_m", 480}},
+       {"'$.mission.items[1].params[6]'", "500.0 m above mean sea level", "above altitude.max_amsl_m 480"}},
+  };
+  for (const Case& c : cases) {
+    const Mission m = missionWithPlan("qgc_limit", {planWaypoint(22, 3, 0, kLat0, kLon0, 40), c.item}, emptyFence(), c.altitude);
+    const std::string msg = test::messageOf<maps::ParseError>([&] { Approver a(m); });
+    EXPECT_EQ(msg.rfind(m.qgc_plan_file + ": ", 0), 0u) << c.name << ": " << msg;
+    for (const std::string& piece : c.expected) EXPECT_NE(msg.find(piece), std::string::npos) << c.name << ": " << msg;
+  }
 }
 
 TEST(Mission, ErrorsNameTheField) {

@@ -45,6 +45,24 @@ json takeoff(double lat, double lon, double alt) { return simpleItem(22, 3, lat,
 json waypoint(double lat, double lon, double alt, int frame = 3) { return simpleItem(16, frame, lat, lon, alt); }
 json land(const json& lat, const json& lon) { return simpleItem(21, 3, lat, lon, 0); }
 json returnToLaunch() { return simpleItem(20, 2, 0, 0, 0); }
+/// A SimpleItem without a position (frame 2, "mission") with these seven parameters.
+json commandItem(int command, const json& params) {
+  json item = simpleItem(command, 2, 0, 0, 0);
+  item["params"] = params;
+  return item;
+}
+json changeSpeed(const json& type, const json& speed_mps) { return commandItem(178, {type, speed_mps, -1, 0, 0, 0, 0}); }
+json delay(const json& seconds) { return commandItem(93, {seconds, -1, -1, -1, 0, 0, 0}); }
+json loiterTime(double seconds, const json& lat, const json& lon, double alt, int frame = 3) {
+  json item = simpleItem(19, frame, lat, lon, alt);
+  item["params"][0] = seconds;
+  return item;
+}
+json holdAt(double lat, double lon, double alt, double hold_s) {
+  json item = waypoint(lat, lon, alt);
+  item["params"][0] = hold_s;
+  return item;
+}
 
 constexpr double kHomeLat = 47.3712, kHomeLon = 8.5320;
 
@@ -197,15 +215,129 @@ TEST(MissionQgcRoute, MissionAltitudeBlockWinsAndMixedPlanHeightsLeaveTheMission
   EXPECT_DOUBLE_EQ(loadWithPlan("qgc_mixed_block", mixed, {{"altitude", {{"cruise_agl_m", 80}}}}).cruise_agl_m, 80.0);
 }
 
-TEST(MissionQgcRoute, PlanHeightOutsideTheMissionLimitsIsRefusedNamingTheWaypoint) {
+TEST(MissionQgcRoute, PlanHeightOutsideTheMissionLimitsIsNotTheCruiseHeight) {
+  // The waypoints' own heights are checked by the approval, which knows the ground
+  // (tests/planner/approval_test.cpp, QgcPlanHeightOutsideTheLimitsIsRefusedNamingTheItemAndTheLimit).
   const json high = plan({waypoint(47.38, 8.55, 150), waypoint(47.39, 8.56, 150)});
-  const std::string msg = test::messageOf<maps::ParseError>([&] { (void)loadWithPlan("qgc_high", high); });
-  EXPECT_EQ(msg.rfind(test::scratchPath("qgc_high/route.plan"), 0), 0u) << msg;
-  EXPECT_NE(msg.find("$.mission.items[0].params[6]"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("150"), std::string::npos) << msg;
-  EXPECT_NE(msg.find("min_agl_m … max_agl_m"), std::string::npos) << msg;
-  // Setting the cruise height in the mission settles it.
-  EXPECT_NO_THROW((void)loadWithPlan("qgc_high_ok", high, {{"altitude", {{"cruise_agl_m", 100}}}}));
+  const Mission m = loadWithPlan("qgc_high", high);
+  EXPECT_DOUBLE_EQ(m.cruise_agl_m, 60.0);  // the default, not the plan's 150 m
+  ASSERT_EQ(m.point_flights.size(), 3u);
+  ASSERT_TRUE(m.point_flights[1].height.has_value());
+  EXPECT_DOUBLE_EQ(m.point_flights[1].height->value_m, 150.0);
+  EXPECT_EQ(m.point_flights[1].height->field, "$.mission.items[0].params[6]");
+}
+
+// --- speeds, hovers and heights ------------------------------------------------------------------
+
+TEST(MissionQgcRoute, SpeedChangeSetsTheSpeedOfTheLegsAfterIt) {
+  // GIVEN a speed change to 5 m/s after the first waypoint, then a "no change" (-1), then 8 m/s
+  // as airspeed (taken as ground speed)
+  const QgcPlanRoute r = parseQgcPlanRoute(
+      plan({takeoff(47.3715, 8.5325, 40), waypoint(47.375, 8.54, 60), changeSpeed(1, 5), waypoint(47.38, 8.548, 60),
+            changeSpeed(1, -1), waypoint(47.383, 8.553, 60), changeSpeed(0, 8), land(47.384, 8.556)}),
+      "route.plan");
+  ASSERT_EQ(r.flights.size(), 5u);
+  // THEN the legs before the change have none (the mission's cruise speed) and the later ones the new speed
+  EXPECT_FALSE(r.flights[0].speed_mps.has_value());
+  EXPECT_FALSE(r.flights[1].speed_mps.has_value());
+  EXPECT_EQ(r.flights[2].speed_mps, 5.0);
+  EXPECT_EQ(r.flights[2].speed_field, "$.mission.items[2].params[1]");
+  EXPECT_EQ(r.flights[3].speed_mps, 5.0);  // -1: no change
+  EXPECT_EQ(r.flights[4].speed_mps, 8.0);
+  EXPECT_EQ(r.flights[4].speed_field, "$.mission.items[6].params[1]");
+}
+
+TEST(MissionQgcRoute, BadSpeedChangesAreRefusedNamingTheParameter) {
+  struct Case {
+    std::string name;
+    json item;
+    std::vector<std::string> expected;
+  };
+  const std::vector<Case> cases{
+      {"zero", changeSpeed(1, 0), {"'$.mission.items[1].params[1]'", "got '0'", "> 0 and ≤ 40"}},
+      {"negative", changeSpeed(1, -3), {"'$.mission.items[1].params[1]'", "got '-3'", "-1: no change"}},
+      {"too fast", changeSpeed(1, 120), {"'$.mission.items[1].params[1]'", "got '120'", "≤ 40"}},
+      {"not a number", changeSpeed(1, "fast"), {"'$.mission.items[1].params[1]'", "a speed in m/s"}},
+      {"climb speed", changeSpeed(2, 2), {"'$.mission.items[1].params[0]'", "got '2'", "climb and descent"}},
+      {"time-of-day delay", delay(-1), {"'$.mission.items[1].params[0]'", "time-of-day form", "in seconds"}},
+      {"negative delay", delay(-5), {"'$.mission.items[1].params[0]'", "got '-5'", "a time in seconds"}},
+      {"endless delay", delay(1e6), {"'$.mission.items[1].params[0]'", "0 … 3600"}},
+      {"negative loiter", loiterTime(-2, 47.38, 8.55, 60), {"'$.mission.items[1].params[0]'", "a time in seconds"}},
+  };
+  for (const Case& c : cases) {
+    const std::string msg = planError(plan({waypoint(47.375, 8.54, 60), c.item, waypoint(47.38, 8.55, 60)}));
+    EXPECT_EQ(msg.rfind("route.plan: ", 0), 0u) << c.name << ": " << msg;
+    for (const std::string& piece : c.expected) EXPECT_NE(msg.find(piece), std::string::npos) << c.name << ": " << msg;
+  }
+}
+
+TEST(MissionQgcRoute, LoiterTimeDelayAndHoldTimeAreHoversAtTheirPoints) {
+  // GIVEN a delay before takeoff, a waypoint held 5 s, a delay there, a timed loiter at a new
+  // place, a timed loiter without a position (where the vehicle is), and a land
+  const QgcPlanRoute r = parseQgcPlanRoute(
+      plan({delay(12), takeoff(47.3715, 8.5325, 40), holdAt(47.375, 8.54, 60, 5), delay(20),
+            loiterTime(30, 47.38, 8.548, 70), loiterTime(10, nullptr, nullptr, 0), land(47.384, 8.556)}),
+      "route.plan");
+  ASSERT_EQ(r.points.size(), 4u);
+  // THEN each hover is on the point the vehicle is at
+  EXPECT_DOUBLE_EQ(r.flights[0].hover_s, 12.0);       // before takeoff: at the start
+  EXPECT_DOUBLE_EQ(r.flights[1].hover_s, 5.0 + 20.0);  // hold time and delay
+  EXPECT_TRUE(samePoint(r.points[2], 47.38, 8.548));
+  EXPECT_DOUBLE_EQ(r.flights[2].hover_s, 30.0 + 10.0);  // the loiter and the one in place
+  ASSERT_TRUE(r.flights[2].height.has_value());
+  EXPECT_DOUBLE_EQ(r.flights[2].height->value_m, 70.0);
+  EXPECT_DOUBLE_EQ(r.flights[3].hover_s, 0.0);
+}
+
+TEST(MissionQgcRoute, EveryPointKeepsItsOwnHeightAndReference) {
+  // GIVEN heights relative to home, above mean sea level and above terrain, a climb on the spot,
+  // and a land and a return that keep the last height
+  const QgcPlanRoute r = parseQgcPlanRoute(
+      plan({takeoff(47.3715, 8.5325, 35), waypoint(47.375, 8.54, 50), waypoint(47.375, 8.54, 90),
+            waypoint(47.38, 8.548, 470, 0), waypoint(47.383, 8.553, 45, 10), returnToLaunch()}),
+      "route.plan");
+  struct Expected {
+    HeightReference reference;
+    double value_m;
+    std::string field;
+  };
+  const std::vector<Expected> expected{
+      {HeightReference::kAboveHome, 35, "$.mission.items[0].params[6]"},
+      {HeightReference::kAboveHome, 50, "$.mission.items[1].params[6]"},
+      {HeightReference::kAboveHome, 90, "$.mission.items[2].params[6]"},  // same place, higher: its own point
+      {HeightReference::kAmsl, 470, "$.mission.items[3].params[6]"},
+      {HeightReference::kAboveGround, 45, "$.mission.items[4].params[6]"},
+      {HeightReference::kAboveGround, 45, "$.mission.items[4].params[6]"},  // RTL at the height it had
+  };
+  ASSERT_EQ(r.flights.size(), expected.size());
+  ASSERT_EQ(r.points.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    ASSERT_TRUE(r.flights[i].height.has_value()) << i;
+    EXPECT_EQ(r.flights[i].height->reference, expected[i].reference) << i;
+    EXPECT_DOUBLE_EQ(r.flights[i].height->value_m, expected[i].value_m) << i;
+    EXPECT_EQ(r.flights[i].height->field, expected[i].field) << i;
+  }
+  EXPECT_TRUE(samePoint(r.home, kHomeLat, kHomeLon));
+  EXPECT_TRUE(samePoint(r.points.back(), kHomeLat, kHomeLon));
+  // Without a takeoff item the start (the home) has no height of its own: the mission's cruise AGL.
+  const QgcPlanRoute no_takeoff = parseQgcPlanRoute(plan({waypoint(47.38, 8.55, 50)}), "route.plan");
+  EXPECT_FALSE(no_takeoff.flights.front().height.has_value());
+}
+
+TEST(MissionQgcRoute, PlanGeofenceJoinsTheZoneFilesOnce) {
+  json fenced = plan({waypoint(47.38, 8.55, 60)});
+  fenced["geoFence"]["circles"] = {{{"inclusion", false}, {"circle", {{"center", {47.376, 8.545}}, {"radius", 50}}}, {"version", 1}}};
+  // GIVEN a plan with a fence and a mission that does not list it under zones
+  const Mission m = loadWithPlan("qgc_fence", fenced, {{"zones", {"other.json"}}});
+  // THEN it is read as a zone file after the listed ones
+  ASSERT_EQ(m.zone_files.size(), 2u);
+  EXPECT_EQ(m.zone_files[0], test::scratchPath("qgc_fence/other.json"));
+  EXPECT_EQ(m.zone_files[1], test::scratchPath("qgc_fence/route.plan"));
+  // Listed under zones as well (another spelling of the same file): once.
+  const Mission twice = loadWithPlan("qgc_fence_twice", fenced, {{"zones", {"./route.plan"}}});
+  ASSERT_EQ(twice.zone_files.size(), 1u);
+  // A plan with an empty geoFence adds nothing.
+  EXPECT_TRUE(loadWithPlan("qgc_no_fence", plan({waypoint(47.38, 8.55, 60)})).zone_files.empty());
 }
 
 TEST(MissionQgcRoute, ComplexItemIsRefusedNamingItsIndex) {
@@ -245,8 +377,14 @@ TEST(MissionQgcRoute, BadItemsAreRefusedNamingTheJsonPathTheValueAndWhatWasExpec
        {"'$.mission.items[1].params[6]'", "an altitude in metres"}},
       {"frame 2 (mission) on a waypoint", [](json& p) { p["mission"]["items"][1]["frame"] = 2; },
        {"'$.mission.items[1].frame'", "got '2'", "0 (AMSL), 3 (relative to home) or 10 (terrain)"}},
-      {"unsupported command", [](json& p) { p["mission"]["items"][2]["command"] = 178; },
-       {"'$.mission.items[2].command'", "got '178'", "16 NAV_WAYPOINT"}},
+      {"unsupported command", [](json& p) { p["mission"]["items"][2]["command"] = 30; },
+       {"'$.mission.items[2].command'", "got '30'", "16 NAV_WAYPOINT", "not supported"}},
+      {"DO_JUMP", [](json& p) { p["mission"]["items"][2]["command"] = 177; },
+       {"'$.mission.items[2].command'", "got '177'", "DO_JUMP is not supported", "unroll the loop"}},
+      {"unlimited loiter", [](json& p) { p["mission"]["items"][2]["command"] = 17; },
+       {"'$.mission.items[2].command'", "NAV_LOITER_UNLIM is not supported", "without end"}},
+      {"loiter turns", [](json& p) { p["mission"]["items"][2]["command"] = 18; },
+       {"'$.mission.items[2].command'", "NAV_LOITER_TURNS is not supported", "NAV_LOITER_TIME"}},
       {"fractional command", [](json& p) { p["mission"]["items"][2]["command"] = 16.5; },
        {"'$.mission.items[2].command'", "a MAVLink command number"}},
       {"unknown item type", [](json& p) { p["mission"]["items"][2]["type"] = "Pattern"; },
