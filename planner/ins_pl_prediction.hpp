@@ -3,7 +3,7 @@
 /// \brief Preflight protection levels of a GNSS/INS vehicle along a timed route: the tracker's
 /// own filter and integrity flow (integrity::ins::Navigator with trackingNavigatorConfig) run
 /// along the route on error-free measurements, so that its PLs are the covariance terms of the
-/// formulas the tracker evaluates live (docs/method.md §4, "Predicted PLs of a GNSS/INS vehicle").
+/// formulas the tracker evaluates live (docs/method.md §7.1, "PLs for the vehicle's navigation").
 ///
 /// The run, step by step:
 /// 1. the truth along the route: position where(t), velocity by a central difference over one

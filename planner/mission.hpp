@@ -31,7 +31,7 @@ struct MissionPoint {
 };
 
 /// \brief What the vehicle navigates with, which decides how its protection levels are predicted
-/// (README "Mission file", `navigation`; docs/method.md §4).
+/// (README "Mission file", `navigation`; docs/method.md §7.1).
 enum class NavigationKind {
   kGnss,      ///< GNSS alone: snapshot RAIM or ARAIM per `integrity.method`
   kGnssIns,   ///< GNSS/INS: the tracker's filter and its fault-mode PLs, predicted along the route
