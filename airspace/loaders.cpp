@@ -379,16 +379,25 @@ Zone geoJsonZone(const Node& feature, bool ed318) {
   z.name = optionalText(props, "name");
   z.country = optionalText(props, "country");
   const char* restriction_key = ed318 ? "type" : "restriction";
+  const bool keep_in_property = !ed318 && props.has("keep_in") && props.at("keep_in").boolean();
   if (props.has(restriction_key)) {
     const Node r = props.at(restriction_key);
-    const auto restriction = parseRestriction(r.str());
-    if (!restriction) r.fail("PROHIBITED, REQ_AUTHORIZATION, CONDITIONAL or NO_RESTRICTION");
-    z.restriction = *restriction;
+    const std::string word = r.str();
+    const auto restriction = parseRestriction(word);
+    // A keep-in zone: plain GeoJSON only (ED-269 and ED-318 have no such restriction).
+    const bool keep_in_word = !ed318 && word == "KEEP_IN";
+    z.keep_in = keep_in_property || keep_in_word;
+    if (!restriction && !keep_in_word) {
+      r.fail(ed318 ? "PROHIBITED, REQ_AUTHORIZATION, CONDITIONAL or NO_RESTRICTION"
+                   : "PROHIBITED, REQ_AUTHORISATION, CONDITIONAL, NO_RESTRICTION or KEEP_IN");
+    }
+    z.restriction = restriction.value_or(Restriction::kProhibited);
   } else if (ed318) {
     throw ParseError(feature.source, 0, props.path + "." + restriction_key, "", "a zone type (ED-318 requires it)");
   } else {
     z.restriction = Restriction::kProhibited;
-    z.notes.push_back(z.feature + " has no restriction property: taken as PROHIBITED");
+    z.keep_in = keep_in_property;
+    if (!z.keep_in) z.notes.push_back(z.feature + " has no restriction property: taken as PROHIBITED");
   }
   if (props.has("reason")) z.reasons = stringList(props.at("reason"));
   z.message = optionalText(props, "message");

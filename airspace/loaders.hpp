@@ -18,7 +18,7 @@
 ///   else the first); sunrise/sunset events (`startEvent`/`endEvent`) are replaced by the
 ///   whole day, on the safe side, with a note.
 /// - Plain GeoJSON: see README ("Zone files"): properties identifier|id, name, restriction
-///   (default PROHIBITED, noted), lower/upper (number or null), lower_reference/
+///   (default PROHIBITED, noted; KEEP_IN: a keep-in zone, as `keep_in: true` says too), lower/upper (number or null), lower_reference/
 ///   upper_reference (AGL|AMSL|WGS84, default AMSL), uom (m|ft), start/end (RFC 3339),
 ///   schedule; circles as Point + radius_m (or Azure's subType "Circle" + radius).
 /// - QGroundControl: `geoFence.polygons[]` ({inclusion, polygon [[lat, lon], …]}) and

@@ -20,6 +20,8 @@ std::optional<Restriction> parseRestriction(std::string_view text) {
   return std::nullopt;
 }
 
+std::string_view restrictionLabel(const Zone& z) { return z.keep_in ? "KEEP_IN" : restrictionName(z.restriction); }
+
 std::string_view referenceName(VerticalReference r) {
   switch (r) {
     case VerticalReference::kAgl: return "AGL";

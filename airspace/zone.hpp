@@ -28,6 +28,10 @@ enum class VerticalReference { kAgl, kAmsl, kWgs84 };
 [[nodiscard]] std::string_view restrictionName(Restriction r);
 /// \brief Parses ED-269 and ED-318 spellings (REQ_AUTHORISATION and REQ_AUTHORIZATION).
 [[nodiscard]] std::optional<Restriction> parseRestriction(std::string_view text);
+/// \brief What a zone is called in reports and exports: "KEEP_IN" for a keep-in zone, else
+/// restrictionName of its restriction.
+struct Zone;
+[[nodiscard]] std::string_view restrictionLabel(const Zone& z);
 /// \brief "AGL", "AMSL", "WGS84".
 [[nodiscard]] std::string_view referenceName(VerticalReference r);
 
@@ -96,7 +100,9 @@ struct Zone {
   std::string message;
   std::vector<Volume> volumes;
   std::vector<Applicability> applicability;  ///< empty: permanent
-  /// A keep-in zone (QGroundControl inclusion fence): the vehicle must stay inside it.
+  /// A keep-in zone (a QGroundControl inclusion fence, a GeoJSON zone with restriction KEEP_IN
+  /// or keep_in: true): the vehicle must stay inside it (inside the union of the active ones,
+  /// geofence/keep_in.hpp); `restriction` then means nothing.
   bool keep_in = false;
   std::string source;   ///< the file it came from
   std::string feature;  ///< where in the file, e.g. "UASZoneList[0]"

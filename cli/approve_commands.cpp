@@ -59,6 +59,12 @@ std::vector<MapShape> obstructionShapes(const geofence::Obstructions& ob, const 
       sh.fill_opacity = 0.18;
       sh.dashed = timed;
       sh.legend = counted ? (timed ? "zone, time-limited" : "zone, prohibited / not authorised") : "zone, authorised or open";
+      if (z.keep_in) {  // a boundary to stay within: an outline, not an area to avoid
+        sh.fill = "none";
+        sh.stroke = "#6a3d9a";
+        sh.stroke_width_px = 2.5;
+        sh.legend = timed ? "keep-in fence, time-limited (stay inside)" : "keep-in fence (stay inside)";
+      }
       shapes.push_back(std::move(sh));
     }
   }

@@ -129,11 +129,8 @@ json fenceVerdictJson(const geofence::FenceVerdict& v, const geofence::Fence& fe
       const geofence::AlertLimits& l = (c.level == geofence::Level::kCorridor ? fence.level1() : fence.level2()).limits();
       j["hal_m"] = metresOrNull(l.hal_m);
       j["val_m"] = metresOrNull(l.val_m);
-    } else if (c.level == geofence::Level::kZone) {
-      const airspace::Zone& z = fence.zones()[c.index];
-      j["name"] = z.name;
-      j["restriction"] = std::string(airspace::restrictionName(z.restriction));
-      j["file"] = z.source;
+    } else if (c.level == geofence::Level::kZone || c.level == geofence::Level::kKeepIn) {
+      j["file"] = fence.zones()[c.index].source;
     }
   }
   return out;

@@ -388,10 +388,11 @@ void drawMapShapes(std::ostream& s, const MapView& v, const std::vector<MapShape
     if (sh.xy.size() < 2) continue;
     s << "<polygon points=\"";
     for (const auto& [x, y] : sh.xy) s << fmt(v.X(x)) << "," << fmt(v.Y(y)) << " ";
-    s << "\" fill=\"" << sh.fill << "\" fill-opacity=\"" << sh.fill_opacity << "\" stroke=\"" << sh.stroke << "\""
+    const std::string width = sh.stroke_width_px == 1.0 ? "" : " stroke-width=\"" + fmt(sh.stroke_width_px) + "\"";
+    s << "\" fill=\"" << sh.fill << "\" fill-opacity=\"" << sh.fill_opacity << "\" stroke=\"" << sh.stroke << "\"" << width
       << (sh.dashed ? " stroke-dasharray=\"5,3\"" : "") << "/>\n";
     remember(legend, sh.legend, "<rect width=\"16\" height=\"12\" fill=\"" + sh.fill + "\" fill-opacity=\"" +
-                                    std::to_string(sh.fill_opacity) + "\" stroke=\"" + sh.stroke + "\"/>");
+                                    std::to_string(sh.fill_opacity) + "\" stroke=\"" + sh.stroke + "\"" + width + "/>");
   }
 }
 

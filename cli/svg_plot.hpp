@@ -74,6 +74,7 @@ struct MapShape {
   std::string stroke;
   double fill_opacity = 0.3;
   bool dashed = false;
+  double stroke_width_px = 1.0;
   std::string legend;      ///< shown once per distinct legend text
 };
 

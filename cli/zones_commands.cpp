@@ -110,7 +110,7 @@ void runValidate(const ValidateOptions& o) {
       }
       std::cout << airspace::describe(zones[i]) << ": " << status << " (" << zones[i].volumes.size() << " volume"
                 << (zones[i].volumes.size() == 1 ? "" : "s") << ", "
-                << airspace::restrictionName(zones[i].restriction) << ")\n";
+                << airspace::restrictionLabel(zones[i]) << ")\n";
       for (const airspace::ZoneIssue& issue : report.issues) {
         if (issue.zone != i) continue;
         std::cout << "  " << (issue.error ? (issue.repaired ? "repaired: " : "error: ") : "note: ") << issue.what;
@@ -168,7 +168,7 @@ void runAt(const AtOptions& o) {
         j["name"] = z.name;
         j["file"] = z.source;
         j["volume"] = vi;
-        j["restriction"] = std::string(airspace::restrictionName(z.restriction));
+        j["restriction"] = std::string(airspace::restrictionLabel(z));
         if (z.keep_in) j["keep_in"] = true;
         j["message"] = z.message;
         j["active"] = active;
@@ -235,7 +235,7 @@ void runExport(const ExportOptions& o) {
         }
         props["identifier"] = z.identifier;
         props["name"] = z.name;
-        props["restriction"] = std::string(airspace::restrictionName(z.restriction));
+        props["restriction"] = std::string(airspace::restrictionLabel(z));
         props["keep_in"] = z.keep_in;
         props["reason"] = z.reasons;
         props["message"] = z.message;

@@ -56,12 +56,18 @@ const char* levelName(Level l) {
     case Level::kAirspace: return "level2";
     case Level::kZone: return "zone";
     case Level::kObstacle: return "obstacle";
+    case Level::kKeepIn: return "keep_in";
   }
   return "?";
 }
 
+const char* verdictWord(Level l, Verdict v) {
+  if (isContainmentLevel(l) || v == Verdict::kIndeterminate) return verdictName(v);
+  return v == Verdict::kInside ? "clear" : "met";
+}
+
 bool counts(const airspace::Zone& zone, const ZonePolicy& policy) {
-  if (zone.keep_in) return false;
+  if (zone.keep_in) return false;  // not to stay clear of: the keep-in check holds it
   const bool authorised = policy.authorisations.count(zone.identifier) > 0;
   switch (zone.restriction) {
     case airspace::Restriction::kProhibited: return true;
@@ -126,9 +132,10 @@ std::vector<ScenePiece> obstaclePieces(const std::vector<maps::Building>& buildi
 }
 
 Obstructions::Obstructions(std::vector<airspace::Zone> zones, std::vector<maps::Building> buildings, Scene scene,
-                           ZonePolicy policy, FenceOptions options)
+                           ZonePolicy policy, FenceOptions options, std::vector<KeepInVolume> keep_in)
     : zones_(std::move(zones)),
       buildings_(std::move(buildings)),
+      keep_in_(std::move(keep_in)),
       scene_(std::move(scene)),
       policy_(std::move(policy)),
       options_(options) {
@@ -143,6 +150,12 @@ Obstructions::Obstructions(std::vector<airspace::Zone> zones, std::vector<maps::
     if (p.owner_index >= n) {
       throw std::invalid_argument(std::string("scene piece names ") + (p.owner == PieceOwner::kZone ? "zone " : "obstacle ") +
                                   std::to_string(p.owner_index) + " but there are only " + std::to_string(n));
+    }
+  }
+  for (const KeepInVolume& k : keep_in_) {
+    if (k.zone >= zones_.size() || !zones_[k.zone].keep_in) {
+      throw std::invalid_argument("keep-in volume names zone " + std::to_string(k.zone) + ", which is not a keep-in zone of " +
+                                  std::to_string(zones_.size()));
     }
   }
   zone_counts_.reserve(zones_.size());
@@ -181,7 +194,14 @@ std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) c
     Check c;
     c.level = h.owner == PieceOwner::kZone ? Level::kZone : Level::kObstacle;
     c.index = h.owner_index;
-    c.subject = c.level == Level::kZone ? zones_[h.owner_index].identifier : buildings_[h.owner_index].feature;
+    if (c.level == Level::kZone) {
+      const airspace::Zone& z = zones_[h.owner_index];
+      c.subject = z.identifier;
+      c.name = z.name;
+      c.restriction = std::string(airspace::restrictionLabel(z));
+    } else {
+      c.subject = buildings_[h.owner_index].feature;
+    }
     c.margin_h_m = s.margin_h_m;
     c.margin_v_m = s.margin_v_m;
     c.clearance_m = s.clearance_m;
@@ -202,7 +222,34 @@ std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) c
 
 std::vector<Check> Obstructions::check(const TimedVolume& v) const { return check(v, options_.horizon_m); }
 
-std::optional<Check> Obstructions::firstConflict(const TimedVolume& v) const {
+std::optional<Check> Obstructions::keepIn(const TimedVolume& v) const {
+  std::vector<const KeepInVolume*> active;
+  for (const KeepInVolume& k : keep_in_) {
+    if (airspace::isActiveDuring(zones_[k.zone], v.t0, v.t1)) active.push_back(&k);
+  }
+  if (active.empty()) return std::nullopt;
+  requireValid(v.volume);
+  const KeepInMargins m = keepInMargins(v.volume, active);
+  const airspace::Zone& z = zones_[active[m.nearest]->zone];
+  Check c;
+  c.level = Level::kKeepIn;
+  c.index = active[m.nearest]->zone;
+  c.subject = z.identifier;
+  c.name = z.name;
+  c.restriction = std::string(airspace::restrictionLabel(z));
+  c.margin_h_m = m.margin_h_m;
+  c.margin_v_m = m.margin_v_m;
+  const double deciding_m = std::min(m.margin_h_m, m.margin_v_m);
+  c.verdict = deciding_m > options_.tolerance_m    ? Verdict::kInside
+              : deciding_m < -options_.tolerance_m ? Verdict::kOutside
+                                                   : Verdict::kIndeterminate;
+  return c;
+}
+
+std::optional<Check> Obstructions::firstConflict(const TimedVolume& v, bool with_keep_in) const {
+  if (with_keep_in) {
+    if (std::optional<Check> k = keepIn(v); k && k->verdict != Verdict::kInside) return k;
+  }
   for (Check& c : check(v, 0.0)) {
     if (c.verdict != Verdict::kInside) return std::move(c);
   }
@@ -228,6 +275,7 @@ FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const O
   const double tol = obstructions.options().tolerance_m;
   out.checks.push_back(boxCheck(Level::kCorridor, level1, v.volume, tol));
   out.checks.push_back(boxCheck(Level::kAirspace, level2, v.volume, tol));
+  if (std::optional<Check> k = obstructions.keepIn(v)) out.checks.push_back(std::move(*k));
   std::vector<Check> near = obstructions.check(v, horizon_m);
   out.checks.insert(out.checks.end(), std::make_move_iterator(near.begin()), std::make_move_iterator(near.end()));
 

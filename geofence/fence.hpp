@@ -9,6 +9,7 @@
 #include "airspace/vertical.hpp"
 #include "airspace/zone.hpp"
 #include "geofence/corridor.hpp"
+#include "geofence/keep_in.hpp"
 #include "geofence/scene.hpp"
 #include "maps/buildings.hpp"
 #include "maps/plane_frame.hpp"
@@ -21,16 +22,26 @@
 
 namespace skylane::geofence {
 
-/// \brief The level a check belongs to.
-enum class Level { kCorridor, kAirspace, kZone, kObstacle };
+/// \brief The level a check belongs to. (kKeepIn comes last so that the per-level state stored by
+/// earlier versions keeps its indices; checks are ordered 1, 2, keep-in, zones, obstacles.)
+enum class Level { kCorridor, kAirspace, kZone, kObstacle, kKeepIn };
 
-/// \brief "level1", "level2", "zone", "obstacle".
+/// \brief "level1", "level2", "zone", "obstacle", "keep_in".
 [[nodiscard]] const char* levelName(Level l);
+
+/// \brief Whether the level is one the volume must lie inside (the two boxes, the keep-in zones)
+/// rather than one it must stay clear of (zones and obstacles).
+[[nodiscard]] inline bool isContainmentLevel(Level l) { return l != Level::kZone && l != Level::kObstacle; }
+
+/// \brief The word a check of this level reports: "inside" / "outside" for the boxes and the
+/// keep-in zones, "clear" / "met" for zones and obstacles; "indeterminate" for both.
+[[nodiscard]] const char* verdictWord(Level l, Verdict v);
 
 /// \brief One check of a protection volume.
 ///
 /// `verdict` says whether the volume lies inside the space the check allows: the box for
-/// levels 1 and 2, everything outside the zone or obstacle otherwise. Margins in metres are how
+/// levels 1 and 2, the union of the active keep-in zones, everything outside the zone or
+/// obstacle otherwise (reported as verdictWord: inside / outside, clear / met). Margins in metres are how
 /// much HPL (margin_h) and VPL (margin_v) could still grow and the verdict stay; negative: by
 /// how much they are exceeded. A box is kept when both margins are positive, a zone when
 /// either is (see Separation); within the tolerance of that the verdict is indeterminate.
@@ -39,6 +50,8 @@ struct Check {
   Verdict verdict = Verdict::kInside;
   std::size_t index = 0;    ///< segment (levels 1, 2) or zone / obstacle index
   std::string subject;      ///< "segment 3", the zone's identifier, the obstacle's feature
+  std::string name;         ///< zones and keep-in: the zone's name
+  std::string restriction;  ///< zones and keep-in: airspace::restrictionLabel (KEEP_IN for keep-in)
   double margin_h_m = 0.0;
   double margin_v_m = 0.0;
   std::optional<double> clearance_m;  ///< zones and obstacles: 3-D distance (0 when met)
@@ -50,13 +63,14 @@ struct Check {
 struct FenceVerdict {
   /// inside only when every check is; outside when any check is; indeterminate otherwise.
   Verdict verdict = Verdict::kInside;
-  /// The first level (in the order 1, 2, zone, obstacle) with an outside check, or else with an
-  /// indeterminate one; empty when inside.
+  /// The first level (in the order 1, 2, keep-in, zone, obstacle) with an outside check, or else
+  /// with an indeterminate one; empty when inside.
   std::optional<Level> violated;
   /// That check's index in `checks`.
   std::optional<std::size_t> deciding;
-  /// Level 1 and level 2 always (their deciding segment); then every zone and obstacle within
-  /// the clearance horizon, nearest first within each level.
+  /// Level 1 and level 2 always (their deciding segment); the keep-in check when a keep-in zone
+  /// is active; then every zone and obstacle within the clearance horizon, nearest first within
+  /// each level.
   std::vector<Check> checks;
 };
 
@@ -69,7 +83,8 @@ struct ZonePolicy {
   bool count_no_restriction = false;   ///< NO_RESTRICTION zones count (off: they restrict nothing)
 };
 
-/// \brief Whether the zone counts under the policy (its activity in time aside).
+/// \brief Whether the zone counts under the policy as one to stay clear of (its activity in time
+/// aside); a keep-in zone never does (it is checked by Obstructions::keepIn, whatever the policy).
 [[nodiscard]] bool counts(const airspace::Zone& zone, const ZonePolicy& policy);
 
 /// \brief Tunables of the check.
@@ -106,27 +121,34 @@ struct TimedVolume {
   ProtectionVolume volume;
 };
 
-/// \brief What a volume must stay clear of: the zones (those the policy counts, when active)
-/// and the obstacles of a scene. Shared by the fence (a protection volume) and the route
-/// planner (the vehicle inflated to its first-level box).
+/// \brief What a volume must stay clear of — the zones (those the policy counts, when active)
+/// and the obstacles of a scene — and inside of: the active keep-in zones. Shared by the fence
+/// (a protection volume) and the route planner (the vehicle inflated to its first-level box).
 class Obstructions {
  public:
   /// \brief `zones` and `buildings` give names and activity to the scene's pieces (a piece's
   /// owner_index indexes them).
-  /// \throws std::invalid_argument for a bad tolerance or horizon, or a piece naming a zone or
-  /// obstacle that is not there.
+  /// `keep_in` (keepInVolumes of the same zones) are the volumes of the keep-in zones.
+  /// \throws std::invalid_argument for a bad tolerance or horizon, or a piece or keep-in volume
+  /// naming a zone or obstacle that is not there.
   Obstructions(std::vector<airspace::Zone> zones, std::vector<maps::Building> buildings, Scene scene,
-               ZonePolicy policy = {}, FenceOptions options = {});
+               ZonePolicy policy = {}, FenceOptions options = {}, std::vector<KeepInVolume> keep_in = {});
   /// \brief One check per zone or obstacle within the options' horizon (zones first, the worst
   /// verdict first, then the nearest); zones count when active at some instant of [t0, t1).
   [[nodiscard]] std::vector<Check> check(const TimedVolume& v) const;
   /// \brief The same within `horizon_m`.
   [[nodiscard]] std::vector<Check> check(const TimedVolume& v, double horizon_m) const;
-  /// \brief The worst zone or obstacle the volume meets or may meet (indeterminate), if any.
-  [[nodiscard]] std::optional<Check> firstConflict(const TimedVolume& v) const;
+  /// \brief The keep-in check: the volume against the union of the keep-in zones active at some
+  /// instant of [t0, t1); none when no keep-in zone is active then.
+  [[nodiscard]] std::optional<Check> keepIn(const TimedVolume& v) const;
+  /// \brief The first of: the keep-in check when it is not inside (unless `with_keep_in` is
+  /// false); the worst zone or obstacle the volume meets or may meet (indeterminate). None when
+  /// the volume is clear of everything.
+  [[nodiscard]] std::optional<Check> firstConflict(const TimedVolume& v, bool with_keep_in = true) const;
 
   [[nodiscard]] const std::vector<airspace::Zone>& zones() const { return zones_; }
   [[nodiscard]] const std::vector<maps::Building>& buildings() const { return buildings_; }
+  [[nodiscard]] const std::vector<KeepInVolume>& keepInVolumes() const { return keep_in_; }
   [[nodiscard]] const ZonePolicy& policy() const { return policy_; }
   [[nodiscard]] const FenceOptions& options() const { return options_; }
   /// \brief Whether zone i counts under the policy (its activity aside).
@@ -136,6 +158,7 @@ class Obstructions {
   std::vector<airspace::Zone> zones_;
   std::vector<maps::Building> buildings_;
   std::vector<bool> zone_counts_;
+  std::vector<KeepInVolume> keep_in_;
   Scene scene_;
   bool pieces_in_band_ = true;  ///< every piece within the scene's height band (volumes may be cut to it)
   ZonePolicy policy_;

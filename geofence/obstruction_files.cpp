@@ -19,9 +19,11 @@ Obstructions loadObstructions(const ObstructionFiles& files, const maps::PlaneFr
   std::vector<maps::Building> buildings;
   if (!files.buildings.empty()) buildings = maps::loadBuildings(files.buildings, terrain);
   std::vector<ScenePiece> pieces = zonePieces(zones, frame, model);
+  std::vector<KeepInVolume> keep_in = keepInVolumes(zones, frame, model);
   std::vector<ScenePiece> obstacles = obstaclePieces(buildings, frame);
   pieces.insert(pieces.end(), obstacles.begin(), obstacles.end());
-  return Obstructions(std::move(zones), std::move(buildings), Scene(std::move(pieces)), std::move(policy), options);
+  return Obstructions(std::move(zones), std::move(buildings), Scene(std::move(pieces)), std::move(policy), options,
+                      std::move(keep_in));
 }
 
 }  // namespace skylane::geofence

@@ -12,14 +12,18 @@ using nlohmann::json;
 void to_json(json& j, const Check& c) {
   j = json::object();
   j["level"] = levelName(c.level);
-  j["verdict"] = verdictName(c.verdict);
+  j["verdict"] = verdictWord(c.level, c.verdict);
   j["subject"] = c.subject;
   j["margin_h_m"] = maps::metresOrNull(c.margin_h_m);
   j["margin_v_m"] = maps::metresOrNull(c.margin_v_m);
+  if (c.level == Level::kZone || c.level == Level::kKeepIn) {
+    j["name"] = c.name;
+    j["restriction"] = c.restriction;
+  }
   if (isBoxLevel(c)) {
     j["segment"] = c.index;
     j["across_joint"] = c.across_joint;
-  } else {
+  } else if (c.level != Level::kKeepIn) {
     j["clearance_m"] = c.clearance_m ? maps::metresOrNull(*c.clearance_m) : json(nullptr);
     j["exact"] = c.exact;
   }
@@ -39,19 +43,23 @@ const std::string kSource = "fence verdict";
 
 Level levelOf(const maps::JsonNode& n) {
   const std::string s = n.str();
-  for (Level l : {Level::kCorridor, Level::kAirspace, Level::kZone, Level::kObstacle}) {
+  for (Level l : {Level::kCorridor, Level::kAirspace, Level::kKeepIn, Level::kZone, Level::kObstacle}) {
     if (s == levelName(l)) return l;
   }
-  n.fail("level1, level2, zone or obstacle");
+  n.fail("level1, level2, keep_in, zone or obstacle");
 }
 
-Verdict verdictOf(const maps::JsonNode& n) {
+/// The verdict word of a check of `level` (verdictWord).
+Verdict verdictOf(const maps::JsonNode& n, Level level) {
   const std::string s = n.str();
   for (Verdict v : {Verdict::kInside, Verdict::kOutside, Verdict::kIndeterminate}) {
-    if (s == verdictName(v)) return v;
+    if (s == verdictWord(level, v)) return v;
   }
-  n.fail("inside, outside or indeterminate");
+  n.fail(isContainmentLevel(level) ? "inside, outside or indeterminate" : "clear, met or indeterminate");
 }
+
+/// The verdict of a whole volume: inside (the allowed space), outside or indeterminate.
+Verdict verdictOf(const maps::JsonNode& n) { return verdictOf(n, Level::kCorridor); }
 
 /// A length of the one form: a number, or null for an unlimited one (the member must be there).
 double metresOf(const maps::JsonNode& n, const char* key) {
@@ -63,8 +71,12 @@ double metresOf(const maps::JsonNode& n, const char* key) {
 Check checkOf(const maps::JsonNode& n) {
   Check c;
   c.level = levelOf(n.at("level"));
-  c.verdict = verdictOf(n.at("verdict"));
+  c.verdict = verdictOf(n.at("verdict"), c.level);
   c.subject = n.at("subject").str();
+  if (c.level == Level::kZone || c.level == Level::kKeepIn) {
+    if (n.has("name")) c.name = n.at("name").str();
+    if (n.has("restriction")) c.restriction = n.at("restriction").str();
+  }
   c.margin_h_m = metresOf(n, "margin_h_m");
   c.margin_v_m = metresOf(n, "margin_v_m");
   if (isBoxLevel(c)) {
@@ -72,7 +84,7 @@ Check checkOf(const maps::JsonNode& n) {
     if (!(segment >= 0.0) || segment != static_cast<double>(static_cast<std::size_t>(segment))) n.at("segment").fail("a segment index ≥ 0");
     c.index = static_cast<std::size_t>(segment);
     c.across_joint = n.at("across_joint").boolean();
-  } else {
+  } else if (c.level != Level::kKeepIn) {
     if (n.has("clearance_m")) c.clearance_m = n.at("clearance_m").number();
     c.exact = n.at("exact").boolean();
   }

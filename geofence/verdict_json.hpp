@@ -6,8 +6,11 @@
 ///
 /// A check: {"level", "verdict", "subject", "margin_h_m", "margin_v_m"} and, for the two box
 /// levels, "segment" (the path segment whose piece decides) and "across_joint"; for zones and
-/// obstacles, "clearance_m" and "exact" (decided by exact predicates). A verdict: {"verdict",
-/// "violated" (the deciding level, null when inside), "checks"}.
+/// keep-in, "name" and "restriction"; for zones and obstacles, "clearance_m" and "exact"
+/// (decided by exact predicates). The verdict word is verdictWord: inside / outside for the
+/// boxes and keep-in, clear / met for zones and obstacles. A verdict: {"verdict" (inside: the
+/// volume lies in the space every check allows; outside; indeterminate), "violated" (the
+/// deciding level, null when inside), "checks"}.
 
 #include "geofence/fence.hpp"
 

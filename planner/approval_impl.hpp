@@ -197,6 +197,10 @@ struct Approver::Impl {
   [[nodiscard]] PathProblem legProblem(const approval_steps::ApprovalSetup& setup, const maps::GpsTime& departure,
                                        int attempt, std::size_t leg, const Eigen::Vector3d& from,
                                        const std::vector<approval_steps::Penalty>& penalties) const;
+  void unflyableCause(const Eigen::Vector3d& p, const maps::GpsTime& from, const maps::GpsTime& until,
+                      const std::string& what, Reason& r) const;
+  [[nodiscard]] std::string conflictCause(const geofence::Check& c, const geofence::TimedVolume& point,
+                                          const geofence::ProtectionVolume& pv) const;
   [[nodiscard]] Reason planningReason(const approval_steps::ApprovalSetup& setup, const maps::GpsTime& departure,
                                       const approval_steps::LegPlan& plan, const std::string& status) const;
   [[nodiscard]] approval_steps::RouteSamples sampleRoute(const std::vector<RoutePoint>& route,

@@ -2,6 +2,7 @@
 // below in the order it runs. The state they pass along is in approval_impl.hpp.
 #include "planner/approval_impl.hpp"
 
+#include "maps/geoid.hpp"
 #include "maps/time.hpp"
 
 #include <algorithm>
@@ -81,16 +82,36 @@ Reason airspaceReason(const geofence::Check& c, const PredictedSample& ps, const
   return r;
 }
 
-/// A zone or an obstacle met by the protection volume.
+/// "zone X (PROHIBITED, "name")", "keep-in zone X", "obstacle X".
+std::string describeCheck(const geofence::Check& c) {
+  if (c.level == geofence::Level::kObstacle) return "obstacle " + c.subject;
+  if (c.level == geofence::Level::kKeepIn) return "keep-in zone " + c.subject + (c.name.empty() ? "" : " (\"" + c.name + "\")");
+  return "zone " + c.subject + " (" + c.restriction + (c.name.empty() ? "" : ", \"" + c.name + "\"") + ")";
+}
+
+/// A zone or an obstacle met by the protection volume, or a keep-in zone it leaves.
 Reason obstructionReason(const geofence::Check& c, const PredictedSample& ps) {
   Reason r;
-  r.kind = c.level == geofence::Level::kZone ? "zone" : "obstacle";
+  const bool keep_in = c.level == geofence::Level::kKeepIn;
+  r.kind = geofence::levelName(c.level);
   r.subject = c.subject;
-  r.value_m = -std::max(c.margin_h_m, c.margin_v_m);
-  r.message = std::string("the protection volume (HPL ") + fmtMetres(ps.hpl_m) + ", VPL " + fmtMetres(ps.vpl_m) +
-              ") meets " + (c.level == geofence::Level::kZone ? "zone " : "obstacle ") + c.subject + " at " +
-              fmtTime(ps.t_s) + "; it must shrink by " + fmtMetres(*r.value_m);
+  r.value_m = keep_in ? -std::min(c.margin_h_m, c.margin_v_m) : -std::max(c.margin_h_m, c.margin_v_m);
+  r.message = std::string("the protection volume (HPL ") + fmtMetres(ps.hpl_m) + ", VPL " + fmtMetres(ps.vpl_m) + ") " +
+              (keep_in ? "leaves " : "meets ") + describeCheck(c) + " at " + fmtTime(ps.t_s) + "; it must shrink by " +
+              fmtMetres(*r.value_m);
   return r;
+}
+
+/// What would lift a zone that makes a place unflyable: an authorisation, met conditions, or nothing.
+std::string liftedBy(const geofence::Check& c) {
+  if (c.level != geofence::Level::kZone) return "";
+  if (c.restriction == "REQ_AUTHORISATION") {
+    return "; an authorisation for it would lift it (list \"" + c.subject + "\" under the mission's authorisations)";
+  }
+  if (c.restriction == "CONDITIONAL") {
+    return "; meeting its conditions would lift it (list \"" + c.subject + "\" under the mission's authorisations)";
+  }
+  return "";
 }
 
 }  // namespace
@@ -252,7 +273,8 @@ PathProblem Approver::Impl::legProblem(const ApprovalSetup& setup, const maps::G
   prob.is_valid = [this, &penalties, start_xy, departure, latest, vehicle, exempt_m](const Eigen::Vector3d& p) {
     const maps::GpsTime earliest = departure.plus((p.head<2>() - start_xy).norm() / m.cruise_speed_mps);
     if (exempt_m > 0.0 && (p - vehicle).norm() <= exempt_m) {
-      return !obstructions->firstConflict({earliest, latest, {p, 0.0, 0.0}});
+      // Round the vehicle only its own point must be clear; outside a keep-in zone it may fly back in.
+      return !obstructions->firstConflict({earliest, latest, {p, 0.0, 0.0}}, /*with_keep_in=*/false);
     }
     return valid(p, earliest, latest, penalties);
   };
@@ -284,21 +306,66 @@ Reason Approver::Impl::planningReason(const ApprovalSetup& setup, const maps::Gp
   }
   const bool start = last.status == PathStatus::kInvalidStart;
   const Eigen::Vector3d p = start ? plan.pts.back() : setup.stops[plan.failed_leg];
-  r.message = std::string(start ? "the start" : "the goal") +
-              " is not flyable at cruise height: it is inside (or within the level-1 box of) an active zone"
-              " or obstacle, or outside the altitude limits";
-  if (const auto c =
-          obstructions->firstConflict({departure, setup.zones_until, {p, limits.level1.hal_m, limits.level1.val_m}})) {
-    r.kind = c->level == geofence::Level::kZone ? "zone" : "obstacle";
-    r.subject = c->subject;
-    r.message = std::string(start ? "the start" : "the goal") + " lies in " +
-                (c->level == geofence::Level::kZone ? "zone " : "obstacle ") + c->subject;
-  }
+  unflyableCause(p, departure, setup.zones_until, start ? "the start" : "the goal", r);
   const maps::Geodetic g = geodetic(p);
   r.lat_rad = g.lat_rad;
   r.lon_rad = g.lon_rad;
   r.h_ell_m = g.h_ell_m;
   return r;
+}
+
+/// Why `p` is not a valid state (Impl::valid), in the order valid() asks: the terrain, the
+/// altitude limits, then what its planning volume (the level-1 box grown to the predicted PL)
+/// reaches — the keep-in zone it leaves, the zone or obstacle it meets, and what would lift it.
+void Approver::Impl::unflyableCause(const Eigen::Vector3d& p, const maps::GpsTime& from, const maps::GpsTime& until,
+                                    const std::string& what, Reason& r) const {
+  r.message = what + " is not flyable at cruise height: ";
+  const auto g = ground(p.head<2>());
+  if (!g) {
+    r.message += "it lies outside the terrain model";
+    return;
+  }
+  const double agl = p.z() - *g;
+  if (agl < m.min_agl_m || agl > m.max_agl_m) {
+    r.message += fmtMetres(agl) + " above the ground is outside the altitude limits " + fmtMetres(m.min_agl_m) + " to " +
+                 fmtMetres(m.max_agl_m) + " AGL";
+    return;
+  }
+  const maps::Geodetic q = geodetic(p);
+  const double amsl = maps::Geoid::egm96().amslFromEllipsoidal_m(q.lat_rad, q.lon_rad, p.z());
+  if (m.max_amsl_m && amsl > *m.max_amsl_m) {
+    r.message += fmtMetres(amsl) + " AMSL is above the mission's max_amsl " + fmtMetres(*m.max_amsl_m);
+    return;
+  }
+  const geofence::ProtectionVolume pv = planningVolume(p);
+  const std::optional<geofence::Check> c = obstructions->firstConflict({from, until, pv});
+  if (!c) {
+    r.message += "it lies where an earlier attempt's route broke a rule";
+    return;
+  }
+  r.kind = geofence::levelName(c->level);
+  r.subject = c->subject;
+  r.message = what + conflictCause(*c, {from, until, {p, 0.0, 0.0}}, pv) + liftedBy(*c);
+}
+
+/// " lies in zone X", or ": its planning volume (…) reaches zone X, d m away" (from the point's own check).
+std::string Approver::Impl::conflictCause(const geofence::Check& c, const geofence::TimedVolume& point,
+                                          const geofence::ProtectionVolume& pv) const {
+  const std::string box = "its planning volume (the level-1 box ±" + fmtMetres(limits.level1.hal_m) + " / ±" +
+                          fmtMetres(limits.level1.val_m) + " grown to 1.2 × the predicted PL: ±" + fmtMetres(pv.hpl_m) +
+                          " / ±" + fmtMetres(pv.vpl_m) + ")";
+  if (c.level == geofence::Level::kKeepIn) {
+    const std::optional<geofence::Check> own = obstructions->keepIn(point);
+    if (own && own->verdict != geofence::Verdict::kInside) return " lies outside " + describeCheck(c);
+    return " is too close to the edge of " + describeCheck(c) + ": " + box + " reaches out of it, " +
+           fmtMetres(std::min(own->margin_h_m, own->margin_v_m)) + " from the edge";
+  }
+  for (const geofence::Check& o : obstructions->check(point, std::max(pv.hpl_m, pv.vpl_m) + 1.0)) {
+    if (o.level != c.level || o.subject != c.subject) continue;
+    if (o.verdict != geofence::Verdict::kInside) return " lies in " + describeCheck(c);
+    return ": " + box + " reaches " + describeCheck(c) + ", " + fmtMetres(*o.clearance_m) + " away";
+  }
+  return ": " + box + " reaches " + describeCheck(c);
 }
 
 /// Sample times every sample_s and the route's end; the place and sky mask at each.
@@ -381,7 +448,7 @@ geofence::FenceVerdict Approver::Impl::checkFence(const ApprovalSetup& setup, co
       checks.reasons.add(airspaceReason(c, ps, limits.level2), ps);
       checks.violations.emplace_back(ps.xyz, violationRadius(ps));
     } else {
-      if (!inside && !leaving) {
+      if (!inside && !leaving) {  // (a zone or obstacle met, a keep-in zone left)
         checks.reasons.add(obstructionReason(c, ps), ps);
         checks.violations.emplace_back(ps.xyz, violationRadius(ps) + limits.level1.hal_m);
       }
@@ -395,7 +462,7 @@ void Approver::Impl::noteZoneApproach(const geofence::Check& c, std::vector<Zone
   auto it = std::find_if(zones.begin(), zones.end(), [&](const ZoneApproach& z) { return z.identifier == c.subject; });
   if (it == zones.end()) {
     const airspace::Zone& z = obstructions->zones()[c.index];
-    zones.push_back({z.identifier, std::string(airspace::restrictionName(z.restriction)), obstructions->zoneCounts(c.index),
+    zones.push_back({z.identifier, std::string(airspace::restrictionLabel(z)), obstructions->zoneCounts(c.index),
                      *c.clearance_m});
   } else {
     it->min_clearance_m = std::min(it->min_clearance_m, *c.clearance_m);

@@ -57,6 +57,9 @@ python3 -c 'import json, os; j=json.load(open(os.environ["OUT"] + "/approve/repo
 echo "--- a mission that is rejected ("$OUT"/approve_rejected/):"
 "$SKYLANE" approve examples/approve/mission_rejected.json --out "$OUT"/approve_rejected > /dev/null || true
 python3 -c 'import json, os; j=json.load(open(os.environ["OUT"] + "/approve_rejected/report.json")); print(j["decision"], "-", j["reasons"][0]["message"])'
+echo "--- the same run inside the operator's QGroundControl site fence, a keep-in zone ("$OUT"/approve_keep_in/):"
+"$SKYLANE" approve examples/approve/mission_keep_in.json --out "$OUT"/approve_keep_in > /dev/null
+python3 -c 'import json, os; j=json.load(open(os.environ["OUT"] + "/approve_keep_in/report.json")); print(j["decision"], "-", round(j["planner"]["length_m"]), "m round the fence corner at", ", ".join("(%.5f, %.5f)" % (p["lat"], p["lon"]) for p in j["route"][1:-1]))'
 echo "--- live corridor tracking of the approved flight ("$OUT"/track/: events.jsonl, track.svg, track.sqlite):"
 mkdir -p "$OUT"/track
 rm -f "$OUT"/track/track.sqlite*

@@ -17,7 +17,7 @@ using maps::metresOrNull;
 
 namespace {
 
-constexpr int kLevels = 4;
+constexpr int kLevels = 5;  // geofence::Level: 1, 2, zone, obstacle, keep-in
 
 /// Pushes v into a window of at most n values and returns how many are true.
 int pushWindow(std::vector<bool>& w, bool v, int n) {
@@ -325,10 +325,10 @@ namespace {
 TrackEvent violationEvent(const TrackedFlight& f, const FixWork& w, geofence::Level level, geofence::Verdict v, bool pl_cause) {
   TrackEvent e = trackEvent("violation", f.id, w.fix.time);
   e["level"] = geofence::levelName(level);
-  e["verdict"] = geofence::verdictName(v);
+  e["verdict"] = geofence::verdictWord(level, v);
   for (const geofence::Check& c : w.verdict.checks) {
     if (c.level != level || c.verdict == geofence::Verdict::kInside) continue;
-    e.body.update(geofence::pickMembers(json(c), {"subject", "margin_h_m", "margin_v_m", "clearance_m"}));
+    e.body.update(geofence::pickMembers(json(c), {"subject", "name", "restriction", "margin_h_m", "margin_v_m", "clearance_m"}));
     break;
   }
   if (level == geofence::Level::kCorridor) {
@@ -371,7 +371,7 @@ void updatePersistence(const TrackerOptions& o, TrackedFlight& f, FixWork& w) {
   for (int l = 0; l < kLevels; ++l) lv[l] = worstVerdict(w.verdict, static_cast<geofence::Level>(l));
   const bool bad1 = lv[0] != geofence::Verdict::kInside;
   const bool bad2 = lv[1] != geofence::Verdict::kInside || lv[2] != geofence::Verdict::kInside ||
-                    lv[3] != geofence::Verdict::kInside;
+                    lv[3] != geofence::Verdict::kInside || lv[4] != geofence::Verdict::kInside;
   const bool pl_cause = *w.hpl_m > f.plan.level1.hal_m || *w.vpl_m > f.plan.level1.val_m;
   // The level-1 window counts the violations a replan can mend (by the position; also by the
   // PLs with replan_on_pl_exceedance), so PL excursions do not make a drift look persistent.
@@ -381,6 +381,7 @@ void updatePersistence(const TrackerOptions& o, TrackedFlight& f, FixWork& w) {
   levelEpisodes(o, f, w, lv, pl_cause);
   if (count2 >= o.level2_m && bad2) {
     w.trigger = lv[1] != geofence::Verdict::kInside   ? geofence::Level::kAirspace
+                : lv[4] != geofence::Verdict::kInside ? geofence::Level::kKeepIn
                 : lv[2] != geofence::Verdict::kInside ? geofence::Level::kZone
                                                       : geofence::Level::kObstacle;
   } else if (count1 >= o.level1_m && mendable1) {

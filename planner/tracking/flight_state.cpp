@@ -5,6 +5,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 namespace skylane::planner {
 
 using nlohmann::json;
@@ -31,6 +35,19 @@ json flightStateJson(const FlightState& s) {
   return j;
 }
 
+namespace {
+
+/// A per-level array; one of 4 (stored before the keep-in level) leaves the keep-in entry at 0.
+template <typename T, std::size_t N>
+void perLevel(const maps::JsonNode& n, std::array<T, N>& out) {
+  const std::vector<T> v = n.j.get<std::vector<T>>();
+  if (v.size() != N && v.size() != N - 1) n.fail("an array of " + std::to_string(N) + " (one per level)");
+  out = {};
+  std::copy(v.begin(), v.end(), out.begin());
+}
+
+}  // namespace
+
 FlightState parseFlightState(const json& j, const std::string& source) {
   const maps::JsonNode root{j, "$", source};
   FlightState s;
@@ -45,8 +62,8 @@ FlightState parseFlightState(const json& j, const std::string& source) {
     s.last_replan = time("last_replan");
     s.level1_window = j.at("level1_window").get<std::vector<bool>>();
     s.level2_window = j.at("level2_window").get<std::vector<bool>>();
-    s.violated = j.at("violated").get<std::array<bool, 4>>();
-    s.inside_streak = j.at("inside_streak").get<std::array<int, 4>>();
+    perLevel(root.at("violated"), s.violated);
+    perLevel(root.at("inside_streak"), s.inside_streak);
     s.stale_reported = j.at("stale_reported").get<bool>();
     s.arrived = j.value("arrived", false);
     s.next_stop = j.at("next_stop").get<std::size_t>();

@@ -18,8 +18,8 @@ namespace skylane::planner {
 struct FlightState {
   std::optional<maps::GpsTime> last_time;
   std::vector<bool> level1_window, level2_window;  ///< oldest first, at most N each
-  std::array<bool, 4> violated{};                  ///< per geofence::Level
-  std::array<int, 4> inside_streak{};
+  std::array<bool, 5> violated{};                  ///< per geofence::Level
+  std::array<int, 5> inside_streak{};
   std::optional<maps::GpsTime> last_replan;
   bool stale_reported = false;
   bool arrived = false;       ///< the last fix was within waypoint_radius_m of the goal

@@ -59,8 +59,11 @@ void to_json(json& j, const FixRecord& f) {
     const json check = c;  // the one form (geofence/verdict_json.hpp); the fix event shows a part
     if (isBoxLevel(c)) {
       levels[geofence::levelName(c.level)] = geofence::pickMembers(check, {"verdict", "margin_h_m", "margin_v_m", "segment"});
+    } else if (c.level == geofence::Level::kKeepIn) {
+      levels[geofence::levelName(c.level)] =
+          geofence::pickMembers(check, {"verdict", "margin_h_m", "margin_v_m", "subject", "name", "restriction"});
     } else {
-      near.push_back(geofence::pickMembers(check, {"level", "subject", "verdict", "clearance_m"}));
+      near.push_back(geofence::pickMembers(check, {"level", "subject", "verdict", "clearance_m", "name", "restriction"}));
     }
   }
   j["levels"] = levels;
@@ -103,12 +106,15 @@ PlSource plSourceOf(const maps::JsonNode& n) {
   n.fail("onboard, raw, nmea_gst, ins, gnss_ins, mavlink_accuracy, ubx_pl or ubx_accuracy");
 }
 
-/// A box level's part of the fix event ({verdict, margins, segment}) as a check of `level`.
+/// A box level's part of the fix event ({verdict, margins, segment}) as a check of `level`; the
+/// keep-in part ({verdict, margins, subject, name, restriction}) as it is.
 geofence::Check boxCheckOf(const json& part, geofence::Level level) {
   json whole = part;
   whole["level"] = geofence::levelName(level);
-  whole["subject"] = "segment " + std::to_string(part.value("segment", 0));
-  whole["across_joint"] = false;
+  if (level != geofence::Level::kKeepIn) {
+    whole["subject"] = "segment " + std::to_string(part.value("segment", 0));
+    whole["across_joint"] = false;
+  }
   return whole.get<geofence::Check>();
 }
 
@@ -149,9 +155,9 @@ void from_json(const json& j, FixRecord& f) {
   }
   if (n.has("ins_degraded")) f.ins_degraded = n.at("ins_degraded").boolean();
   json verdict{{"verdict", j.at("verdict")}, {"violated", j.value("violated", json())}, {"checks", json::array()}};
-  for (const auto& [name, part] : n.at("levels").j.items()) {
-    const geofence::Level level = name == "level1" ? geofence::Level::kCorridor : geofence::Level::kAirspace;
-    verdict["checks"].push_back(boxCheckOf(part, level));
+  const maps::JsonNode levels = n.at("levels");
+  for (geofence::Level level : {geofence::Level::kCorridor, geofence::Level::kAirspace, geofence::Level::kKeepIn}) {
+    if (levels.has(geofence::levelName(level))) verdict["checks"].push_back(boxCheckOf(levels.at(geofence::levelName(level)).j, level));
   }
   for (const json& part : n.at("near").array()) verdict["checks"].push_back(nearCheckOf(part));
   f.verdict = verdict.get<geofence::FenceVerdict>();
@@ -290,10 +296,33 @@ bool validUtf8(std::string_view v) {
 
 namespace {
 
-/// The two box levels of a fix event, as the object "levels".
+/// The keep-in part of "levels" (its members in sorted order).
+void writeKeepIn(LineWriter& w, const geofence::Check& c) {
+  w.key(geofence::levelName(c.level));
+  w.open('{');
+  w.key("margin_h_m");
+  w.metres(c.margin_h_m);
+  w.key("margin_v_m");
+  w.metres(c.margin_v_m);
+  w.key("name");
+  w.string(c.name);
+  w.key("restriction");
+  w.string(c.restriction);
+  w.key("subject");
+  w.string(c.subject);
+  w.key("verdict");
+  w.string(geofence::verdictWord(c.level, c.verdict));
+  w.close('}');
+}
+
+/// The two box levels and the keep-in check of a fix event, as the object "levels" (keep_in
+/// sorts before level1).
 void writeLevels(LineWriter& w, const FixRecord& f) {
   w.key("levels");
   w.open('{');
+  for (const geofence::Check& c : f.verdict.checks) {
+    if (c.level == geofence::Level::kKeepIn) writeKeepIn(w, c);
+  }
   for (const geofence::Check& c : f.verdict.checks) {
     if (!isBoxLevel(c)) continue;
     w.key(geofence::levelName(c.level));
@@ -316,7 +345,7 @@ void writeNear(LineWriter& w, const FixRecord& f) {
   w.key("near");
   w.open('[');
   for (const geofence::Check& c : f.verdict.checks) {
-    if (isBoxLevel(c)) continue;
+    if (geofence::isContainmentLevel(c.level)) continue;
     w.item();
     w.open('{');
     w.key("clearance_m");
@@ -327,10 +356,16 @@ void writeNear(LineWriter& w, const FixRecord& f) {
     }
     w.key("level");
     w.string(geofence::levelName(c.level));
+    if (c.level == geofence::Level::kZone) {
+      w.key("name");
+      w.string(c.name);
+      w.key("restriction");
+      w.string(c.restriction);
+    }
     w.key("subject");
     w.string(c.subject);
     w.key("verdict");
-    w.string(geofence::verdictName(c.verdict));
+    w.string(geofence::verdictWord(c.level, c.verdict));
     w.close('}');
   }
   w.close(']');
@@ -409,7 +444,9 @@ void writeFixTail(LineWriter& w, const TrackEvent& e, const FixRecord& f) {
 std::string TrackEvent::jsonLine() const {
   const bool plain = fix && validUtf8(flight) && validUtf8(fix->note) &&
                      std::all_of(fix->verdict.checks.begin(), fix->verdict.checks.end(),
-                                 [](const geofence::Check& c) { return validUtf8(c.subject); });
+                                 [](const geofence::Check& c) {
+                                   return validUtf8(c.subject) && validUtf8(c.name) && validUtf8(c.restriction);
+                                 });
   if (!plain) return toJson().dump(-1, ' ', false, json::error_handler_t::replace);
   std::string out;
   out.reserve(512);

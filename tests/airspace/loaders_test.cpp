@@ -128,7 +128,9 @@ TEST(ZoneLoaders, QgcFenceIsLatitudeFirstWithInclusionAsKeepIn) {
   const auto zones = loadZones(test::dataPath("geozones/qgc_fence.plan"));
   ASSERT_EQ(zones.size(), 3u);
   EXPECT_TRUE(zones[0].keep_in);
+  EXPECT_EQ(restrictionLabel(zones[0]), "KEEP_IN");  // what zones validate / at / export say
   EXPECT_FALSE(zones[1].keep_in);
+  EXPECT_EQ(restrictionLabel(zones[1]), "PROHIBITED");
   EXPECT_NEAR(latDeg(zones[1].volumes[0].outline.ring[0]), 46.53, kDegTol);
   EXPECT_NEAR(lonDeg(zones[1].volumes[0].outline.ring[0]), 6.60, kDegTol);
   EXPECT_EQ(zones[2].volumes[0].outline.radius_m, 250.0);
@@ -215,6 +217,29 @@ TEST(ZoneLoaders, JsonSyntaxErrorNamesTheLine) {
   } catch (const maps::ParseError& e) {
     EXPECT_EQ(e.line(), 3) << e.what();
     EXPECT_NE(std::string(e.what()).find(path + ":3"), std::string::npos) << e.what();
+  }
+}
+
+// Plain GeoJSON keep-in zones: restriction KEEP_IN or keep_in: true; ED-318 has no such type.
+TEST(ZoneLoaders, GeoJsonKeepInByRestrictionOrProperty) {
+  auto feature = [](const json& props) {
+    return json{{"type", "FeatureCollection"},
+                {"features", {{{"type", "Feature"},
+                               {"properties", props},
+                               {"geometry", {{"type", "Point"}, {"coordinates", {8.5, 47.3}}}}}}}};
+  };
+  const auto by_word = parseZones(feature({{"restriction", "KEEP_IN"}, {"radius_m", 100}}), "mem.json");
+  ASSERT_EQ(by_word.size(), 1u);
+  EXPECT_TRUE(by_word[0].keep_in);
+  const auto by_flag = parseZones(feature({{"keep_in", true}, {"radius_m", 100}}), "mem.json");
+  EXPECT_TRUE(by_flag[0].keep_in);
+  EXPECT_TRUE(by_flag[0].notes.empty());  // not "taken as PROHIBITED"
+  try {
+    (void)parseZones(feature({{"restriction", "KEEPIN"}, {"radius_m", 100}}), "mem.json");
+    FAIL() << "an unknown restriction was accepted";
+  } catch (const maps::ParseError& e) {
+    EXPECT_NE(std::string(e.what()).find("KEEP_IN"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("properties.restriction"), std::string::npos) << e.what();
   }
 }
 

@@ -2,6 +2,8 @@
 // the rounding and null rules, and the views the outputs take of it.
 #include "geofence/verdict_json.hpp"
 
+#include "maps/parse_error.hpp"
+
 #include <gtest/gtest.h>
 
 #include <limits>
@@ -29,6 +31,8 @@ Check zoneCheck() {
   c.verdict = Verdict::kOutside;
   c.index = 7;
   c.subject = "LSZH-CTR";
+  c.name = "Zurich CTR";
+  c.restriction = "REQ_AUTHORISATION";
   c.margin_h_m = -0.0004;
   c.margin_v_m = 12.0;
   c.clearance_m = 0.0;
@@ -44,8 +48,17 @@ TEST(VerdictJson, ABoxLevelCheckNamesItsSegmentAndRoundsToTheMillimetre) {
 
 TEST(VerdictJson, AZoneCheckGivesItsClearanceAndHowItWasDecided) {
   const json j = zoneCheck();
-  EXPECT_EQ(j, json::parse(R"({"level": "zone", "verdict": "outside", "subject": "LSZH-CTR", "margin_h_m": -0.0,
-                               "margin_v_m": 12.0, "clearance_m": 0.0, "exact": true})"));
+  // A zone check says "met" (not "outside": the volume is in the zone) and names the zone.
+  EXPECT_EQ(j, json::parse(R"({"level": "zone", "verdict": "met", "subject": "LSZH-CTR", "margin_h_m": -0.0,
+                               "margin_v_m": 12.0, "clearance_m": 0.0, "exact": true, "name": "Zurich CTR",
+                               "restriction": "REQ_AUTHORISATION"})"));
+  Check clear = zoneCheck();
+  clear.verdict = Verdict::kInside;
+  EXPECT_EQ(json(clear).at("verdict"), "clear");
+  EXPECT_EQ(json(clear).get<Check>().verdict, Verdict::kInside);
+  json wrong = json(clear);
+  wrong["verdict"] = "inside";  // a box's word on a zone check
+  EXPECT_THROW((void)wrong.get<Check>(), maps::ParseError);
   Check unknown = zoneCheck();
   unknown.clearance_m.reset();
   EXPECT_TRUE(json(unknown).at("clearance_m").is_null());

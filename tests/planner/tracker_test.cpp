@@ -359,7 +359,10 @@ TEST_F(TrackerOnExample, ProtectionVolumeTouchingAProhibitedZoneIsReportedAtOnce
   const json& near = touch.back().at("near");
   const auto in_near = std::find_if(near.begin(), near.end(), [](const json& n) { return n.at("subject") == "EX-ZH-HELIPORT"; });
   ASSERT_NE(in_near, near.end());
-  EXPECT_EQ(in_near->at("verdict"), "outside");
+  EXPECT_EQ(in_near->at("verdict"), "met");  // a zone check: met, not "outside"
+  EXPECT_EQ(in_near->at("restriction"), "PROHIBITED");
+  EXPECT_EQ(zone->at("verdict"), "met");
+  EXPECT_EQ(zone->at("restriction"), "PROHIBITED");
   EXPECT_EQ(in_near->at("clearance_m"), 0.0);
 }
 
