@@ -127,29 +127,46 @@ std::string mapSvg(const planner::ApprovalReport& r, const planner::Approver& a)
                           lines, markers, 250.0, footer);
 }
 
-std::string plSvg(const planner::ApprovalReport& r, const planner::Mission& m) {
+/// How far above the larger level-1 limit the level-1 panel reaches before PLs are drawn on
+/// its top edge: the limits stay a third of the panel high however large the PLs are.
+constexpr double kLevel1PanelCap = 3.0;
+
+/// One level's panel: HPL and VPL against that level's HAL and VAL.
+Panel levelPanel(const planner::ApprovalReport& r, int level) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  std::vector<double> t;
+  const geofence::AlertLimits& lim = level == 1 ? r.limits.level1 : r.limits.level2;
+  const std::string n = level == 1 ? "₁" : "₂";
   Series hpl{"HPL", "#d62728", {}, false, false}, vpl{"VPL", "#1f77b4", {}, false, false};
-  Series hal2{"HAL₂ (level 2)", "#d62728", {}, true, false}, val2{"VAL₂ (level 2)", "#1f77b4", {}, true, false};
-  Series hal1{"HAL₁ (level 1)", "#ff9896", {}, true, false}, val1{"VAL₁ (level 1)", "#aec7e8", {}, true, false};
+  Series hal{"HAL" + n + " (level " + std::to_string(level) + ")", "#ff7f0e", {}, true, false};
+  Series val{"VAL" + n + " (level " + std::to_string(level) + ")", "#17becf", {}, true, false};
+  for (const planner::PredictedSample& s : r.predicted) {
+    hpl.y.push_back(s.pl_available ? s.hpl_m : nan);
+    vpl.y.push_back(s.pl_available ? s.vpl_m : nan);
+    hal.y.push_back(lim.hal_m);
+    val.y.push_back(lim.val_m);
+  }
+  const planner::LevelAvailability& a = level == 1 ? r.level1_availability : r.level2_availability;
+  Panel p{"level " + std::to_string(level) + ": PL [m], held " + planner::availabilityPercent(a.fraction), {hpl, vpl, hal, val},
+          level == 1 ? 240.0 : 200.0};
+  if (level == 1) p.y_cap = kLevel1PanelCap * std::max(lim.hal_m, lim.val_m);
+  return p;
+}
+
+/// pl.svg: level 1 (the corridor, PLs above 3 × its limits on the top edge), level 2 (the
+/// airspace), and the satellites; the title names the mission, the decision and the departure.
+std::string plSvg(const planner::ApprovalReport& r, const planner::Mission& m) {
+  std::vector<double> t;
   Series sats{"satellites", "#2ca02c", {}, false, true}, blocked{"hidden by buildings/terrain", "#7f7f7f", {}, false, true};
   for (const planner::PredictedSample& s : r.predicted) {
     t.push_back(s.t_s);
-    hpl.y.push_back(s.pl_available ? s.hpl_m : nan);
-    vpl.y.push_back(s.pl_available ? s.vpl_m : nan);
-    hal2.y.push_back(r.limits.level2.hal_m);
-    val2.y.push_back(r.limits.level2.val_m);
-    hal1.y.push_back(r.limits.level1.hal_m);
-    val1.y.push_back(r.limits.level1.val_m);
     sats.y.push_back(s.satellites);
     blocked.y.push_back(s.blocked);
   }
-  Panel pl{"protection level [m]", {hpl, vpl, hal2, val2, hal1, val1}, 300};
-  Panel sv{"satellites", {sats, blocked}, 160};
+  Panel sv{"satellites", {sats, blocked}, 140};
   return renderTimeSeriesSvg("skylane approve: " + (m.name.empty() ? m.source : m.name) + " — " +
-                                 (r.approved ? "approved" : "rejected") + ", departure " + maps::formatRfc3339(r.departure),
-                             "time after departure", t, {pl, sv});
+                                 (r.approved ? "approved" : "rejected") + ", departure " + maps::formatRfc3339(r.departure) +
+                                 ", navigation " + planner::navigationKindName(m.navigation.kind),
+                             "time after departure", t, {levelPanel(r, 1), levelPanel(r, 2), sv});
 }
 
 void runApprove(const ApproveOptions& o) {
@@ -178,8 +195,9 @@ void runApprove(const ApproveOptions& o) {
   }
   std::cout << j.dump(2) << "\n";
   for (const std::string& w : r.warnings) std::cerr << "skylane: warning: " << w << "\n";
-  std::cerr << "skylane: approve: " << (r.approved ? "APPROVED" : "REJECTED") << " in " << r.elapsed_s << " s";
-  if (!r.reasons.empty()) std::cerr << ": " << r.reasons.front().message;
+  char elapsed[32];
+  std::snprintf(elapsed, sizeof elapsed, "%.2f", r.elapsed_s);
+  std::cerr << "skylane: approve: " << planner::approvalSummary(r) << " (in " << elapsed << " s)";
   if (r.planner.stopped_by_time) {
     std::cerr << " (the planner's time limit ended a search before its iteration budget: this route is not reproducible)";
   }

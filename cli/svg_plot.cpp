@@ -64,6 +64,7 @@ std::string renderTimeSeriesSvg(const std::string& title, const std::string& x_l
         any = true;
       }
     }
+    if (std::isfinite(p.y_cap) && hi > p.y_cap) hi = p.y_cap;
     if (!any || hi <= lo) hi = lo + 1;
     const double ystep = niceStep(hi - lo, 5);
     hi = std::ceil(hi / ystep) * ystep;
@@ -98,7 +99,7 @@ std::string renderTimeSeriesSvg(const std::string& title, const std::string& x_l
         pen = true;
       }
       s << "<path d=\"" << d.str() << "\" fill=\"none\" stroke=\"" << se.colour << "\" stroke-width=\"1.6\""
-        << (se.dashed ? " stroke-dasharray=\"6,4\"" : "") << "/>\n";
+        << (se.dashed ? " stroke-dasharray=\"6,4\"" : "") << "><title>" << escape(se.label) << "</title></path>\n";
       s << "<line x1=\"" << left + plot_w + 12 << "\" x2=\"" << left + plot_w + 36 << "\" y1=\"" << legend_y - 4
         << "\" y2=\"" << legend_y - 4 << "\" stroke=\"" << se.colour << "\" stroke-width=\"2\""
         << (se.dashed ? " stroke-dasharray=\"6,4\"" : "") << "/><text x=\"" << left + plot_w + 42 << "\" y=\""

@@ -3,6 +3,7 @@
 /// \brief A small SVG time-series plotter (no dependency): stacked panels sharing the time axis.
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -22,9 +23,13 @@ struct Panel {
   std::string y_label;
   std::vector<Series> series;
   double height_px = 260;
+  /// The y axis ends here when the data reach higher (NaN: at the data's top); values above are
+  /// drawn on the panel's top edge. Keeps small limits readable beside large values.
+  double y_cap = std::numeric_limits<double>::quiet_NaN();
 };
 
-/// \brief Renders panels against x (seconds from the start) as an SVG document.
+/// \brief Renders panels against x (seconds from the start) as an SVG document; each line is a
+/// `path` carrying its label as a `title` (a tooltip).
 [[nodiscard]] std::string renderTimeSeriesSvg(const std::string& title, const std::string& x_label,
                                               const std::vector<double>& x_s, const std::vector<Panel>& panels);
 

@@ -93,6 +93,8 @@ MissionRecord missionRecord(const Mission& m) {
   if (!m.source.empty()) r.source_absolute = std::filesystem::absolute(m.source).lexically_normal().string();
   r.k1 = m.levels.k1;
   r.k2 = m.levels.k2;
+  r.navigation = m.navigation;
+  r.policy = m.policy;
   r.seed = m.seed;
   auto add = [&r](const std::string& role, const std::string& path) {
     if (!path.empty()) r.inputs.push_back({role, path, maps::fileSha256Hex(path)});
@@ -199,7 +201,14 @@ integrity::PredictSample Approver::Impl::predictAt(const maps::Geodetic& g, cons
   req.mask_rad = maps::deg2rad(m.mask_deg);
   req.model = m.model;
   req.sky_mask = mask;
-  return integrity::predictAt(orbits, req, t, m.method);
+  integrity::PredictSample s = integrity::predictAt(orbits, req, t, m.method);
+  if (m.navigation.kind == NavigationKind::kReceiver) {
+    // The receiver states its PLs: they hold wherever it is (the satellites are still counted).
+    s.pl.pl_computed = true;
+    s.pl.hpl_m = m.navigation.hpl_m;
+    s.pl.vpl_m = m.navigation.vpl_m;
+  }
+  return s;
 }
 
 double Approver::Impl::ratioOf(const integrity::PredictSample& s) const {

@@ -26,9 +26,14 @@
 /// 3. Every `sample_s` seconds of flight, and where each hover starts and ends: the position
 ///    (held at a stop while it hovers), its sky mask, the predicted PLs with the mission's
 ///    method, and the fence check of the protection volume at that time.
+///    The PLs are those of the mission's navigation (Mission::navigation): GNSS alone (RAIM or
+///    ARAIM per sample), GNSS/INS (the tracker's filter run along the route, see
+///    planner/ins_pl_prediction.hpp) or a receiver's declared constants.
 /// 4. Approved when every sample has a PL and its protection volume is inside level 2 and clear
-///    of the zones and the obstacles. Level-1 exceedances (HPL > HAL₁ or VPL > VAL₁) are counted
-///    and reported: in flight they trigger a monitoring rerun, not a rejection.
+///    of the zones and the obstacles, and the level-1 availability (the fraction of samples with
+///    HPL ≤ HAL₁ and VPL ≤ VAL₁) meets the policy's minimum when it sets one. Otherwise level-1
+///    exceedances are reported, with each level's availability and worst stretch: in flight they
+///    trigger a monitoring rerun, not a rejection.
 /// 5. Otherwise the violating places are penalised (no state within a protection level of a
 ///    violation, plus the level-1 box, is valid) and the route replanned, up to `max_replans`
 ///    times; then the next departure of the window. A rejection names where, when and why, and
@@ -69,8 +74,35 @@ struct PredictedSample {
   double hpl_m = 0.0, vpl_m = 0.0;
   int satellites = 0;
   int blocked = 0;  ///< satellites above the mask hidden by buildings or terrain
+  /// GNSS/INS: the three-hypothesis INS PL of the same filter beside the fault-mode PL above
+  /// (which is the one the tracker flies with and the one checked); none for the other kinds.
+  std::optional<double> three_hypothesis_hpl_m, three_hypothesis_vpl_m;
   geofence::FenceVerdict fence;
 };
+
+/// \brief The longest run of consecutive route samples whose PLs exceed a level's limits.
+struct FailingStretch {
+  double t_start_s = 0.0, t_end_s = 0.0;  ///< its first and last failing sample, after departure
+  double lat_start_rad = 0.0, lon_start_rad = 0.0;
+  double lat_end_rad = 0.0, lon_end_rad = 0.0;
+  int samples = 0;
+  /// \brief From its first to its last failing sample [s] (0 for a single sample).
+  [[nodiscard]] double duration_s() const { return t_end_s - t_start_s; }
+};
+
+/// \brief How much of the route one box level holds: a sample holds it when it has PLs and
+/// HPL ≤ HAL and VPL ≤ VAL (a sample without PLs does not).
+struct LevelAvailability {
+  geofence::AlertLimits limits;
+  int samples = 0;
+  int held = 0;
+  double fraction = 0.0;  ///< held / samples; 0 without samples
+  std::optional<FailingStretch> worst_stretch;  ///< none when every sample holds
+};
+
+/// \brief The availability of `limits` over `samples` (in time order).
+[[nodiscard]] LevelAvailability levelAvailability(const std::vector<PredictedSample>& samples,
+                                                  const geofence::AlertLimits& limits);
 
 /// \brief Why a route was refused.
 struct Reason {
@@ -117,6 +149,8 @@ struct MissionRecord {
   std::string source;           ///< the mission file as given
   std::string source_absolute;  ///< its absolute path (for a tracker started elsewhere)
   double k1 = 0.0, k2 = 0.0;    ///< the box levels' factors
+  NavigationModel navigation;   ///< how the PLs were predicted
+  MissionPolicy policy;
   std::uint64_t seed = 0;       ///< the planner's seed
   std::vector<InputDigest> inputs;
 };
@@ -135,7 +169,9 @@ struct ApprovalReport {
   std::vector<PredictedSample> predicted;
   std::vector<ZoneApproach> zones;
   PlannerStats planner;
-  int level1_exceedances = 0;  ///< samples with HPL > HAL₁ or VPL > VAL₁
+  int level1_exceedances = 0;  ///< samples whose level-1 fence check was not inside (kept for compatibility)
+  LevelAvailability level1_availability;  ///< of the report's route (HAL₁, VAL₁)
+  LevelAvailability level2_availability;  ///< (HAL₂, VAL₂)
   std::optional<maps::GpsTime> earliest_passing_departure;
   double elapsed_s = 0.0;
   /// Findings that do not decide the approval but that its reader must see: an orbit file

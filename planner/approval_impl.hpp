@@ -182,6 +182,18 @@ struct Approver::Impl {
   [[nodiscard]] std::vector<RoutePoint> timeRoute(const std::vector<Eigen::Vector3d>& pts,
                                                   const std::vector<approval_steps::StopTiming>& per_point) const;
 
+  // --- the PLs for the mission's navigation and the levels' availability (approval_prediction.cpp) ---
+
+  /// Every sample's place and PLs for the mission's navigation (no fence check yet).
+  [[nodiscard]] std::vector<PredictedSample> predictRoute(const std::vector<RoutePoint>& route,
+                                                          const approval_steps::RouteSamples& samples,
+                                                          const maps::GpsTime& departure) const;
+  void applyInsPrediction(const std::vector<RoutePoint>& route, const approval_steps::RouteSamples& samples,
+                          const maps::GpsTime& departure, std::vector<PredictedSample>& out) const;
+  /// The policy's minimum level-1 availability missed: a reason naming the worst stretch; none
+  /// when it is met or the policy sets none.
+  [[nodiscard]] std::optional<Reason> availabilityShortfall(const LevelAvailability& level1) const;
+
   // --- the approval (approval_steps.cpp) ---
 
   /// The approval steps of approval.hpp from `stops` (map frame; `stop_timing`: per stop, the
@@ -226,7 +238,7 @@ struct Approver::Impl {
   [[nodiscard]] approval_steps::SampleChecks checkSamples(const approval_steps::ApprovalSetup& setup,
                                                           const maps::GpsTime& departure,
                                                           const std::vector<Eigen::Vector3d>& pts,
-                                                          const approval_steps::RouteSamples& samples,
+                                                          std::vector<PredictedSample> predicted,
                                                           std::vector<ZoneApproach>& zones) const;
   [[nodiscard]] PredictedSample predictSample(const approval_steps::RouteSamples& samples, std::size_t k,
                                               const maps::GpsTime& t) const;
@@ -238,7 +250,7 @@ struct Approver::Impl {
   [[nodiscard]] std::optional<maps::GpsTime> searchLaterDeparture(const maps::GpsTime& departure,
                                                                   const approval_steps::AttemptHistory& history) const;
   [[nodiscard]] bool routePassesAt(const maps::GpsTime& departure, const approval_steps::RouteCorridors& corridors,
-                                   const approval_steps::RouteSamples& samples) const;
+                                   const std::vector<RoutePoint>& route, const approval_steps::RouteSamples& samples) const;
 };
 
 }  // namespace skylane::planner

@@ -235,8 +235,13 @@ AttemptOutcome Approver::Impl::attemptRoute(const ApprovalSetup& setup, const ma
   const std::vector<RoutePoint> route = timeRoute(plan.pts, pointTiming(setup, plan));
   report.planner.length_m = polylineLength(plan.pts);
   const RouteSamples samples = sampleRoute(route, say);
-  SampleChecks checks = checkSamples(setup, departure, plan.pts, samples, report.zones);
+  SampleChecks checks = checkSamples(setup, departure, plan.pts, predictRoute(route, samples, departure), report.zones);
   std::vector<Reason> reasons = checks.reasons.summarised();
+  report.level1_availability = levelAvailability(checks.predicted, limits.level1);
+  report.level2_availability = levelAvailability(checks.predicted, limits.level2);
+  if (std::optional<Reason> shortfall = availabilityShortfall(report.level1_availability)) {
+    reasons.push_back(std::move(*shortfall));
+  }
   history.last_route = route;
   history.last_samples = samples;
   report.route = route;
@@ -450,15 +455,15 @@ RouteCorridors Approver::Impl::corridorsAlong(const std::vector<Eigen::Vector3d>
   return {geofence::Corridor(pts, limits.level1, {}), geofence::Corridor(pts, limits.level2, {})};
 }
 
-/// Every sample: its predicted PLs, then (with a PL) the fence check of its protection volume.
+/// Every sample with its predicted PLs (predictRoute): with a PL, the fence check of its
+/// protection volume.
 SampleChecks Approver::Impl::checkSamples(const ApprovalSetup& setup, const maps::GpsTime& departure,
-                                          const std::vector<Eigen::Vector3d>& pts, const RouteSamples& samples,
+                                          const std::vector<Eigen::Vector3d>& pts, std::vector<PredictedSample> predicted,
                                           std::vector<ZoneApproach>& zones) const {
   const RouteCorridors corridors = corridorsAlong(pts);
   SampleChecks checks;
-  for (std::size_t k = 0; k < samples.t_s.size(); ++k) {
-    const maps::GpsTime t = departure.plus(samples.t_s[k]);
-    PredictedSample ps = predictSample(samples, k, t);
+  for (PredictedSample& ps : predicted) {
+    const maps::GpsTime t = departure.plus(ps.t_s);
     if (ps.pl_available) {
       ps.fence = checkFence(setup, corridors, t, ps, checks, zones);
     } else {
@@ -563,19 +568,21 @@ std::optional<maps::GpsTime> Approver::Impl::searchLaterDeparture(const maps::Gp
   const RouteCorridors corridors = corridorsAlong(pts);
   for (double shift = m.departure_step_s; shift <= kLaterDepartureHorizon_s; shift += m.departure_step_s) {
     const maps::GpsTime later = departure.plus(shift);
-    if (routePassesAt(later, corridors, history.last_samples)) return later;
+    if (routePassesAt(later, corridors, history.last_route, history.last_samples)) return later;
   }
   return std::nullopt;
 }
 
-/// The same rule as the approval: every sample has a PL, and every check but level 1 holds.
+/// The same rule as the approval: every sample has a PL (for the mission's navigation), every
+/// check but level 1 holds, and the policy's level-1 availability is met.
 bool Approver::Impl::routePassesAt(const maps::GpsTime& departure, const RouteCorridors& corridors,
-                                   const RouteSamples& samples) const {
-  for (std::size_t k = 0; k < samples.t_s.size(); ++k) {
-    const maps::GpsTime t = departure.plus(samples.t_s[k]);
-    const integrity::PredictSample pr = predictAt(samples.geo[k], t, samples.masks[k]);
-    if (!pr.pl.pl_computed) return false;
-    const geofence::TimedVolume v{t, t, {samples.xyz[k], pr.pl.hpl_m, pr.pl.vpl_m}};
+                                   const std::vector<RoutePoint>& route, const RouteSamples& samples) const {
+  const std::vector<PredictedSample> predicted = predictRoute(route, samples, departure);
+  if (availabilityShortfall(levelAvailability(predicted, limits.level1))) return false;
+  for (const PredictedSample& ps : predicted) {
+    const maps::GpsTime t = departure.plus(ps.t_s);
+    if (!ps.pl_available) return false;
+    const geofence::TimedVolume v{t, t, {ps.xyz, ps.hpl_m, ps.vpl_m}};
     for (const geofence::Check& c : geofence::checkVolume(corridors.level1, corridors.level2, *obstructions, v).checks) {
       if (c.level != geofence::Level::kCorridor && c.verdict != geofence::Verdict::kInside) return false;
     }

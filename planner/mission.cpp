@@ -430,7 +430,7 @@ void addRouteItem(PlanWalk& w, const JsonNode& item, int command) {
 void requireMissionFields(const JsonNode& root) {
   root.requireKnownFields({"name", "vehicle", "k1", "k2", "start", "goal", "waypoints", "qgc_plan", "altitude",
                            "departure", "departure_window", "zones", "zone_format", "terrain", "ground_amsl_m",
-                           "buildings", "authorisations", "orbits", "integrity", "planner"});
+                           "buildings", "authorisations", "orbits", "integrity", "navigation", "policy", "planner"});
 }
 
 void readVehicle(const JsonNode& v, Mission& m) {
@@ -578,6 +578,51 @@ void readIntegrity(const JsonNode& n, Mission& m) {
   if (n.has("cost_cell_m")) m.cost_cell_m = positive(n.at("cost_cell_m"));
 }
 
+/// \brief A declared protection level: a finite number > 0 [m].
+double declaredPl(const JsonNode& n) {
+  const double v = n.number();
+  if (!(std::isfinite(v) && v > 0.0)) n.fail("a protection level in metres > 0");
+  return v;
+}
+
+/// \brief `navigation`: {"kind": "gnss"}, {"kind": "gnss_ins", "imu": grade} or
+/// {"kind": "receiver", "hpl_m": x, "vpl_m": y}; each kind takes only its own fields.
+void readNavigation(const JsonNode& n, Mission& m) {
+  if (!n.j.is_object()) n.fail("an object with kind \"gnss\", \"gnss_ins\" or \"receiver\"");
+  const JsonNode kind = n.at("kind");
+  const std::string k = kind.str();
+  NavigationModel& nav = m.navigation;
+  if (k == "gnss") {
+    n.requireKnownFields({"kind"});
+    nav.kind = NavigationKind::kGnss;
+  } else if (k == "gnss_ins") {
+    n.requireKnownFields({"kind", "imu"});
+    nav.kind = NavigationKind::kGnssIns;
+    const JsonNode imu = n.at("imu");
+    const auto grade = integrity::ins::parseImuGrade(imu.str());
+    if (!grade) imu.fail("an IMU grade: \"aviation\", \"tactical\" or \"consumer\"");
+    nav.imu = *grade;
+  } else if (k == "receiver") {
+    n.requireKnownFields({"kind", "hpl_m", "vpl_m"});
+    nav.kind = NavigationKind::kReceiver;
+    nav.hpl_m = declaredPl(n.at("hpl_m"));
+    nav.vpl_m = declaredPl(n.at("vpl_m"));
+  } else {
+    kind.fail("\"gnss\", \"gnss_ins\" or \"receiver\"");
+  }
+}
+
+/// \brief `policy`: {"min_level1_availability": a fraction in [0, 1]}.
+void readPolicy(const JsonNode& p, Mission& m) {
+  p.requireKnownFields({"min_level1_availability"});
+  if (p.has("min_level1_availability")) {
+    const JsonNode a = p.at("min_level1_availability");
+    const double v = a.number();
+    if (!(v >= 0.0 && v <= 1.0)) a.fail("a fraction of the route's samples in [0, 1] (0.95 for 95 %)");
+    m.policy.min_level1_availability = v;
+  }
+}
+
 void readPlannerSettings(const JsonNode& p, Mission& m) {
   p.requireKnownFields(
       {"algorithm", "time_limit_s", "iterations", "seed", "resolution_m", "simplify", "margin_m", "max_replans"});
@@ -608,6 +653,15 @@ void readPlannerSettings(const JsonNode& p, Mission& m) {
 }
 
 }  // namespace
+
+const char* navigationKindName(NavigationKind kind) {
+  switch (kind) {
+    case NavigationKind::kGnss: return "gnss";
+    case NavigationKind::kGnssIns: return "gnss_ins";
+    case NavigationKind::kReceiver: return "receiver";
+  }
+  return "?";
+}
 
 QgcPlanRoute parseQgcPlanRoute(const nlohmann::json& doc, const std::string& source) {
   const JsonNode root{doc, "$", source};
@@ -649,6 +703,8 @@ Mission parseMission(const nlohmann::json& doc, const std::string& source, const
   readDataFiles(root, base_dir, m);
   addPlanFence(plan_route, m);
   if (root.has("integrity")) readIntegrity(root.at("integrity"), m);
+  if (root.has("navigation")) readNavigation(root.at("navigation"), m);
+  if (root.has("policy")) readPolicy(root.at("policy"), m);
   if (root.has("planner")) readPlannerSettings(root.at("planner"), m);
   return m;
 }

@@ -8,6 +8,7 @@
 
 #include "geofence/corridor.hpp"
 #include "integrity/gnss/error_model.hpp"
+#include "integrity/ins/imu_grade.hpp"
 #include "integrity/pl_summary.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/time.hpp"
@@ -53,6 +54,31 @@ struct PointFlight {
   double hover_s = 0.0;     ///< time the vehicle stays at the point after arriving
 };
 
+/// \brief What the vehicle navigates with, which decides how its protection levels are predicted
+/// (README "Mission file", `navigation`; docs/method.md §7.1).
+enum class NavigationKind {
+  kGnss,      ///< GNSS alone: snapshot RAIM or ARAIM per `integrity.method`
+  kGnssIns,   ///< GNSS/INS: the tracker's filter and its fault-mode PLs, predicted along the route
+  kReceiver,  ///< a receiver that states its own protection levels (e.g. RTK): constant declared PLs
+};
+
+/// \brief "gnss", "gnss_ins", "receiver".
+[[nodiscard]] const char* navigationKindName(NavigationKind kind);
+
+/// \brief The mission's `navigation` block.
+struct NavigationModel {
+  NavigationKind kind = NavigationKind::kGnss;
+  integrity::ins::ImuGrade imu = integrity::ins::ImuGrade::kTactical;  ///< kGnssIns: the IMU's grade
+  double hpl_m = 0.0, vpl_m = 0.0;  ///< kReceiver: the declared protection levels
+};
+
+/// \brief The mission's `policy` block: what the operator requires beyond the fence.
+struct MissionPolicy {
+  /// Least fraction of route samples whose PLs are within the level-1 limits (HPL ≤ HAL₁ and
+  /// VPL ≤ VAL₁); a route below it is rejected naming its worst stretch. None: not required.
+  std::optional<double> min_level1_availability;
+};
+
 /// \brief Everything a mission file says (paths resolved against the file's folder).
 struct Mission {
   std::string source;
@@ -89,6 +115,8 @@ struct Mission {
   integrity::IntegrityMethod method = integrity::IntegrityMethod::kRaim;
   double mask_deg = 5.0;
   integrity::ErrorModel model;
+  NavigationModel navigation;  ///< how the PLs are predicted (default: GNSS alone)
+  MissionPolicy policy;
   double sample_s = 1.0;       ///< prediction step along the route
   double cost_weight = 1.0;    ///< weight of the integrity cost against path length
   double cost_cell_m = 50.0;   ///< grid of the integrity cost field

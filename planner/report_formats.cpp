@@ -5,6 +5,7 @@
 #include "maps/json_numbers.hpp"
 
 #include <cmath>
+#include <sstream>
 
 namespace skylane::planner {
 
@@ -64,11 +65,56 @@ json predictedSampleJson(const PredictedSample& s, const ApprovalReport& r) {
          {"val1_m", roundToMm(r.limits.level1.val_m)},
          {"hal2_m", roundToMm(r.limits.level2.hal_m)},
          {"val2_m", roundToMm(r.limits.level2.val_m)}};
+  if (s.three_hypothesis_hpl_m) p["three_hypothesis_hpl_m"] = roundToMm(*s.three_hypothesis_hpl_m);
+  if (s.three_hypothesis_vpl_m) p["three_hypothesis_vpl_m"] = roundToMm(*s.three_hypothesis_vpl_m);
   for (const geofence::Check& c : s.fence.checks) {
     // The sample shows the level-2 check's margins (geofence/verdict_json.hpp's form).
     if (c.level == geofence::Level::kAirspace) p.update(geofence::pickMembers(json(c), {"margin_h_m", "margin_v_m"}));
   }
   return p;
+}
+
+/// The navigation the PLs were predicted for (the mission's `navigation` block).
+json navigationJson(const NavigationModel& n) {
+  json j{{"kind", navigationKindName(n.kind)}};
+  if (n.kind == NavigationKind::kGnssIns) j["imu"] = std::string(integrity::ins::imuGradeName(n.imu));
+  if (n.kind == NavigationKind::kReceiver) {
+    j["hpl_m"] = roundToMm(n.hpl_m);
+    j["vpl_m"] = roundToMm(n.vpl_m);
+  }
+  return j;
+}
+
+/// One level's availability over the route's samples, with its worst stretch (null: none fails).
+json availabilityJson(const LevelAvailability& a, int level, const maps::GpsTime& dep) {
+  json j{{"level", level},
+         {"hal_m", roundToMm(a.limits.hal_m)},
+         {"val_m", roundToMm(a.limits.val_m)},
+         {"samples", a.samples},
+         {"held", a.held},
+         {"fraction", std::round(a.fraction * 1e6) / 1e6},
+         {"worst_stretch", nullptr}};
+  if (const auto& w = a.worst_stretch) {
+    j["worst_stretch"] = {{"samples", w->samples},
+                          {"start", maps::formatRfc3339(dep.plus(w->t_start_s), 1)},
+                          {"end", maps::formatRfc3339(dep.plus(w->t_end_s), 1)},
+                          {"start_t_s", roundToMm(w->t_start_s)},
+                          {"end_t_s", roundToMm(w->t_end_s)},
+                          {"duration_s", roundToMm(w->duration_s())},
+                          {"start_lat", deg(w->lat_start_rad)},
+                          {"start_lon", deg(w->lon_start_rad)},
+                          {"end_lat", deg(w->lat_end_rad)},
+                          {"end_lon", deg(w->lon_end_rad)}};
+  }
+  return j;
+}
+
+std::string metres(double v) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(1);
+  s << v << " m";
+  return s.str();
 }
 
 json zonesJson(const ApprovalReport& r) {
@@ -123,11 +169,54 @@ void to_json(nlohmann::json& j, const ApprovalReport& r) {
   for (const PredictedSample& s : r.predicted) predicted.push_back(predictedSampleJson(s, r));
   j["predicted"] = predicted;
   j["level1_exceedances"] = r.level1_exceedances;
+  j["navigation"] = navigationJson(m.navigation);
+  if (m.policy.min_level1_availability) {
+    j["policy"] = {{"min_level1_availability", *m.policy.min_level1_availability}};
+  }
+  j["availability"] = {{"level1", availabilityJson(r.level1_availability, 1, r.departure)},
+                       {"level2", availabilityJson(r.level2_availability, 2, r.departure)}};
+  j["summary"] = approvalSummary(r);
   j["zones"] = zonesJson(r);
   j["planner"] = plannerJson(r);
   j["elapsed_s"] = std::round(r.elapsed_s * 1e3) / 1e3;
   j["inputs"] = inputsJson(m);
   j["software"] = {{"name", "skylane"}, {"planner_seed", m.seed}};
+}
+
+std::string availabilityPercent(double fraction) {
+  const double v = 100.0 * fraction;
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  const double whole = std::round(v);
+  if (fraction <= 0.0 || fraction >= 1.0 || (whole > 0.0 && whole < 100.0)) {
+    s.precision(0);
+    s << (fraction <= 0.0 ? 0.0 : fraction >= 1.0 ? 100.0 : whole);
+  } else {
+    s.precision(1);
+    s << (whole >= 100.0 ? std::floor(v * 10.0) / 10.0 : std::ceil(v * 10.0) / 10.0);
+  }
+  s << " %";
+  return s.str();
+}
+
+std::string approvalSummary(const ApprovalReport& r) {
+  std::string line = r.approved ? "APPROVED" : "REJECTED";
+  if (!r.approved && !r.reasons.empty()) line += " — " + r.reasons.front().message;
+  if (r.predicted.empty()) return line;  // no route was timed: nothing was predicted
+  const LevelAvailability& a = r.level1_availability;
+  line += std::string(r.approved ? " — " : "; ") + "corridor ±" + metres(a.limits.hal_m) + " / ±" + metres(a.limits.val_m) +
+          " held at " + availabilityPercent(a.fraction) + " of samples";
+  if (a.held == a.samples) return line;
+  if (a.held == 0) return line + ": expect a monitoring rerun at every fix";
+  line += ": expect monitoring reruns";
+  if (const auto& w = a.worst_stretch) {
+    std::ostringstream s;
+    s.setf(std::ios::fixed);
+    s.precision(0);
+    s << ", the longest for " << w->samples << " samples (" << w->duration_s() << " s) from t+" << w->t_start_s << " s";
+    line += s.str();
+  }
+  return line;
 }
 
 std::vector<Eigen::Vector2d> segmentOutline(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double hal_m) {

@@ -13,9 +13,21 @@ namespace skylane::planner {
 
 /// \brief The one JSON form of an approval report (`skylane approve` prints it, `report.json`;
 /// README "The report"): decision, reasons, departure, route with ETAs, both box levels,
-/// predicted samples, zones, planner statistics and the inputs' SHA-256 digests. Numbers by the
+/// predicted samples, each level's availability and worst stretch, the navigation the PLs were
+/// predicted for, zones, planner statistics and the inputs' SHA-256 digests. Numbers by the
 /// rule of maps/json_numbers.hpp.
 void to_json(nlohmann::json& j, const ApprovalReport& report);
+
+/// \brief A fraction of samples as a percentage a reader can trust: "0 %" and "100 %" only
+/// when exact, one decimal where rounding would reach them ("99.7 %", "0.4 %"), else whole.
+[[nodiscard]] std::string availabilityPercent(double fraction);
+
+/// \brief The one-line verdict of an approval (`skylane approve` prints it on stderr): the
+/// decision (and a rejection's first reason), the corridor's limits (±HAL₁ / ±VAL₁) and the share
+/// of route samples whose PLs are within them, and what a shortfall means in flight, e.g.
+/// "APPROVED — corridor ±1.8 m / ±2.0 m held at 0 % of samples: expect a monitoring rerun at
+/// every fix".
+[[nodiscard]] std::string approvalSummary(const ApprovalReport& report);
 
 /// \brief What live tracking needs of an approval report.
 struct ApprovedFlight {

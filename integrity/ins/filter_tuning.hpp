@@ -28,6 +28,10 @@ struct SensorErrorSpec {
 /// risk allocation (the filter's other settings stay as they are).
 void tuneFilterToSensors(NavigatorConfig& nav, const SensorErrorSpec& sensors, ImuGrade grade);
 
+/// \brief The filter's initial position σ per axis when a tracker aligns it at a snapshot fix
+/// (a snapshot's error is a few metres) [m]; the preflight prediction aligns with it too.
+inline constexpr double kTrackingAlignPositionSigma_m = 10.0;
+
 /// \brief The navigator a live tracker runs for an IMU of `grade` (the grade's datasheet figures,
 /// the default clock, barometer and magnetometer), with the mission's error model and mask,
 /// `initial_position_m` the σ of the snapshot it aligns at, and no snapshot ARAIM beside it.

@@ -11,8 +11,6 @@ namespace skylane::planner {
 
 namespace {
 
-/// The filter's initial position σ per axis at alignment: a snapshot's error is a few metres.
-constexpr double kAlignPositionSigma_m = 10.0;
 /// How far the IMU increments' span may differ from the time between two fixes (+0.1 %).
 constexpr double kSpanTolerance_s = 0.02;
 
@@ -79,7 +77,7 @@ void TrackedFlight::align(const TrackFix& fix, const integrity::LiveFix& snap, s
   if (!clock_m) return;
   const auto grade = static_cast<integrity::ins::ImuGrade>(fix.imu->grade);
   nav = std::make_unique<integrity::ins::Navigator>(
-      integrity::ins::trackingNavigatorConfig(grade, live.model, live.elevation_mask_rad, kAlignPositionSigma_m), s, *clock_m, 0.0);
+      integrity::ins::trackingNavigatorConfig(grade, live.model, live.elevation_mask_rad, integrity::ins::kTrackingAlignPositionSigma_m), s, *clock_m, 0.0);
   nav_grade = fix.imu->grade;
   nav_t0 = nav_time = fix.time;
   if (note.empty()) note = "GNSS/INS aligned at the snapshot position with the fix's velocity and attitude";

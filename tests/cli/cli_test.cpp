@@ -8,6 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <cmath>
+#include <fstream>
+#include <iterator>
 #include <cstdio>
 #include <sstream>
 #include <sys/wait.h>
@@ -467,6 +470,52 @@ TEST(Cli, ApprovePlanAndPlanExportWriteTheSameQgroundcontrolPlan) {
   EXPECT_FALSE(std::filesystem::exists(rejected + "/mission.plan"));
   EXPECT_EQ(refused.status, 2) << refused.out;
   EXPECT_NE(refused.out.find("'$.decision'"), std::string::npos) << refused.out;
+}
+
+/// Where a line labelled `label` starts in a time-series SVG, as a fraction of its panel's height
+/// above the panel's bottom (NaN when the line is not there).
+double lineHeightInPanel(const std::string& svg, const std::string& label) {
+  const std::size_t title = svg.find("<title>" + label + "</title>");
+  if (title == std::string::npos) return std::nan("");
+  const std::size_t path = svg.rfind("<path d=\"", title);
+  const std::size_t rect = svg.rfind("<rect x=\"70\" y=\"", path);
+  if (path == std::string::npos || rect == std::string::npos) return std::nan("");
+  const double y = std::stod(svg.substr(svg.find(',', path) + 1));
+  const double top = std::stod(svg.substr(rect + 16));
+  const double height = std::stod(svg.substr(svg.find("height=\"", rect) + 8));
+  return (top + height - y) / height;
+}
+
+TEST(Cli, ApproveSaysHowMuchOfTheRouteHoldsTheCorridorAndDrawsBothLevelsReadably) {
+  // GIVEN a 1.5 m drone (HAL₁ = VAL₁ = 1.8 m) on GNSS alone, whose HPL is metres
+  const std::string mission = writeTemp("mission_level1.json",
+                                        R"({"name":"level-1 truth","vehicle":{"lateral_m":1.5,"longitudinal_m":1.5,"cruise_speed_mps":12},)"
+                                        R"("k1":1.2,"k2":150,"start":{"lat":47.3712,"lon":8.532},"goal":{"lat":47.3712,"lon":8.5518},)"
+                                        R"("departure":"2020-01-01T14:00:00Z","ground_amsl_m":408,"integrity":{"cost_weight":0},)"
+                                        R"("planner":{"iterations":600,"seed":3},)"
+                                        R"("orbits":[")" + test::dataPath("gnss/alm01jan2020.txt") + R"("]})");
+  const std::string out = test::scratchPath("approve_level1");
+  const RunResult r = run("approve " + mission + " --out " + out);
+  // THEN the summary line says the corridor is held nowhere and what that means in flight
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("skylane: approve: APPROVED — corridor ±1.8 m / ±1.8 m held at 0 % of samples: expect a "
+                       "monitoring rerun at every fix (in "),
+            std::string::npos)
+      << r.out;
+  std::ifstream report(out + "/report.json");
+  const json j = json::parse(report);
+  EXPECT_EQ(j["availability"]["level1"]["fraction"], 0.0);
+  EXPECT_EQ(j["availability"]["level2"]["fraction"], 1.0);
+  // AND pl.svg draws each level's limits well above its panel's floor, under the mission's departure
+  std::ifstream svg_file(out + "/pl.svg");
+  const std::string svg((std::istreambuf_iterator<char>(svg_file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(svg.find("level-1 truth — approved, departure 2020-01-01T14:00:00Z"), std::string::npos);
+  for (const char* label : {"HAL₁ (level 1)", "VAL₁ (level 1)", "HAL₂ (level 2)", "VAL₂ (level 2)"}) {
+    const double h = lineHeightInPanel(svg, label);
+    EXPECT_GT(h, 0.2) << label;
+    EXPECT_LE(h, 1.0) << label;
+  }
+  EXPECT_LT(lineHeightInPanel(svg, "HAL₁ (level 1)"), 0.5);  // the PLs above it still fit the panel
 }
 
 TEST(Cli, ApproveRejectsAGoalInAProhibitedZoneWithExitOne) {
