@@ -60,6 +60,9 @@ python3 -c 'import json, os; j=json.load(open(os.environ["OUT"] + "/approve_reje
 echo "--- the same run inside the operator's QGroundControl site fence, a keep-in zone ("$OUT"/approve_keep_in/):"
 "$SKYLANE" approve examples/approve/mission_keep_in.json --out "$OUT"/approve_keep_in > /dev/null
 python3 -c 'import json, os; j=json.load(open(os.environ["OUT"] + "/approve_keep_in/report.json")); print(j["decision"], "-", round(j["planner"]["length_m"]), "m round the fence corner at", ", ".join("(%.5f, %.5f)" % (p["lat"], p["lon"]) for p in j["route"][1:-1]))'
+echo "--- the same run for an operator whose policy requires the corridor held at 95 % of the route ("$OUT"/approve_level1_policy/):"
+"$SKYLANE" approve examples/approve/mission_level1_policy.json --out "$OUT"/approve_level1_policy > /dev/null 2>&1 || true
+python3 -c 'import json, os; j=json.load(open(os.environ["OUT"] + "/approve_level1_policy/report.json")); print(j["decision"], "-", j["reasons"][0]["message"])'
 echo "--- live corridor tracking of the approved flight ("$OUT"/track/: events.jsonl, track.svg, track.sqlite):"
 mkdir -p "$OUT"/track
 rm -f "$OUT"/track/track.sqlite*
