@@ -1,5 +1,7 @@
 #include "geofence/fence.hpp"
 
+#include "geofence/zone_heights.hpp"
+
 #include "airspace/applicability.hpp"
 #include "maps/geodesy.hpp"
 
@@ -87,15 +89,10 @@ std::vector<ScenePiece> zonePieces(const std::vector<airspace::Zone>& zones, con
     if (z.keep_in) continue;
     for (std::size_t vi = 0; vi < z.volumes.size(); ++vi) {
       const airspace::Volume& v = z.volumes[vi];
-      const auto floor = airspace::limitRange(v.lower, false, v.outline, model);
-      const auto ceiling = airspace::limitRange(v.upper, true, v.outline, model);
-      if (!floor || !ceiling) {
-        throw std::invalid_argument(airspace::describe(z) + ": volume " + std::to_string(vi) +
-                                    ": an AGL limit lies where the terrain model has no data");
-      }
+      const VolumeHeights heights = volumeHeights(z, vi, model);
       airspace::PlanarPrism prism;
-      prism.floor_h_ell_m = floor->h_ell_min_m;
-      prism.ceiling_h_ell_m = ceiling->h_ell_max_m;
+      prism.floor_h_ell_m = heights.floor.h_ell_min_m;
+      prism.ceiling_h_ell_m = heights.ceiling.h_ell_max_m;
       if (v.outline.kind == airspace::Outline::Kind::kCircle) {
         const airspace::LatLon& c = v.outline.centre;
         // Azimuthal scale k' = c / sin c of the azimuthal equidistant projection, c = ρ/R the

@@ -1,5 +1,7 @@
 #include "geofence/keep_in.hpp"
 
+#include "geofence/zone_heights.hpp"
+
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/multi_polygon.hpp>
 #include <boost/geometry/geometries/point_xy.hpp>
@@ -110,16 +112,11 @@ std::vector<KeepInVolume> keepInVolumes(const std::vector<airspace::Zone>& zones
     if (!z.keep_in) continue;
     for (std::size_t vi = 0; vi < z.volumes.size(); ++vi) {
       const airspace::Volume& v = z.volumes[vi];
-      const auto floor = airspace::limitRange(v.lower, false, v.outline, model);
-      const auto ceiling = airspace::limitRange(v.upper, true, v.outline, model);
-      if (!floor || !ceiling) {
-        throw std::invalid_argument(airspace::describe(z) + ": volume " + std::to_string(vi) +
-                                    ": an AGL limit lies where the terrain model has no data");
-      }
+      const VolumeHeights heights = volumeHeights(z, vi, model);
       KeepInVolume k;
       k.zone = zi;
-      k.floor_h_ell_m = floor->h_ell_max_m;  // the zone only shrinks: its floor at its highest
-      k.ceiling_h_ell_m = ceiling->h_ell_min_m;
+      k.floor_h_ell_m = heights.floor.h_ell_max_m;  // the zone only shrinks: its floor at its highest
+      k.ceiling_h_ell_m = heights.ceiling.h_ell_min_m;
       k.ring = airspace::projectOutline(v.outline, frame, kKeepInCircleError_m, airspace::SafeSide::kContained);
       if (airspace::twiceSignedArea_m2(k.ring) < 0) std::reverse(k.ring.begin(), k.ring.end());
       if (k.ring.size() < 3 || !bg::is_simple(toBoost(k.ring))) {
