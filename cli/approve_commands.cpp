@@ -2,6 +2,7 @@
 
 #include "cli/svg_plot.hpp"
 #include "cli/zones_commands.hpp"
+#include "maps/atomic_file.hpp"
 #include "maps/file_digest.hpp"
 #include "planner/approval.hpp"
 #include "link/qgc_plan.hpp"
@@ -15,7 +16,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <limits>
 
@@ -169,30 +169,45 @@ std::string plSvg(const planner::ApprovalReport& r, const planner::Mission& m) {
                              "time after departure", t, {levelPanel(r, 1), levelPanel(r, 2), sv});
 }
 
+/// The --out folder's files into the staged outputs (report.json, pl.svg, map.svg,
+/// route.geojson added before the approval, in that order), committed together.
+void writeApprovalFiles(maps::OutputSet& outputs, const std::filesystem::path& dir, const planner::ApprovalReport& r,
+                        const json& j, const planner::Approver& approver) {
+  outputs.stream(0) << j.dump(2) << "\n";
+  outputs.stream(1) << plSvg(r, approver.mission());
+  outputs.stream(2) << mapSvg(r, approver);
+  outputs.stream(3) << planner::routeGeoJson(r, approver.mission(), approver.frame()).dump(1) << "\n";
+  // An operational intent is only for an approved route (F3548 state "Accepted"); a rejection
+  // deletes those of an earlier approval.
+  if (r.approved) {
+    outputs.add((dir / "operational_intent.json").string(), "--out")
+        << json(planner::operationalIntent(r, approver.frame())).dump(1) << "\n";
+    // The route and its fence for a ground station (QGroundControl) to upload to the vehicle,
+    // made from the report as written (so that `plan export report.json` gives the same file).
+    outputs.add((dir / "mission.plan").string(), "--out") << link::qgcPlan(j.get<planner::ApprovedFlight>(), approver).dump(2) << "\n";
+  } else {
+    outputs.removeOnCommit((dir / "operational_intent.json").string());
+    outputs.removeOnCommit((dir / "mission.plan").string());
+  }
+  outputs.commit();
+}
+
 void runApprove(const ApproveOptions& o) {
   planner::Approver approver(planner::loadMission(o.mission));
+  // The outputs are staged before the approval (a folder that cannot be written fails at once)
+  // and replace earlier ones only once every file is written (maps/atomic_file.hpp).
+  maps::OutputSet outputs;
+  const std::filesystem::path dir(o.out_dir);
+  if (!o.out_dir.empty()) {
+    maps::createOutputFolder(o.out_dir, "--out");
+    for (const char* name : {"report.json", "pl.svg", "map.svg", "route.geojson"}) outputs.add((dir / name).string(), "--out");
+  }
   const bool show = o.progress || isatty(STDERR_FILENO);
   const planner::ApprovalReport r = approver.approve([show](const std::string& s) {
     if (show) std::cerr << "skylane: approve: " << s << "\n";
   });
   const json j = r;
-  if (!o.out_dir.empty()) {
-    std::filesystem::create_directories(o.out_dir);
-    std::ofstream(std::filesystem::path(o.out_dir) / "report.json") << j.dump(2) << "\n";
-    const std::filesystem::path dir(o.out_dir);
-    std::ofstream(dir / "pl.svg") << plSvg(r, approver.mission());
-    std::ofstream(dir / "map.svg") << mapSvg(r, approver);
-    std::ofstream(dir / "route.geojson") << planner::routeGeoJson(r, approver.mission(), approver.frame()).dump(1) << "\n";
-    // An operational intent is only for an approved route (F3548 state "Accepted").
-    std::filesystem::remove(dir / "operational_intent.json");
-    std::filesystem::remove(dir / "mission.plan");
-    if (r.approved) {
-      std::ofstream(dir / "operational_intent.json") << json(planner::operationalIntent(r, approver.frame())).dump(1) << "\n";
-      // The route and its fence for a ground station (QGroundControl) to upload to the vehicle,
-      // made from the report as written (so that `plan export report.json` gives the same file).
-      std::ofstream(dir / "mission.plan") << link::qgcPlan(j.get<planner::ApprovedFlight>(), approver).dump(2) << "\n";
-    }
-  }
+  if (!o.out_dir.empty()) writeApprovalFiles(outputs, dir, r, j, approver);
   std::cout << j.dump(2) << "\n";
   for (const std::string& w : r.warnings) std::cerr << "skylane: warning: " << w << "\n";
   char elapsed[32];

@@ -10,16 +10,15 @@
 #include "integrity/gnss/parse_error.hpp"
 #include "integrity/predict.hpp"
 #include "integrity/raim/spp.hpp"
+#include "maps/atomic_file.hpp"
 #include "maps/text_file.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <memory>
 #include <unistd.h>
 
 namespace skylane::cli {
@@ -70,17 +69,11 @@ json plJson(const integrity::RaimPl& pl, const integrity::Requirements& req, boo
   return j;
 }
 
-std::unique_ptr<std::ostream> openOutput(const std::string& path) {
-  if (path.empty() || path == "-") return nullptr;
-  auto f = std::make_unique<std::ofstream>(path);
-  if (!*f) throw ParseError(path, 0, "--output", path, "a writable file");
-  return f;
-}
-
-void writeText(const std::string& path, const std::string& text, const char* option) {
-  std::ofstream f(path);
-  if (!f) throw ParseError(path, 0, option, path, "a writable file");
-  f << text;
+/// The stream of an output option: standard output for "" or "-", else a file staged in
+/// `outputs` (written in place only when the command has succeeded: maps/atomic_file.hpp).
+std::ostream& outputStream(maps::OutputSet& outputs, const std::string& path, const char* option) {
+  if (path.empty() || path == "-") return std::cout;
+  return outputs.add(path, option);
 }
 
 /// Reads a JSON file holding an ISM (either {"ism":{…}} or the bare object) into `model`.
@@ -284,10 +277,8 @@ json predictJsonLine(const integrity::PredictSample& s, const std::string& metho
 }
 
 /// The samples as CSV (with a header line) or JSON lines, to --output or stdout.
-void writePredictSamples(const std::vector<integrity::PredictSample>& samples, const PredictOptions& o,
+void writePredictSamples(std::ostream& out, const std::vector<integrity::PredictSample>& samples, const PredictOptions& o,
                          integrity::IntegrityMethod method, bool has_sky_mask) {
-  const auto out_file = openOutput(o.output);
-  std::ostream& out = out_file ? *out_file : std::cout;
   if (o.format == "csv") {
     out << "time_utc,gps_week,gps_sow,satellites,hdop,vdop,hpl_m,vpl_m,available,emt_m,sigma_acc_m,fault_modes\n";
   }
@@ -301,7 +292,7 @@ void writePredictSamples(const std::vector<integrity::PredictSample>& samples, c
 }
 
 /// The --plot SVG: protection levels against the alert limits, and the satellites in view.
-void writePredictPlot(const std::vector<integrity::PredictSample>& samples, const integrity::PredictRequest& req,
+void writePredictPlot(std::ostream& out, const std::vector<integrity::PredictSample>& samples, const integrity::PredictRequest& req,
                       const PredictOptions& o, integrity::IntegrityMethod method) {
   const integrity::Requirements& limits = req.araim.requirements;
   std::vector<double> x, hpl, vpl, hal, val, nsat;
@@ -322,7 +313,7 @@ void writePredictPlot(const std::vector<integrity::PredictSample>& samples, cons
       {Panel{"protection level [m]",
              {{"HPL", "#1f77b4", hpl}, {"VPL", "#d62728", vpl}, {"HAL", "#1f77b4", hal, true}, {"VAL", "#d62728", val, true}}},
        Panel{"satellites in view", {{"satellites", "#2ca02c", nsat, false, true}}, 160}});
-  writeText(o.plot, svg, "--plot");
+  out << svg;
 }
 
 void runPredict(const PredictOptions& o) {
@@ -330,10 +321,14 @@ void runPredict(const PredictOptions& o) {
   const integrity::PredictRequest req = predictRequest(o);
   const integrity::OrbitSource orbits = loadOrbits(o.almanacs, o.navs);
   checkOrbitAges(orbits, req.start);
+  maps::OutputSet outputs;  // staged first: a path that cannot be written fails before the work
+  std::ostream& out = outputStream(outputs, o.output, "--output");
+  std::ostream* plot = o.plot.empty() ? nullptr : &outputs.add(o.plot, "--plot");
   Progress bar("predict", o.progress);
   const auto samples = integrity::predictIntegrity(orbits, req, method, std::ref(bar));
-  writePredictSamples(samples, o, method, req.sky_mask.has_value());
-  if (!o.plot.empty()) writePredictPlot(samples, req, o, method);
+  writePredictSamples(out, samples, o, method, req.sky_mask.has_value());
+  if (plot) writePredictPlot(*plot, samples, req, o, method);
+  outputs.commit();
 }
 
 // ---------------------------------------------------------------------------
@@ -367,10 +362,10 @@ void runSpp(const SppOptions& o) {
   const integrity::ObservationData obs = integrity::loadRinexObs(o.obs);
   integrity::NavigationData nav;
   for (const auto& n : o.navs) nav.merge(integrity::loadRinexNav(n));
+  maps::OutputSet outputs;
+  std::ostream& out = outputStream(outputs, o.output, "--output");
   Progress bar("spp", o.progress);
   const auto epochs = integrity::solveSpp(obs, nav, cfg, std::ref(bar));
-  const auto out_file = openOutput(o.output);
-  std::ostream& out = out_file ? *out_file : std::cout;
   for (const auto& e : epochs) {
     json j;
     j["time"] = integrity::formatRfc3339(e.t, 3);
@@ -405,6 +400,7 @@ void runSpp(const SppOptions& o) {
     if (!e.note.empty()) j["note"] = e.note;
     out << j.dump() << "\n";
   }
+  outputs.commit();
 }
 
 // ---------------------------------------------------------------------------
@@ -445,11 +441,12 @@ void runAvailability(const AvailabilityOptions& o) {
   req.araim.horizontal_only = o.horizontal_only;
   if (!o.ism.empty()) applyIsmFile(o.ism, req.model);
   const integrity::OrbitSource orbits = loadOrbits(o.almanacs, o.navs);
+  maps::OutputSet outputs;  // staged first: a path that cannot be written fails before the work
+  std::ostream& out = outputStream(outputs, o.output, "--output");
+  std::ostream* map_svg = o.map.empty() ? nullptr : &outputs.add(o.map, "--map");
   Progress bar("availability", o.progress);
   const integrity::AvailabilityMap map = integrity::computeAvailability(orbits, req, std::ref(bar));
 
-  const auto out_file = openOutput(o.output);
-  std::ostream& out = out_file ? *out_file : std::cout;
   out << "lat_deg,lon_deg,epochs,available_epochs,availability_pct,max_hpl_m,max_vpl_m\n";
   std::vector<MapCell> cells;
   for (const auto& c : map.cells) {
@@ -462,7 +459,7 @@ void runAvailability(const AvailabilityOptions& o) {
   const double cov = map.coveragePercent(99.5);
   std::cerr << "skylane: " << map.user_epochs << " user-epochs; " << std::fixed << std::setprecision(2) << cov
             << " % of the Earth's area has >= 99.5 % availability\n";
-  if (!o.map.empty()) {
+  if (map_svg) {
     char title[200];
     std::snprintf(title, sizeof title, "%s availability%s, %s + %s, mask %.0f°, step %s", o.method == "araim" ? "ARAIM" : "RAIM",
                   o.horizontal_only ? " (horizontal)" : " (LPV-200)", integrity::formatRfc3339(req.start).c_str(),
@@ -470,8 +467,9 @@ void runAvailability(const AvailabilityOptions& o) {
     char footer[200];
     std::snprintf(footer, sizeof footer, "%.1f° grid, %zu user-epochs; %.2f %% of the area has ≥ 99.5 %% availability",
                   o.grid_deg, map.user_epochs, cov);
-    writeText(o.map, renderAvailabilityMapSvg(title, cells, o.grid_deg, footer), "--map");
+    *map_svg << renderAvailabilityMapSvg(title, cells, o.grid_deg, footer);
   }
+  outputs.commit();
 }
 
 }  // namespace

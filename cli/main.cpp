@@ -10,11 +10,23 @@
 #include "cli/track_commands.hpp"
 #include "cli/zones_commands.hpp"
 #include "integrity/gnss/parse_error.hpp"
+#include "maps/atomic_file.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <iostream>
 #include <stdexcept>
+
+/// `status`, or 2 with a message when a write to standard output failed (a full disk, /dev/full).
+static int afterStandardOutput(int status) {
+  try {
+    skylane::maps::flushStandardOutput();
+  } catch (const skylane::maps::OutputError& e) {
+    std::cerr << "skylane: error: " << e.what() << "\n";
+    return 2;
+  }
+  return status;
+}
 
 int main(int argc, char** argv) {
   CLI::App app{"skylane: airspace geofence and path-planning integrity planner for unmanned aircraft"};
@@ -28,14 +40,18 @@ int main(int argc, char** argv) {
   skylane::cli::addApproveCommands(app);
   skylane::cli::addTrackCommands(app);
   skylane::cli::addPlanCommands(app);
+  skylane::maps::watchStandardOutput();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   } catch (const skylane::cli::ExitStatus& e) {
-    return e.status;
+    return afterStandardOutput(e.status);
   } catch (const skylane::integrity::ParseError& e) {
+    std::cerr << "skylane: error: " << e.what() << "\n";
+    return 2;
+  } catch (const skylane::maps::OutputError& e) {
     std::cerr << "skylane: error: " << e.what() << "\n";
     return 2;
   } catch (const std::invalid_argument& e) {
@@ -45,5 +61,5 @@ int main(int argc, char** argv) {
     std::cerr << "skylane: internal error: " << e.what() << "\n";
     return 1;
   }
-  return 0;
+  return afterStandardOutput(0);
 }

@@ -1,6 +1,7 @@
 #include "cli/plan_commands.hpp"
 
 #include "link/qgc_plan.hpp"
+#include "maps/atomic_file.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
 #include "planner/report_formats.hpp"
@@ -8,7 +9,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -58,8 +58,7 @@ void runPlanExport(const PlanExportOptions& o) {
     std::cout << text;
     return;
   }
-  std::ofstream out(o.out);
-  if (!(out << text)) throw ParseError(o.out, 0, "--out", o.out, "a writable file");
+  maps::writeFileAtomically(o.out, text, "--out");
   std::cerr << "skylane: plan export: wrote " << o.out << " (" << flight.route.size() << " route points)\n";
 }
 

@@ -4,6 +4,7 @@
 #include "cli/progress.hpp"
 #include "cli/svg_plot.hpp"
 #include "integrity/sim/run.hpp"
+#include "maps/atomic_file.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -11,7 +12,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <limits>
 #include <thread>
@@ -33,10 +33,9 @@ struct SimulateOptions {
   bool no_plots = false;
 };
 
-void writeFile(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path.string() + ": cannot write");
-  f << text;
+/// A file of the output folder, staged: written in place when the run has succeeded.
+void writeFile(maps::OutputSet& outputs, const std::filesystem::path& path, const std::string& text) {
+  outputs.add(path.string(), "--out") << text;
 }
 
 std::vector<std::string> regionLines(const integrity::sim::StanfordHistogram& h) {
@@ -208,7 +207,8 @@ void runSimulate(const SimulateOptions& o) {
                                   ? std::filesystem::path(o.scenario).parent_path() /
                                         (std::filesystem::path(o.scenario).stem().string() + "_out")
                                   : std::filesystem::path(o.out_dir);
-  std::filesystem::create_directories(out);
+  maps::createOutputFolder(out.string(), "--out");
+  maps::OutputSet outputs;
   const auto t0 = std::chrono::steady_clock::now();
 
   if (o.monte_carlo > 0) {
@@ -226,22 +226,19 @@ void runSimulate(const SimulateOptions& o) {
     j["seed"] = s.seed;
     j["hal_m"] = s.hal_m;
     j["val_m"] = s.val_m;
-    writeFile(out / "monte_carlo.json", j.dump(2) + "\n");
+    writeFile(outputs, out / "monte_carlo.json", j.dump(2) + "\n");
     if (!o.no_plots) {
-      writeFile(out / "stanford_horizontal.svg", stanfordSvg(result, true, "Stanford diagram, horizontal — Monte Carlo"));
-      writeFile(out / "stanford_vertical.svg", stanfordSvg(result, false, "Stanford diagram, vertical — Monte Carlo"));
+      writeFile(outputs, out / "stanford_horizontal.svg", stanfordSvg(result, true, "Stanford diagram, horizontal — Monte Carlo"));
+      writeFile(outputs, out / "stanford_vertical.svg", stanfordSvg(result, false, "Stanford diagram, vertical — Monte Carlo"));
     }
+    outputs.commit();
     std::printf("skylane: simulate: wrote %s\n", out.string().c_str());
     return;
   }
 
   const integrity::sim::RunResult run = integrity::sim::runScenario(s, orbits, s.seed);
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  {
-    std::ofstream csv(out / "epochs.csv");
-    if (!csv) throw std::runtime_error((out / "epochs.csv").string() + ": cannot write");
-    integrity::sim::writeCsv(csv, run);
-  }
+  integrity::sim::writeCsv(outputs.add((out / "epochs.csv").string(), "--out"), run);
   integrity::sim::MonteCarloResult single = integrity::sim::emptyMonteCarlo(s);
   integrity::sim::accumulate(run, single);
   std::printf("skylane: simulate: %s: %.0f s of flight, %zu GNSS epochs, %ld IMU samples in %.2f s (%.0f× real time)\n",
@@ -263,10 +260,11 @@ void runSimulate(const SimulateOptions& o) {
                 v.misleading == 0 ? "bounded" : "NOT bounded", worst_v);
   }
   if (!o.no_plots) {
-    writeFile(out / "errors_and_pls.svg", curvesSvg(run, s));
-    writeFile(out / "stanford_horizontal.svg", stanfordSvg(single, true, "Stanford diagram, horizontal — " + s.source));
-    writeFile(out / "stanford_vertical.svg", stanfordSvg(single, false, "Stanford diagram, vertical — " + s.source));
+    writeFile(outputs, out / "errors_and_pls.svg", curvesSvg(run, s));
+    writeFile(outputs, out / "stanford_horizontal.svg", stanfordSvg(single, true, "Stanford diagram, horizontal — " + s.source));
+    writeFile(outputs, out / "stanford_vertical.svg", stanfordSvg(single, false, "Stanford diagram, vertical — " + s.source));
   }
+  outputs.commit();
   std::printf("skylane: simulate: wrote %s\n", out.string().c_str());
 }
 

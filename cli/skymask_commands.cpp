@@ -4,13 +4,13 @@
 #include "cli/svg_plot.hpp"
 #include "maps/buildings.hpp"
 #include "maps/geoid.hpp"
+#include "maps/atomic_file.hpp"
 #include "maps/parse_error.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -96,9 +96,7 @@ void runSkyMask(const SkyMaskCliOptions& o) {
     std::snprintf(title, sizeof title, "sky mask at %.6f°, %.6f°, %.1f m (ellipsoidal)", o.lat_deg, o.lon_deg, h_ell);
     const std::string footer = std::to_string(count) + " buildings from " + (o.buildings.empty() ? "(none)" : o.buildings) +
                                "; bins of " + json(o.bin_deg).dump() + "°; shaded: blocked";
-    std::ofstream f(o.svg);
-    if (!f) throw ParseError(o.svg, 0, "--svg", o.svg, "a writable file");
-    f << renderSkyPlotSvg(title, blocked_deg, o.bin_deg, footer);
+    maps::writeFileAtomically(o.svg, renderSkyPlotSvg(title, blocked_deg, o.bin_deg, footer), "--svg");
   }
 }
 

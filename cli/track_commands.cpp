@@ -11,6 +11,7 @@
 #include "link/mavlink/handoff.hpp"
 #include "link/plan_file_sink.hpp"
 #include "link/ubx/fix_source.hpp"
+#include "maps/atomic_file.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
@@ -25,6 +26,8 @@
 #include <atomic>
 #include <csignal>
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -281,6 +284,18 @@ void drawRoutes(TrackMap& map, const planner::Tracker& tracker) {
   }
 }
 
+/// A session stopped by a failed write of its event stream: a full disk or a lost file is an
+/// error naming it; a closed pipe (the reader has gone) is the clean stop the summary reports.
+void requireOutputWritten(const planner::JsonLinesSink& out, const std::string& path) {
+  if (!out.closed()) return;
+  if (out.error() != EPIPE) throw maps::OutputError(path.empty() ? "standard output" : path, path.empty() ? "" : "--out",
+                                                    maps::systemReason(out.error() != 0 ? out.error() : EIO));
+  if (path.empty()) {  // nothing more can reach the reader: not an error at exit either
+    std::cout.clear();
+    std::clearerr(stdout);
+  }
+}
+
 void runTrack(const TrackOptions& o) {
   if (o.format != "jsonl" && o.format != "nmea" && o.format != "rinex" && o.format != "mavlink" && o.format != "ubx") {
     throw ParseError("--format", 0, "--format", o.format, "jsonl, nmea, rinex, mavlink or ubx");
@@ -292,10 +307,13 @@ void runTrack(const TrackOptions& o) {
   addApprovals(session, o);
   TrackMap track_map;
   drawRoutes(track_map, session.tracker());
+  // The map is staged before the run (a path that cannot be written fails at once) and
+  // replaces an earlier one when the run has ended (maps/atomic_file.hpp).
+  std::unique_ptr<maps::AtomicFile> map_file = o.map.empty() ? nullptr : std::make_unique<maps::AtomicFile>(o.map, "--map");
   std::ofstream out_file;
   if (!o.out.empty()) {
     out_file.open(o.out, std::ios::app);
-    if (!out_file) throw ParseError(o.out, 0, "--out", o.out, "a writable file");
+    if (!out_file) throw maps::OutputError(o.out, "--out", maps::systemReason(errno));
   }
   planner::JsonLinesSink out(o.out.empty() ? std::cout : out_file);
   session.addSink(out);
@@ -315,8 +333,10 @@ void runTrack(const TrackOptions& o) {
     session.addSink(*plans);
   }
   const planner::SessionSummary sum = session.run(*source);
-  if (!o.map.empty()) {
-    std::ofstream(o.map) << track_map.svg(session.tracker());
+  requireOutputWritten(out, o.out);
+  if (map_file) {
+    map_file->stream() << track_map.svg(session.tracker());
+    map_file->commit();
     log("wrote " + o.map);
   }
   log(std::to_string(sum.accepted) + " fix" + (sum.accepted == 1 ? "" : "es") + " accepted, " + std::to_string(sum.rejected) +
@@ -354,29 +374,26 @@ void runFly(const FlyOptions& o) {
     const maps::JsonNode list = doc.is_object() ? root.at("faults") : root;
     for (std::size_t i = 0; i < list.array().size(); ++i) sim.faults.push_back(integrity::sim::parseFault(list.item(i)));
   }
-  std::ofstream out(o.out);
-  if (!out) throw ParseError(o.out, 0, "--out", o.out, "a writable file");
-  std::ofstream truth;
-  if (!o.truth.empty()) {
-    truth.open(o.truth);
-    if (!truth) throw ParseError(o.truth, 0, "--truth", o.truth, "a writable file");
-    truth << "line,time,t_s,lat_deg,lon_deg,h_ell_m,faulty_sat\n";
-  }
+  // Both files are staged and written in place only when the flight has been written whole.
+  maps::OutputSet outputs;
+  std::ostream& out = outputs.add(o.out, "--out");
+  std::ostream* truth = o.truth.empty() ? nullptr : &outputs.add(o.truth, "--truth");
+  if (truth) *truth << "line,time,t_s,lat_deg,lon_deg,h_ell_m,faulty_sat\n";
   Progress bar("flying", o.progress);
   const std::vector<planner::SimulatedFix> fixes =
       planner::simulateFlight(plan, approver, sim, [&bar](double f) { bar(static_cast<std::size_t>(f * 1000.0), 1000); });
   if (fixes.empty()) throw ParseError(o.report, 0, "$.route", "", "a route long enough for one GNSS epoch (1 s of flight)");
   for (const planner::SimulatedFix& f : fixes) {
     out << planner::trackFixJson(f.fix).dump() << '\n';
-    if (truth.is_open()) {
+    if (truth) {
       char buf[200];
       std::snprintf(buf, sizeof buf, "%zu,%s,%.3f,%.9f,%.9f,%.4f,%s\n", f.fix.line, maps::formatRfc3339(f.fix.time, 3).c_str(),
                     f.t_s, maps::rad2deg(f.truth.lat_rad), maps::rad2deg(f.truth.lon_rad), f.truth.h_ell_m,
                     f.faulty ? f.faulty->str().c_str() : "");
-      truth << buf;
+      *truth << buf;
     }
   }
-  if (!out) throw ParseError(o.out, 0, "--out", o.out, "a file with room for the fixes");
+  outputs.commit();
   std::cerr << "skylane: fly: " << fixes.size() << " fixes of flight " << sim.flight << " (" << fixes.front().t_s << "–"
             << fixes.back().t_s << " s" << (sim.imu ? ", with IMU increments" : "") << ", " << sim.faults.size()
             << " fault(s)) written to " << o.out << "\n";

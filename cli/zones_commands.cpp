@@ -8,13 +8,13 @@
 #include "cli/json_numbers.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/geoid.hpp"
+#include "maps/atomic_file.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/terrain.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
-#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -259,9 +259,7 @@ void runExport(const ExportOptions& o) {
   if (o.output.empty()) {
     std::cout << out.dump(1) << "\n";
   } else {
-    std::ofstream f(o.output);
-    if (!f) throw ParseError(o.output, 0, "--output", o.output, "a writable file");
-    f << out.dump(1) << "\n";
+    maps::writeFileAtomically(o.output, out.dump(1) + "\n", "--output");
   }
 }
 

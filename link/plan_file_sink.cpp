@@ -1,16 +1,16 @@
 #include "link/plan_file_sink.hpp"
 
+#include "maps/atomic_file.hpp"
 #include "planner/report_formats.hpp"
 
 #include <cctype>
 #include <filesystem>
-#include <fstream>
 
 namespace skylane::link {
 
 PlanFileSink::PlanFileSink(std::string dir, const planner::Tracker& tracker, Log log)
     : dir_(std::move(dir)), tracker_(tracker), log_(std::move(log)) {
-  std::filesystem::create_directories(dir_);
+  maps::createOutputFolder(dir_, "");
 }
 
 void PlanFileSink::write(const planner::TrackEvent& e, const std::string&) {
@@ -22,7 +22,7 @@ void PlanFileSink::write(const planner::TrackEvent& e, const std::string&) {
   const std::filesystem::path path =
       std::filesystem::path(dir_) / (name + "-route" + std::to_string(e.body.value("route_version", 0)) + ".plan");
   const planner::ApprovedFlight flight = planner::parseApprovalReport(e.body.at("report"), "replan of " + e.flight);
-  std::ofstream(path) << qgcPlan(flight, tracker_.approver(e.flight)).dump(2) << "\n";
+  maps::writeFileAtomically(path.string(), qgcPlan(flight, tracker_.approver(e.flight)).dump(2) + "\n", "");
   if (log_) log_("wrote " + path.string());
 }
 

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include <sys/mount.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -117,6 +118,47 @@ inline CommandResult runCommand(const std::string& command) {
   const int st = pclose(p);
   r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   return r;
+}
+
+/// A small tmpfs mounted on a scratch folder for full-disk cases, when this process may mount
+/// (root, or a container with CAP_SYS_ADMIN); mounted() is false otherwise and the test skips.
+class SmallDisk {
+ public:
+  explicit SmallDisk(const std::string& name, const std::string& size = "64k") : path_(scratchPath(name)) {
+    std::filesystem::create_directories(path_);
+    mounted_ = ::geteuid() == 0 && ::mount("tmpfs", path_.c_str(), "tmpfs", 0, ("size=" + size).c_str()) == 0;
+  }
+  ~SmallDisk() {
+    if (mounted_) ::umount2(path_.c_str(), MNT_DETACH);
+  }
+  SmallDisk(const SmallDisk&) = delete;
+  SmallDisk& operator=(const SmallDisk&) = delete;
+  [[nodiscard]] bool mounted() const { return mounted_; }
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  bool mounted_ = false;
+};
+
+/// The whole file as text ("" when it cannot be read).
+inline std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// The names in a folder that start with '.' (an output's temporary files), for checks that
+/// none is left behind.
+inline std::vector<std::string> hiddenFiles(const std::string& folder) {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(folder, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!name.empty() && name[0] == '.') out.push_back(name);
+  }
+  return out;
 }
 
 }  // namespace skylane::test

@@ -32,10 +32,15 @@ class JsonLinesSink final : public EventSink {
   void write(const TrackEvent& event, const std::string& json_line) override;
   void flush() override;
   [[nodiscard]] bool closed() const override { return closed_; }
+  /// \brief The system's error (errno) of the write that closed the sink (EPIPE: the reader has
+  /// gone; ENOSPC: a full disk), 0 when open or unknown.
+  [[nodiscard]] int error() const { return error_; }
 
  private:
+  void check();
   std::ostream& out_;
   bool closed_ = false;
+  int error_ = 0;
 };
 
 /// \brief The events kept in memory (tests, a service's response).

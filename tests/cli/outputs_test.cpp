@@ -1,0 +1,160 @@
+// Outputs end to end (issue 23, items 3, 8 and 10): every command that writes files writes
+// them whole or not at all — a write error (a missing folder, a file in the way, a full disk,
+// standard output on /dev/full) exits 2 with one line naming the file, and a failing command
+// leaves the outputs of an earlier run as they were.
+#include "tests/test_util.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace skylane {
+namespace {
+
+using RunResult = test::CommandResult;
+
+const std::string kBin = SKYLANE_BINARY;
+const std::string kExamples = std::string(SKYLANE_TEST_DATA) + "/../../examples";
+
+/// The skylane command with these arguments, stdout and stderr together.
+RunResult run(const std::string& args) { return test::runCommand(kBin + " " + args + " 2>&1"); }
+
+/// A line-count of text (the error contract: one line).
+std::size_t lines(const std::string& text) { return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')); }
+
+/// The example mission approved once for the suite (its report feeds fly, track and plan export).
+class CliOutputs : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(test::scratchPath("cli-outputs"));
+    std::filesystem::create_directories(*dir_);
+    const RunResult r = test::runCommand(kBin + " approve " + kExamples + "/approve/mission.json --out " + *dir_ +
+                                         "/approve > /dev/null 2>&1");
+    ASSERT_EQ(r.status, 0) << r.out;
+    std::ofstream(*dir_ + "/plain") << "a regular file where a folder is expected\n";
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static std::string report() { return *dir_ + "/approve/report.json"; }
+  /// A file holding `text` from "an earlier run".
+  static std::string earlier(const std::string& name, const std::string& text = "earlier run\n") {
+    const std::string path = *dir_ + "/" + name;
+    std::ofstream(path) << text;
+    return path;
+  }
+  static std::string* dir_;
+};
+std::string* CliOutputs::dir_ = nullptr;
+
+TEST_F(CliOutputs, TrackMapIntoAMissingFolderExitsTwoBeforeTheRun) {
+  const std::string fixes = *dir_ + "/fixes.jsonl";
+  ASSERT_EQ(run("fly " + report() + " --out " + fixes).status, 0);
+  const RunResult r = run("track --approval " + report() + " --input " + fixes + " --no-replan --map /nonexistent/m.svg");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_EQ(r.out, "skylane: error: /nonexistent/m.svg: cannot write (--map): its folder /nonexistent does not exist\n");
+}
+
+TEST_F(CliOutputs, FlyWithATruthFileItCannotWriteLeavesTheEarlierFixes) {
+  const std::string fixes = earlier("fly_fixes.jsonl");
+  const RunResult r = run("fly " + report() + " --out " + fixes + " --truth /nonexistent/t.csv");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("/nonexistent/t.csv: cannot write (--truth)"), std::string::npos) << r.out;
+  EXPECT_EQ(lines(r.out), 1u) << r.out;
+  EXPECT_EQ(test::readFile(fixes), "earlier run\n");
+}
+
+TEST_F(CliOutputs, PredictWithAPlotItCannotWriteLeavesTheEarlierOutput) {
+  const std::string csv = earlier("predict.csv");
+  const RunResult r = run("integrity predict --almanac " + test::dataPath("gnss/alm01jan2020.txt") +
+                          " --lat 47 --lon 8 --start 2020-01-01T00:00:00Z --duration 1h --output " + csv +
+                          " --plot /nonexistent/p.svg");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_EQ(r.out, "skylane: error: /nonexistent/p.svg: cannot write (--plot): its folder /nonexistent does not exist\n");
+  EXPECT_EQ(test::readFile(csv), "earlier run\n");
+}
+
+TEST_F(CliOutputs, AFailingCommandLeavesEveryEarlierOutputIntact) {
+  // GIVEN outputs of an earlier run WHEN the same command fails on its input THEN they stay
+  const std::string plan = earlier("export.plan"), zones = earlier("zones.geojson");
+  const std::string bad = earlier("bad.json", "{\"not\": \"a report\"}\n");
+  EXPECT_EQ(run("plan export " + bad + " --out " + plan).status, 2);
+  EXPECT_EQ(run("zones export " + bad + " --output " + zones).status, 2);
+  EXPECT_EQ(test::readFile(plan), "earlier run\n");
+  EXPECT_EQ(test::readFile(zones), "earlier run\n");
+  // AND the same commands on good input replace them whole
+  EXPECT_EQ(run("plan export " + report() + " --out " + plan).status, 0);
+  EXPECT_EQ(nlohmann::json::parse(test::readFile(plan)).at("fileType"), "Plan");
+  EXPECT_TRUE(test::hiddenFiles(*dir_).empty());
+}
+
+TEST_F(CliOutputs, AnOutputUnderARegularFileExitsTwoNamingIt) {
+  const std::string under = *dir_ + "/plain/";
+  struct Case {
+    std::string args, expected;
+  };
+  const Case cases[] = {
+      {"zones export " + kExamples + "/zones/geo-awareness-che-1.json --output " + under + "z.geojson",
+       under + "z.geojson: cannot write (--output): its folder"},
+      {"approve " + kExamples + "/approve/mission.json --out " + under + "approve",
+       under + "approve: cannot write (--out): cannot make the folder: "},
+      {"simulate " + kExamples + "/simulate/gnss_ins_no_fault.json --out " + under + "sim",
+       under + "sim: cannot write (--out): cannot make the folder: "},
+      {"track --approval " + report() + " --input /dev/null --out " + under + "events.jsonl",
+       under + "events.jsonl: cannot write (--out): Not a directory"},
+      {"plan export " + report() + " --out " + under + "x.plan", under + "x.plan: cannot write (--out): its folder"},
+  };
+  for (const Case& c : cases) {
+    const RunResult r = run(c.args);
+    EXPECT_EQ(r.status, 2) << c.args << "\n" << r.out;
+    EXPECT_NE(r.out.find("skylane: error: " + c.expected), std::string::npos) << c.args << "\n" << r.out;
+    EXPECT_EQ(lines(r.out), 1u) << c.args << "\n" << r.out;
+  }
+}
+
+TEST_F(CliOutputs, AWriteErrorOnStandardOutputExitsTwo) {
+  const RunResult r = test::runCommand(kBin + " integrity pl --geometry " + kExamples + "/predict/geometry.json 2>&1 > /dev/full");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_EQ(r.out, "skylane: error: standard output: cannot write: No space left on device\n");
+  // A rejected approval (exit 1) with its report lost is a write error too.
+  const RunResult rejected =
+      test::runCommand(kBin + " approve " + kExamples + "/approve/mission_rejected.json 2>&1 > /dev/full | tail -n 1");
+  EXPECT_EQ(rejected.out, "skylane: error: standard output: cannot write: No space left on device\n");
+}
+
+TEST_F(CliOutputs, ApproveOnAFullDiskExitsTwoAndKeepsTheEarlierReport) {
+  test::SmallDisk disk("approve-full");
+  if (!disk.mounted()) GTEST_SKIP() << "mounting a tmpfs needs root";
+  const std::string out = disk.path() + "/approve";
+  std::filesystem::create_directories(out);
+  std::ofstream(out + "/report.json") << "earlier run\n";
+  const RunResult r = run("approve " + kExamples + "/approve/mission.json --out " + out);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("skylane: error: " + out + "/"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(": cannot write (--out): No space left on device\n"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("APPROVED"), std::string::npos) << r.out;
+  EXPECT_EQ(test::readFile(out + "/report.json"), "earlier run\n");
+  EXPECT_TRUE(test::hiddenFiles(out).empty());
+}
+
+TEST_F(CliOutputs, PredictAndTrackOnAFullDiskExitTwoNamingTheFile) {
+  test::SmallDisk disk("stream-full");
+  if (!disk.mounted()) GTEST_SKIP() << "mounting a tmpfs needs root";
+  const std::string csv = disk.path() + "/predict.csv";
+  const RunResult p = run("integrity predict --almanac " + test::dataPath("gnss/alm01jan2020.txt") +
+                          " --lat 47 --lon 8 --start 2020-01-01T00:00:00Z --duration 24h --step 30s --output " + csv);
+  EXPECT_EQ(p.status, 2) << p.out;
+  EXPECT_EQ(p.out, "skylane: error: " + csv + ": cannot write (--output): No space left on device\n");
+  EXPECT_FALSE(std::filesystem::exists(csv));
+  // The tracker's event stream is appended as it goes (not atomic); a full disk stops it with exit 2.
+  const std::string fixes = *dir_ + "/full_fixes.jsonl", events = disk.path() + "/events.jsonl";
+  ASSERT_EQ(run("fly " + report() + " --out " + fixes).status, 0);
+  const RunResult t = run("track --approval " + report() + " --input " + fixes + " --no-replan --out " + events);
+  EXPECT_EQ(t.status, 2) << t.out;
+  EXPECT_NE(t.out.find("skylane: error: " + events + ": cannot write (--out): No space left on device\n"), std::string::npos)
+      << t.out;
+}
+
+}  // namespace
+}  // namespace skylane
