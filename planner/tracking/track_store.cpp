@@ -1,10 +1,14 @@
 #include "planner/tracking/track_store.hpp"
 
+#include "maps/atomic_file.hpp"
+#include "maps/parse_error.hpp"
 #include "maps/time.hpp"
 
 #include <sqlite3.h>
 
+#include <filesystem>
 #include <stdexcept>
+#include <system_error>
 
 namespace skylane::planner {
 
@@ -25,10 +29,34 @@ std::string columnText(sqlite3_stmt* s, int i) {
   return t ? std::string(reinterpret_cast<const char*>(t)) : std::string();
 }
 
+/// A SQLite failure as the error a user can act on: a file that is not a tracker database, or
+/// is damaged, is bad input (ParseError); the rest (cannot open, a full disk, no permission, a
+/// lock held by another process) is a database that cannot be written (OutputError).
+[[noreturn]] void raiseStoreError(const std::string& path, int code, const std::string& what, const std::string& reason) {
+  const int primary = code & 0xff;
+  if (primary == SQLITE_NOTADB || primary == SQLITE_CORRUPT) {
+    throw maps::ParseError(path, 0, "(tracker database)", reason, "an undamaged skylane tracker database (SQLite 3)");
+  }
+  throw maps::OutputError(path, "", "tracker database: " + what + ": " + reason);
+}
+
 }  // namespace
 
 TrackStore::TrackStore(const std::string& path) : path_(path) {
-  if (sqlite3_open(path.c_str(), &db_) != SQLITE_OK) fail("cannot open");
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw maps::ParseError(path, 0, "(tracker database)", "a folder", "a tracker database file (SQLite 3)");
+  }
+  try {
+    open();
+  } catch (...) {
+    close();  // the constructor throws: no destructor runs to release the connection
+    throw;
+  }
+}
+
+void TrackStore::open() {
+  if (sqlite3_open(path_.c_str(), &db_) != SQLITE_OK) fail("cannot open");
   sqlite3_busy_timeout(db_, 2000);
   // WAL: a kill between batches leaves the last committed batch intact; NORMAL sync is durable
   // against a process kill (the case a restart resumes from), not against power loss.
@@ -51,23 +79,30 @@ TrackStore::~TrackStore() {
   // A batch still open here was cut short (an error unwound the run): it is not half-kept —
   // its events without the states and input position would be stored twice after a restart.
   if (in_batch_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-  sqlite3_finalize(put_flight_);
-  sqlite3_finalize(put_state_);
-  sqlite3_finalize(put_event_);
-  sqlite3_finalize(put_input_);
-  sqlite3_close(db_);
+  close();
+}
+
+void TrackStore::close() noexcept {
+  for (sqlite3_stmt** s : {&put_flight_, &put_state_, &put_event_, &put_input_}) {
+    sqlite3_finalize(*s);
+    *s = nullptr;
+  }
+  sqlite3_close(db_);  // also a handle that sqlite3_open() returned with an error
+  db_ = nullptr;
 }
 
 void TrackStore::fail(const std::string& what) const {
-  throw std::runtime_error("tracker database " + path_ + ": " + what + ": " + (db_ ? sqlite3_errmsg(db_) : "out of memory"));
+  if (!db_) raiseStoreError(path_, SQLITE_NOMEM, what, "out of memory");
+  raiseStoreError(path_, sqlite3_extended_errcode(db_), what, sqlite3_errmsg(db_));
 }
 
 void TrackStore::exec(const char* sql) const {
   char* err = nullptr;
-  if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
-    const std::string msg = err ? err : "?";
+  const int rc = sqlite3_exec(db_, sql, nullptr, nullptr, &err);
+  if (rc != SQLITE_OK) {
+    const std::string msg = err ? err : sqlite3_errstr(rc);
     sqlite3_free(err);
-    throw std::runtime_error("tracker database " + path_ + ": " + sql + ": " + msg);
+    raiseStoreError(path_, rc, sql, msg);
   }
 }
 

@@ -35,7 +35,9 @@ struct StoredFlight {
 class TrackStore final : public EventSink {
  public:
   /// \brief Opens (creates) the database file.
-  /// \throws std::runtime_error naming the file and SQLite's message.
+  /// \throws maps::ParseError when the file is a folder, not a SQLite database or damaged;
+  /// maps::OutputError when it cannot be opened or written (both name the file and SQLite's
+  /// message). Every later failure (a full disk at a COMMIT) throws the same way.
   explicit TrackStore(const std::string& path);
   ~TrackStore() override;
   TrackStore(const TrackStore&) = delete;
@@ -65,6 +67,8 @@ class TrackStore final : public EventSink {
   [[nodiscard]] const std::string& path() const { return path_; }
 
  private:
+  void open();
+  void close() noexcept;
   void exec(const char* sql) const;
   [[noreturn]] void fail(const std::string& what) const;
   std::string path_;

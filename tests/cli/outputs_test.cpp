@@ -113,6 +113,25 @@ TEST_F(CliOutputs, AnOutputUnderARegularFileExitsTwoNamingIt) {
   }
 }
 
+TEST_F(CliOutputs, DatabaseProblemsExitTwoNamingTheFile) {
+  const std::string folder = *dir_ + "/db_folder";
+  std::filesystem::create_directories(folder);
+  struct Case {
+    std::string db, expected;
+  };
+  const Case cases[] = {
+      {report(), report() + ": field '(tracker database)': got 'file is not a database'"},
+      {folder, folder + ": field '(tracker database)': got 'a folder'"},
+      {*dir_ + "/plain/track.sqlite", *dir_ + "/plain/track.sqlite: cannot write: tracker database: cannot open"},
+  };
+  for (const Case& c : cases) {
+    const RunResult r = run("track --approval " + report() + " --input /dev/null --db " + c.db);
+    EXPECT_EQ(r.status, 2) << c.db << "\n" << r.out;
+    EXPECT_NE(r.out.find("skylane: error: " + c.expected), std::string::npos) << r.out;
+    EXPECT_EQ(lines(r.out), 1u) << r.out;
+  }
+}
+
 TEST_F(CliOutputs, AWriteErrorOnStandardOutputExitsTwo) {
   const RunResult r = test::runCommand(kBin + " integrity pl --geometry " + kExamples + "/predict/geometry.json 2>&1 > /dev/full");
   EXPECT_EQ(r.status, 2) << r.out;
