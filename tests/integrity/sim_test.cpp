@@ -435,6 +435,20 @@ TEST(SimScenario, ErrorsNameTheFieldAndWhatWasExpected) {
       {"probability", [](nlohmann::json& j) { j["integrity"]["p_sat"] = 1.5; }, {"p_sat", "probability"}},
       {"both trajectories", [](nlohmann::json& j) { j["trajectory"]["waypoints"] = nlohmann::json::array(); }, {"lawnmower"}},
       {"zero lines", [](nlohmann::json& j) { j["trajectory"]["lawnmower"]["lines"] = 0; }, {"lawnmower.lines", "1…1000"}},
+      // Bounds (issue 23 item 9): each number that feeds a loop, the frame or the clock.
+      {"IMU rate 1e9", [](nlohmann::json& j) { j["imu"]["rate_hz"] = 1e9; }, {"test.json", "$.imu.rate_hz", "1000000000", "≤ 2000 Hz"}},
+      {"IMU samples", [](nlohmann::json& j) { j["imu"]["rate_hz"] = 2000; j["trajectory"]["lawnmower"]["lines"] = 100; },
+       {"$.imu.rate_hz", "at most 2e+07 IMU samples"}},
+      {"IMU rate not a multiple", [](nlohmann::json& j) { j["gnss"]["rate_hz"] = 3; }, {"$.imu.rate_hz", "whole multiple of the GNSS rate (3 Hz)"}},
+      {"GNSS rate", [](nlohmann::json& j) { j["gnss"]["rate_hz"] = 1e6; }, {"$.gnss.rate_hz", "≤ 20 Hz"}},
+      {"spacing 1e99", [](nlohmann::json& j) { j["trajectory"]["lawnmower"]["spacing_m"] = 1e99; },
+       {"lawnmower.spacing_m", "1e+99", "lines × spacing within 100 km"}},
+      {"line length", [](nlohmann::json& j) { j["trajectory"]["lawnmower"]["line_length_m"] = 1e12; }, {"line_length_m", "≤ 100000 m"}},
+      {"slow flight", [](nlohmann::json& j) { j["trajectory"]["lawnmower"]["speed_mps"] = 1e-3; },
+       {"$.trajectory", "a flight of at most 86400 s"}},
+      {"height", [](nlohmann::json& j) { j["origin"]["h_ell_m"] = 1e308; }, {"origin.h_ell_m", "[-1000, 20000] m"}},
+      {"fault end", [](nlohmann::json& j) { j["faults"][1]["end_s"] = 1e99; }, {"faults[1].end_s", "[0, 86400] s"}},
+      {"fault bias", [](nlohmann::json& j) { j["faults"][0]["bias_sigma"] = 1e308; }, {"faults[0].bias_sigma", "sigma"}},
       {"unflyable reversal",
        [](nlohmann::json& j) {
          j["trajectory"].erase("lawnmower");
