@@ -115,6 +115,19 @@ TimeWindow parseTimeWindow(const std::string& start, const std::string& duration
   return w;
 }
 
+/// Heights a GNSS user can have: below the Dead Sea shore to the top of the atmosphere (100 km,
+/// where the troposphere model and the sky mask end); beyond, the signal geometry is garbage.
+constexpr double kMinUserHeight_m = -1000.0, kMaxUserHeight_m = 100e3;
+
+double parseUserHeight(double alt_m) {
+  if (!(alt_m >= kMinUserHeight_m && alt_m <= kMaxUserHeight_m)) {
+    char value[32];
+    std::snprintf(value, sizeof value, "%g", alt_m);
+    throw ParseError("--alt", 0, "--alt", value, "an ellipsoidal height in [-1000, 100000] m");
+  }
+  return alt_m;
+}
+
 double parseMask(double mask_deg) {
   if (!(mask_deg >= 0 && mask_deg < 90)) {
     throw ParseError("--mask-deg", 0, "--mask-deg", std::to_string(mask_deg), "an elevation mask in [0, 90) degrees");
@@ -212,8 +225,7 @@ integrity::PredictRequest predictRequest(const PredictOptions& o) {
   integrity::PredictRequest req;
   if (!(o.lat_deg >= -90 && o.lat_deg <= 90)) throw ParseError("--lat", 0, "--lat", std::to_string(o.lat_deg), "a latitude in [-90, 90] degrees");
   if (!(o.lon_deg >= -180 && o.lon_deg <= 360)) throw ParseError("--lon", 0, "--lon", std::to_string(o.lon_deg), "a longitude in degrees");
-  if (!std::isfinite(o.alt_m)) throw ParseError("--alt", 0, "--alt", std::to_string(o.alt_m), "an ellipsoidal height in metres");
-  req.place = {maps::deg2rad(o.lat_deg), maps::deg2rad(o.lon_deg), o.alt_m};
+  req.place = {maps::deg2rad(o.lat_deg), maps::deg2rad(o.lon_deg), parseUserHeight(o.alt_m)};
   const TimeWindow window = parseTimeWindow(o.start, o.duration, o.step, 1e6);
   req.start = window.start;
   req.duration_s = window.duration_s;
@@ -434,8 +446,7 @@ void runAvailability(const AvailabilityOptions& o) {
   req.duration_s = window.duration_s;
   req.step_s = window.step_s;
   req.mask_rad = parseMask(o.mask_deg);
-  if (!std::isfinite(o.alt_m)) throw ParseError("--alt", 0, "--alt", std::to_string(o.alt_m), "an ellipsoidal height in metres");
-  req.user_h_m = o.alt_m;
+  req.user_h_m = parseUserHeight(o.alt_m);
   if (o.threads < 0 || o.threads > 256) throw ParseError("--threads", 0, "--threads", std::to_string(o.threads), "0 (all cores) to 256");
   req.threads = o.threads;
   req.araim.horizontal_only = o.horizontal_only;

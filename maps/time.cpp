@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
+#include <stdexcept>
 #include <string>
 
 namespace skylane::maps {
@@ -87,8 +89,16 @@ bool isValidCalendar(const CalendarTime& c) {
 }
 
 GpsTime GpsTime::fromTotalSeconds(double t_s) {
+  // A non-finite time, or one whose week does not fit an int, would make the cast below
+  // undefined behaviour; every input time is range-checked before it gets here.
+  const double week = std::floor(t_s / kSecondsPerWeek);
+  if (!(std::abs(week) <= static_cast<double>(std::numeric_limits<int>::max()) - 1.0)) {
+    char value[40];
+    std::snprintf(value, sizeof value, "%g", t_s);
+    throw std::invalid_argument(std::string("GPS time: ") + value + " s since the GPS epoch is not a time (|weeks| < 2^31 expected)");
+  }
   GpsTime t;
-  t.week = static_cast<int>(std::floor(t_s / kSecondsPerWeek));
+  t.week = static_cast<int>(week);
   t.sow = t_s - t.week * kSecondsPerWeek;
   return t;
 }

@@ -33,6 +33,7 @@ struct GpsTime {
   /// \brief Seconds since the GPS epoch (1980-01-06 00:00:00 GPS).
   [[nodiscard]] double totalSeconds() const { return week * kSecondsPerWeek + sow; }
   /// \brief From seconds since the GPS epoch.
+  /// \throws std::invalid_argument when t_s is not finite or its week does not fit an int.
   [[nodiscard]] static GpsTime fromTotalSeconds(double t_s);
   /// \brief This time plus dt seconds, normalised.
   [[nodiscard]] GpsTime plus(double dt_s) const { return fromTotalSeconds(totalSeconds() + dt_s); }
@@ -40,7 +41,8 @@ struct GpsTime {
 
 /// \brief t1 − t0 in seconds.
 [[nodiscard]] inline double operator-(const GpsTime& t1, const GpsTime& t0) {
-  return (t1.week - t0.week) * kSecondsPerWeek + (t1.sow - t0.sow);
+  // The weeks are subtracted as doubles: two int weeks far apart would overflow an int.
+  return (static_cast<double>(t1.week) - static_cast<double>(t0.week)) * kSecondsPerWeek + (t1.sow - t0.sow);
 }
 
 /// \brief True for a real calendar date-time in 1980 … 2200 (month lengths, leap years,

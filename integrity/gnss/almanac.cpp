@@ -198,7 +198,8 @@ GpsTime resolveAlmanacEpoch(int week_field, double toa_s, const GpsTime& near) {
   // The roll-over count that brings t_oa nearest to `near` (never before week_field itself).
   const double rollovers = std::round((near.totalSeconds() - GpsTime{week_field, toa_s}.totalSeconds()) /
                                       (kAlmanacWeekModulus * kSecondsPerWeek));
-  const int k = static_cast<int>(std::clamp(rollovers, 0.0, 1e6));
+  // (NaN, from a time that is not one, is taken as no roll-over: its cast would be undefined.)
+  const int k = std::isfinite(rollovers) ? static_cast<int>(std::clamp(rollovers, 0.0, 1e6)) : 0;
   return GpsTime{week_field + k * kAlmanacWeekModulus, toa_s};
 }
 

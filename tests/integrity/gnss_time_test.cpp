@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
 namespace skylane::integrity {
 namespace {
 
@@ -71,6 +75,21 @@ TEST(GnssTime, DaysFromCivilMatchesKnownDates) {
   EXPECT_EQ(daysFromCivil(1970, 1, 1), 0);
   EXPECT_EQ(daysFromCivil(1980, 1, 6), 3657);
   EXPECT_EQ(daysFromCivil(2000, 3, 1), 11017);
+}
+
+TEST(GnssTime, ATimeThatIsNotOneIsAnErrorNotUndefinedBehaviour) {
+  // (issue 23 item 12: −inf reached the int cast of the week)
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const double t : {inf, -inf, std::nan(""), 1e300, -1e300}) {
+    EXPECT_THROW((void)GpsTime::fromTotalSeconds(t), std::invalid_argument) << t;
+  }
+  // The largest week that fits still converts, and back.
+  const GpsTime far = GpsTime::fromTotalSeconds(2.0e9 * 604800.0);
+  EXPECT_EQ(far.week, 2000000000);
+  EXPECT_DOUBLE_EQ(far.sow, 0.0);
+  // Differences of weeks far apart are computed in doubles (an int subtraction would overflow).
+  const GpsTime a{2000000000, 0.0}, b{-2000000000, 0.0};
+  EXPECT_DOUBLE_EQ(a - b, 4.0e9 * 604800.0);
 }
 
 }  // namespace
