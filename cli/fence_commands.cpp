@@ -6,6 +6,7 @@
 #include "cli/json_numbers.hpp"
 #include "cli/skymask_commands.hpp"
 #include "geofence/corridor_file.hpp"
+#include "maps/text_file.hpp"
 #include "geofence/fix.hpp"
 #include "geofence/obstruction_files.hpp"
 #include "geofence/verdict_json.hpp"
@@ -86,6 +87,7 @@ void runFenceCheck(const FenceCheckOptions& o) {
   // and the stream goes on.
   std::ifstream file;
   if (o.fixes != "-") {
+    maps::requireNotAFolder(o.fixes, "--fixes");
     file.open(o.fixes);
     if (!file) throw ParseError(o.fixes, 0, "--fixes", o.fixes, "a readable JSON-lines file");
   }

@@ -55,10 +55,10 @@ int main(int argc, char** argv) {
     std::cerr << "skylane: error: " << e.what() << "\n";
     return 2;
   } catch (const std::invalid_argument& e) {
-    std::cerr << "skylane: error: " << e.what() << "\n";
+    std::cerr << "skylane: error: " << skylane::maps::printable(e.what()) << "\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "skylane: internal error: " << e.what() << "\n";
+    std::cerr << "skylane: internal error: " << skylane::maps::printable(e.what()) << "\n";
     return 1;
   }
   return afterStandardOutput(0);

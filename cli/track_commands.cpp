@@ -205,7 +205,32 @@ bool linkCanUpload(const TrackOptions& o) {
   return o.input.rfind("udp://", 0) == 0 || (stat(o.input.c_str(), &info) == 0 && S_ISCHR(info.st_mode));
 }
 
+/// A longest time a tracker option can name (a day of stream time).
+constexpr double kMaxTrackerSeconds = 86400.0;
+/// The widest horizon a fix event lists zones within.
+constexpr double kMaxHorizon_m = 100e3;
+
+/// The tracker's numeric options in their ranges, each error naming the option as typed.
+void requireTrackerRanges(const planner::TrackerOptions& t) {
+  const auto need = [](bool ok, const char* option, double value, const char* expected) {
+    if (ok) return;
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", value);
+    throw ParseError(option, 0, option, text, expected);
+  };
+  need(t.stale_after_s > 0 && t.stale_after_s <= kMaxTrackerSeconds, "--stale-after", t.stale_after_s, "seconds in (0, 86400]");
+  need(t.max_time_jump_s > 0 && t.max_time_jump_s <= kMaxTrackerSeconds, "--max-time-jump", t.max_time_jump_s,
+       "seconds in (0, 86400]");
+  need(t.replan_cooldown_s >= 0 && t.replan_cooldown_s <= kMaxTrackerSeconds, "--cooldown", t.replan_cooldown_s,
+       "seconds in [0, 86400]");
+  need(t.join_timeout_s > 0 && t.join_timeout_s <= kMaxTrackerSeconds, "--join-timeout", t.join_timeout_s, "seconds in (0, 86400]");
+  need(t.horizon_m >= 0 && t.horizon_m <= kMaxHorizon_m, "--horizon", t.horizon_m, "metres in [0, 100000]");
+  need(t.recover_after >= 1, "--recover-after", t.recover_after, "a whole number ≥ 1");
+  need(t.jump_confirm >= 1, "--jump-confirm", t.jump_confirm, "a whole number ≥ 1");
+}
+
 planner::TrackerOptions trackerOptions(const TrackOptions& o) {
+  requireTrackerRanges(o.tracker);
   planner::TrackerOptions topt = o.tracker;
   topt.handoff_by_link = linkCanUpload(o);
   std::tie(topt.level1_m, topt.level1_n) = parseMofN(o.level1, "--level1");

@@ -25,11 +25,15 @@ double longitude(const JsonNode& n) {
   return maps::deg2rad(v);
 }
 
-double positive(const JsonNode& n) {
-  const double v = n.number();
-  if (!(v > 0)) n.fail("a positive number of metres");
-  return v;
-}
+/// Vehicle sizes: any UAS is smaller than this (the largest span about 80 m); a size of 1e308
+/// made the alert limits k × size infinite.
+constexpr double kMaxVehicleSize_m = 1000.0;
+/// k1, k2 with override_ranges (their ranges are 1.1–1.3 and 100–1000).
+constexpr double kMaxBoxFactor = 1e4;
+/// Heights of the path and the operating limits: below the Dead Sea shore to 100 km.
+constexpr double kMinHeight_m = -1000.0, kMaxHeight_m = 100e3;
+
+double positive(const JsonNode& n) { return n.positiveUpTo(kMaxVehicleSize_m, "m"); }
 
 Dimension dimension(const JsonNode& n) {
   const std::string s = n.str();
@@ -52,7 +56,7 @@ CorridorSpec parseCorridorSpec(const nlohmann::json& doc, const std::string& sou
   for (std::size_t i = 0; i < path.j.size(); ++i) {
     const JsonNode w = path.item(i);
     w.requireKnownFields({"lat", "lon", "h_ell_m"});
-    spec.path.push_back({latitude(w.at("lat")), longitude(w.at("lon")), w.at("h_ell_m").number()});
+    spec.path.push_back({latitude(w.at("lat")), longitude(w.at("lon")), w.at("h_ell_m").numberIn(kMinHeight_m, kMaxHeight_m, "m")});
   }
   spec.origin = spec.path.front();
   if (root.has("origin")) {
@@ -65,8 +69,8 @@ CorridorSpec parseCorridorSpec(const nlohmann::json& doc, const std::string& sou
   spec.vehicle.lateral_m = positive(v.at("lateral_m"));
   spec.vehicle.longitudinal_m = positive(v.at("longitudinal_m"));
   if (v.has("height_m")) spec.vehicle.height_m = positive(v.at("height_m"));
-  if (root.has("k1")) spec.levels.k1 = root.at("k1").number();
-  if (root.has("k2")) spec.levels.k2 = root.at("k2").number();
+  if (root.has("k1")) spec.levels.k1 = root.at("k1").positiveUpTo(kMaxBoxFactor, "(a factor)");
+  if (root.has("k2")) spec.levels.k2 = root.at("k2").positiveUpTo(kMaxBoxFactor, "(a factor)");
   if (root.has("override_ranges")) spec.levels.override_ranges = root.at("override_ranges").boolean();
   if (root.has("alert_mapping")) {
     const JsonNode m = root.at("alert_mapping");
@@ -77,8 +81,8 @@ CorridorSpec parseCorridorSpec(const nlohmann::json& doc, const std::string& sou
   if (root.has("operating_limits")) {
     const JsonNode o = root.at("operating_limits");
     o.requireKnownFields({"floor_h_ell_m", "ceiling_h_ell_m"});
-    if (o.has("floor_h_ell_m")) spec.operating.floor_h_ell_m = o.at("floor_h_ell_m").number();
-    if (o.has("ceiling_h_ell_m")) spec.operating.ceiling_h_ell_m = o.at("ceiling_h_ell_m").number();
+    if (o.has("floor_h_ell_m")) spec.operating.floor_h_ell_m = o.at("floor_h_ell_m").numberIn(kMinHeight_m, kMaxHeight_m, "m");
+    if (o.has("ceiling_h_ell_m")) spec.operating.ceiling_h_ell_m = o.at("ceiling_h_ell_m").numberIn(kMinHeight_m, kMaxHeight_m, "m");
     if (!(spec.operating.floor_h_ell_m < spec.operating.ceiling_h_ell_m)) {
       o.fail("floor_h_ell_m below ceiling_h_ell_m");
     }

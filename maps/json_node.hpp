@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <initializer_list>
 #include <string>
 
@@ -104,6 +105,26 @@ struct JsonNode {
     if (!j.is_number()) fail("a number");
     const double v = j.get<double>();
     if (!std::isfinite(v)) fail("a finite number");
+    return v;
+  }
+  /// \brief A number in [lo, hi]; the error names the range and `unit` ("m", "Hz").
+  [[nodiscard]] double numberIn(double lo, double hi, const std::string& unit) const {
+    const double v = number();
+    if (!(v >= lo && v <= hi)) {
+      char range[96];
+      std::snprintf(range, sizeof range, "a number in [%g, %g] %s", lo, hi, unit.c_str());
+      fail(range);
+    }
+    return v;
+  }
+  /// \brief A number in (0, hi]; the error names the bound and `unit`.
+  [[nodiscard]] double positiveUpTo(double hi, const std::string& unit) const {
+    const double v = number();
+    if (!(v > 0.0 && v <= hi)) {
+      char range[96];
+      std::snprintf(range, sizeof range, "a number > 0 and ≤ %g %s", hi, unit.c_str());
+      fail(range);
+    }
     return v;
   }
   /// \brief true or false.

@@ -8,9 +8,19 @@
 
 namespace skylane::maps {
 
+/// \brief Longest part of an offending value that a message repeats (the rest is cut, "…").
+inline constexpr std::size_t kMaxQuotedBytes = 100;
+
+/// \brief `text` made safe to print on one line of a terminal: control characters (newlines,
+/// escape sequences, NUL), C1 controls and bytes that are not well-formed UTF-8 are written as
+/// escapes (\n, \t, \r, \xNN); cut after `max_bytes` of the input, marked "…". Text that is
+/// already printable comes back unchanged (so applying it twice changes nothing).
+[[nodiscard]] std::string printable(const std::string& text, std::size_t max_bytes = std::string::npos);
+
 /// \brief Bad external input: names the source (file), the line (0 = not line-based), the
 /// field (for JSON a path such as "features[2](LSZB003).geometry.layer.upper"), the offending
 /// value and what was expected.
+/// The message quotes every part through printable(), the value cut at kMaxQuotedBytes.
 class ParseError : public std::runtime_error {
  public:
   ParseError(std::string source, int line, std::string field, std::string value,

@@ -4,13 +4,22 @@
 
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <fstream>
 #include <sstream>
 
 namespace skylane::maps {
 
+void requireNotAFolder(const std::string& path, const std::string& field) {
+  struct stat info {};
+  // (A folder opens for reading and reads as empty: "empty" or "invalid JSON" would hide why.)
+  if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode)) throw ParseError(path, 0, field, "a folder", "a file");
+}
+
 std::string readTextFile(const std::string& path) {
+  requireNotAFolder(path, "file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ParseError(path, 0, "file", "", "a readable file");
   std::ostringstream ss;

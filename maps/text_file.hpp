@@ -9,6 +9,10 @@
 
 namespace skylane::maps {
 
+/// \brief A ParseError naming `path` and `field` (an option such as "--input") when it is a
+/// folder: a folder opens for reading and reads as empty.
+void requireNotAFolder(const std::string& path, const std::string& field);
+
 /// \brief The whole file as bytes; ParseError naming the file when it cannot be read.
 [[nodiscard]] std::string readTextFile(const std::string& path);
 

@@ -23,11 +23,14 @@ namespace {
 /// The latitude limit of mission points (the planner's local frame is not made for the poles).
 constexpr double kMaxMissionLatitude_deg = 89.0;
 
-double positive(const JsonNode& n) {
-  const double v = n.number();
-  if (!(v > 0.0)) n.fail("a number > 0");
-  return v;
-}
+// Bounds of the numbers that become geometry (a margin of 1e308 m made the planner's bounds and
+// the terrain look-ups NaN): far above any UAS, far below a double's range.
+constexpr double kMaxVehicleSize_m = 1000.0;   ///< any UAS is smaller (the largest spans ~80 m)
+constexpr double kMaxSpeed_mps = 300.0;        ///< below the speed of sound
+constexpr double kMaxPlannerLength_m = 10e3;   ///< planner resolution and clearance margin
+constexpr double kMaxTimeLimit_s = 86400.0;    ///< one day of planning
+constexpr double kMaxBoxFactor = 1e4;          ///< k1, k2 with override_ranges (the ranges are 1.1–1.3, 100–1000)
+constexpr double kMaxHeightAgl_m = 20000.0;    ///< above any UAS's ceiling
 
 MissionPoint point(const JsonNode& n) {
   n.requireKnownFields({"lat", "lon"});
@@ -435,11 +438,11 @@ void requireMissionFields(const JsonNode& root) {
 
 void readVehicle(const JsonNode& v, Mission& m) {
   v.requireKnownFields({"lateral_m", "longitudinal_m", "height_m", "cruise_speed_mps", "climb_speed_mps"});
-  m.vehicle.lateral_m = positive(v.at("lateral_m"));
-  m.vehicle.longitudinal_m = positive(v.at("longitudinal_m"));
-  if (v.has("height_m")) m.vehicle.height_m = positive(v.at("height_m"));
-  m.cruise_speed_mps = positive(v.at("cruise_speed_mps"));
-  if (v.has("climb_speed_mps")) m.climb_speed_mps = positive(v.at("climb_speed_mps"));
+  m.vehicle.lateral_m = v.at("lateral_m").positiveUpTo(kMaxVehicleSize_m, "m");
+  m.vehicle.longitudinal_m = v.at("longitudinal_m").positiveUpTo(kMaxVehicleSize_m, "m");
+  if (v.has("height_m")) m.vehicle.height_m = v.at("height_m").positiveUpTo(kMaxVehicleSize_m, "m");
+  m.cruise_speed_mps = v.at("cruise_speed_mps").positiveUpTo(kMaxSpeed_mps, "m/s");
+  if (v.has("climb_speed_mps")) m.climb_speed_mps = v.at("climb_speed_mps").positiveUpTo(kMaxSpeed_mps, "m/s");
 }
 
 /// \brief The route: start, waypoints and goal here, or a QGroundControl .plan; exactly one of
@@ -511,9 +514,9 @@ void readAltitudes(const JsonNode& root, const std::optional<QgcPlanRoute>& plan
     const JsonNode a = root.at("altitude");
     a.requireKnownFields({"cruise_agl_m", "min_agl_m", "max_agl_m", "max_amsl_m"});
     cruise_given = a.has("cruise_agl_m");
-    if (cruise_given) m.cruise_agl_m = positive(a.at("cruise_agl_m"));
+    if (cruise_given) m.cruise_agl_m = a.at("cruise_agl_m").positiveUpTo(kMaxHeightAgl_m, "m");
     if (a.has("min_agl_m")) m.min_agl_m = a.at("min_agl_m").number();
-    if (a.has("max_agl_m")) m.max_agl_m = positive(a.at("max_agl_m"));
+    if (a.has("max_agl_m")) m.max_agl_m = a.at("max_agl_m").positiveUpTo(kMaxHeightAgl_m, "m");
     if (a.has("max_amsl_m")) m.max_amsl_m = a.at("max_amsl_m").number();
   }
   // The plan's common height is the cruise height when it lies within the limits; each point's
@@ -534,7 +537,7 @@ void readDeparture(const JsonNode& root, Mission& m) {
     w.requireKnownFields({"latest", "step_s"});
     m.departure_latest = time(w.at("latest"));
     if (m.departure_latest - m.departure_earliest < 0) w.at("latest").fail("a time not before departure");
-    if (w.has("step_s")) m.departure_step_s = positive(w.at("step_s"));
+    if (w.has("step_s")) m.departure_step_s = w.at("step_s").positiveUpTo(kMaxTimeLimit_s, "s");
   }
 }
 
@@ -570,12 +573,12 @@ void readIntegrity(const JsonNode& n, Mission& m) {
     else if (u == "single_frequency") m.model.setUserModel(integrity::UserErrorModel::kSingleFrequency);
     else n.at("user_model").fail("\"dual_frequency\" or \"single_frequency\"");
   }
-  if (n.has("sample_s")) m.sample_s = positive(n.at("sample_s"));
+  if (n.has("sample_s")) m.sample_s = n.at("sample_s").positiveUpTo(kMaxTimeLimit_s, "s");
   if (n.has("cost_weight")) {
     m.cost_weight = n.at("cost_weight").number();
     if (!(m.cost_weight >= 0.0)) n.at("cost_weight").fail("a weight ≥ 0");
   }
-  if (n.has("cost_cell_m")) m.cost_cell_m = positive(n.at("cost_cell_m"));
+  if (n.has("cost_cell_m")) m.cost_cell_m = n.at("cost_cell_m").positiveUpTo(kMaxPlannerLength_m, "m");
 }
 
 /// \brief A declared protection level: a finite number > 0 [m].
@@ -631,7 +634,7 @@ void readPlannerSettings(const JsonNode& p, Mission& m) {
     if (!k) p.at("algorithm").fail("\"rrtstar\", \"informed_rrtstar\", \"bitstar\" or \"prmstar\"");
     m.planner = *k;
   }
-  if (p.has("time_limit_s")) m.time_limit_s = positive(p.at("time_limit_s"));
+  if (p.has("time_limit_s")) m.time_limit_s = p.at("time_limit_s").positiveUpTo(kMaxTimeLimit_s, "s");
   if (p.has("iterations")) {
     const double it = p.at("iterations").number();
     if (!(it >= 1 && it <= 1e9 && it == std::floor(it))) p.at("iterations").fail("a whole number 1…10⁹");
@@ -642,9 +645,9 @@ void readPlannerSettings(const JsonNode& p, Mission& m) {
     if (!(s >= 0 && s < 4294967296.0 && s == std::floor(s))) p.at("seed").fail("a whole number 0…2³²−1");
     m.seed = static_cast<std::uint64_t>(s);
   }
-  if (p.has("resolution_m")) m.resolution_m = positive(p.at("resolution_m"));
+  if (p.has("resolution_m")) m.resolution_m = p.at("resolution_m").positiveUpTo(kMaxPlannerLength_m, "m");
   if (p.has("simplify")) m.simplify = p.at("simplify").boolean();
-  if (p.has("margin_m")) m.margin_m = positive(p.at("margin_m"));
+  if (p.has("margin_m")) m.margin_m = p.at("margin_m").positiveUpTo(kMaxPlannerLength_m, "m");
   if (p.has("max_replans")) {
     const double r = p.at("max_replans").number();
     if (!(r >= 0 && r <= 20 && r == std::floor(r))) p.at("max_replans").fail("a whole number 0…20");
@@ -695,8 +698,8 @@ Mission parseMission(const nlohmann::json& doc, const std::string& source, const
   m.source = source;
   if (root.has("name")) m.name = root.at("name").str();
   readVehicle(root.at("vehicle"), m);
-  if (root.has("k1")) m.levels.k1 = root.at("k1").number();
-  if (root.has("k2")) m.levels.k2 = root.at("k2").number();
+  if (root.has("k1")) m.levels.k1 = root.at("k1").positiveUpTo(kMaxBoxFactor, "(a factor)");
+  if (root.has("k2")) m.levels.k2 = root.at("k2").positiveUpTo(kMaxBoxFactor, "(a factor)");
   const std::optional<QgcPlanRoute> plan_route = readRoute(root, base_dir, read_json, m);
   readAltitudes(root, plan_route, m);
   readDeparture(root, m);

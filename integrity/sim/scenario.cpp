@@ -33,27 +33,9 @@ constexpr double kMaxSatBias_sigma = 1e4;      ///< in sigmas of the satellite's
 constexpr double kMaxAccelBias_mps2 = 1000.0;  ///< 100 g: beyond any IMU's measuring range
 constexpr double kMaxGyroBias_radps = 100.0;   ///< 5700 °/s: beyond any IMU's measuring range
 
-/// A number in [lo, hi]; the message names the field, the value and the range with its unit.
-double within(const JsonNode& n, double lo, double hi, const std::string& unit) {
-  const double v = n.number();
-  if (!(v >= lo && v <= hi)) {
-    char range[96];
-    std::snprintf(range, sizeof range, "a number in [%g, %g] %s", lo, hi, unit.c_str());
-    n.fail(range);
-  }
-  return v;
-}
+double within(const JsonNode& n, double lo, double hi, const std::string& unit) { return n.numberIn(lo, hi, unit); }
 
-/// A number in (0, hi].
-double positiveUpTo(const JsonNode& n, double hi, const std::string& unit) {
-  const double v = n.number();
-  if (!(v > 0.0 && v <= hi)) {
-    char range[96];
-    std::snprintf(range, sizeof range, "a number > 0 and ≤ %g %s", hi, unit.c_str());
-    n.fail(range);
-  }
-  return v;
-}
+double positiveUpTo(const JsonNode& n, double hi, const std::string& unit) { return n.positiveUpTo(hi, unit); }
 
 int axisOf(const JsonNode& n) {
   const std::string a = n.str();

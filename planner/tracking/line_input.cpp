@@ -1,6 +1,7 @@
 #include "planner/tracking/line_input.hpp"
 
 #include "maps/parse_error.hpp"
+#include "maps/text_file.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -65,6 +66,7 @@ void PosixLineInput::bindUdp(const std::string& hostport) {
 }
 
 void PosixLineInput::openFile() {
+  maps::requireNotAFolder(name_, "--input");
   fd_ = open(name_.c_str(), O_RDONLY);
   if (fd_ < 0) throw ParseError(name_, 0, "--input", name_, std::string("a readable file (") + std::strerror(errno) + ")");
   struct stat info {};

@@ -132,6 +132,69 @@ TEST_F(CliOutputs, DatabaseProblemsExitTwoNamingTheFile) {
   }
 }
 
+TEST_F(CliOutputs, AFolderGivenAsAnInputFileIsAnErrorNamingIt) {
+  const std::string folder = *dir_ + "/input_folder";
+  std::filesystem::create_directories(folder);
+  struct Case {
+    std::string args, expected;
+  };
+  const Case cases[] = {
+      {"fence check --corridor " + kExamples + "/fence/corridor.json --fixes " + folder, folder + ": field '--fixes': got 'a folder', expected a file"},
+      {"track --approval " + report() + " --input " + folder, folder + ": field '--input': got 'a folder', expected a file"},
+      {"zones validate " + folder, folder + ": field 'file': got 'a folder', expected a file"},
+      {"integrity predict --almanac " + folder + " --lat 1 --lon 2 --start 2020-01-01T00:00:00Z",
+       folder + ": field 'file': got 'a folder', expected a file"},
+  };
+  for (const Case& c : cases) {
+    const RunResult r = run(c.args);
+    EXPECT_EQ(r.status, 2) << c.args << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.expected), std::string::npos) << c.args << "\n" << r.out;
+  }
+}
+
+TEST_F(CliOutputs, RawBytesOfABadInputAreQuotedOnOneLine) {
+  // GIVEN a YUMA almanac whose health field holds a newline-free run of terminal escapes and a NUL
+  const std::string alm = *dir_ + "/escapes_alm.txt";
+  {
+    std::ofstream f(alm, std::ios::binary);
+    f << "******** Week 1 almanac for PRN-01 ********\nID:                         01\nHealth:  \x1b[2J\x1b]0;x\x07";
+    f.put('\0');
+    f << "tail\n";
+  }
+  const RunResult r = run("integrity predict --almanac " + alm + " --lat 1 --lon 2 --start 2020-01-01T00:00:00Z");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_EQ(lines(r.out), 1u) << r.out;
+  EXPECT_EQ(r.out.find('\x1b'), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\\x1b[2J\\x1b]0;x\\x07\\x00tail"), std::string::npos) << r.out;
+}
+
+TEST_F(CliOutputs, NumbersBeyondTheirRangeNameTheOptionOrTheField) {
+  const std::string corridor = *dir_ + "/huge_vehicle.json";
+  nlohmann::json c = nlohmann::json::parse(test::readFile(kExamples + "/fence/corridor.json"));
+  c["vehicle"]["lateral_m"] = 1e308;
+  std::ofstream(corridor) << c.dump();
+  const std::string mission = *dir_ + "/huge_margin.json";
+  nlohmann::json m = nlohmann::json::parse(test::readFile(kExamples + "/approve/mission.json"));
+  m["planner"]["margin_m"] = 1e308;
+  std::ofstream(mission) << m.dump();
+  struct Case {
+    std::string args, expected;
+  };
+  const Case cases[] = {
+      {"track --approval " + report() + " --input /dev/null --stale-after 0",
+       "--stale-after: field '--stale-after': got '0', expected seconds in (0, 86400]"},
+      {"track --approval " + report() + " --input /dev/null --horizon 1e300", "field '--horizon': got '1e+300'"},
+      {"fence check --corridor " + corridor + " --fix '{}'", corridor + ": field '$.vehicle.lateral_m': got '1e+308'"},
+      {"approve " + mission, mission + ": field '$.planner.margin_m': got '1e+308', expected a number > 0 and ≤ 10000 m"},
+  };
+  for (const Case& k : cases) {
+    const RunResult r = run(k.args);
+    EXPECT_EQ(r.status, 2) << k.args << "\n" << r.out;
+    EXPECT_NE(r.out.find(k.expected), std::string::npos) << k.args << "\n" << r.out;
+    EXPECT_EQ(lines(r.out), 1u) << k.args << "\n" << r.out;
+  }
+}
+
 TEST_F(CliOutputs, AWriteErrorOnStandardOutputExitsTwo) {
   const RunResult r = test::runCommand(kBin + " integrity pl --geometry " + kExamples + "/predict/geometry.json 2>&1 > /dev/full");
   EXPECT_EQ(r.status, 2) << r.out;
@@ -173,6 +236,39 @@ TEST_F(CliOutputs, PredictAndTrackOnAFullDiskExitTwoNamingTheFile) {
   EXPECT_EQ(t.status, 2) << t.out;
   EXPECT_NE(t.out.find("skylane: error: " + events + ": cannot write (--out): No space left on device\n"), std::string::npos)
       << t.out;
+}
+
+// fuzz/run_fuzzers.sh (issue 23 item 13): a target without seed files runs from an empty corpus
+// and never stops the targets after it; a missing target is reported and the others run.
+TEST(FuzzScript, AMissingSeedFolderOrTargetStopsNoOtherTarget) {
+  // GIVEN a copy of the script in a tree with one seed folder (fence) and no tests/data, and
+  // stand-in targets that print libFuzzer's final statistics
+  const std::string tree = test::scratchPath("fuzz-tree");
+  std::filesystem::remove_all(tree);
+  std::filesystem::create_directories(tree + "/fuzz/corpus/fence");
+  std::filesystem::create_directories(tree + "/build/fuzz");
+  std::filesystem::copy_file(std::string(SKYLANE_TEST_DATA) + "/../../fuzz/run_fuzzers.sh", tree + "/fuzz/run_fuzzers.sh");
+  std::ofstream(tree + "/fuzz/corpus/fence/seed.json") << "{}\n";
+  const std::string targets[] = {"buildings", "zones", "fence", "scenario", "mission", "nmea", "track"};
+  for (const std::string& t : targets) {
+    const std::string exe = tree + "/build/fuzz/fuzz_" + t;
+    std::ofstream(exe) << "#!/bin/sh\necho 'stat::number_of_executed_units: 7'\n";
+    std::filesystem::permissions(exe, std::filesystem::perms::owner_all);
+  }
+  std::string list;
+  for (const std::string& t : targets) list += " " + t;
+  // WHEN it runs all of them THEN every target ran, and the exit status is 0
+  const RunResult r = test::runCommand("SKYLANE_FUZZ_WORK=" + tree + "/work bash " + tree + "/fuzz/run_fuzzers.sh " + tree +
+                                       "/build 1" + list + " 2>&1; echo status=$?");
+  for (const std::string& t : targets) EXPECT_NE(r.out.find("== fuzz_" + t + ":"), std::string::npos) << t << "\n" << r.out;
+  EXPECT_NE(r.out.find("no seed files for buildings"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("status=0"), std::string::npos) << r.out;
+  // AND a target that is not built is reported, the ones after it still run, the status is 1
+  const RunResult missing = test::runCommand("SKYLANE_FUZZ_WORK=" + tree + "/work bash " + tree + "/fuzz/run_fuzzers.sh " +
+                                             tree + "/build 1 ubx fence 2>&1; echo status=$?");
+  EXPECT_NE(missing.out.find("== fuzz_ubx: missing"), std::string::npos) << missing.out;
+  EXPECT_NE(missing.out.find("== fuzz_fence: 1 s, 1 seeds"), std::string::npos) << missing.out;
+  EXPECT_NE(missing.out.find("status=1"), std::string::npos) << missing.out;
 }
 
 }  // namespace
