@@ -3,9 +3,11 @@
 #
 #   fuzz/run_fuzzers.sh [build-dir] [seconds-per-target] [target ...]
 #
-# Defaults: build-fuzz, 60 s, all twelve targets. Work files go to $SKYLANE_FUZZ_WORK
+# Defaults: build-fuzz, 60 s, every target. Work files go to $SKYLANE_FUZZ_WORK
 # (default /tmp/skylane-fuzz): <target>/corpus (grows), <target>/artifacts (crash-*, timeout-*,
-# oom-*), <target>/log. The repository is only read. Exits non-zero if any target found something.
+# oom-*), <target>/log. The repository is only read. Exits non-zero if any target found something
+# or is missing; a target whose seed files are missing runs from an empty corpus (said on stderr)
+# and never stops the targets after it.
 # Extra libFuzzer flags can be passed in $SKYLANE_FUZZ_ARGS (e.g. "-jobs=2 -workers=2").
 set -euo pipefail
 
@@ -17,11 +19,25 @@ targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=(yuma sem rinex_nav rinex_obs geometry text_fields zones buildings fence scenario mission nmea track mavlink ubx)
 work="${SKYLANE_FUZZ_WORK:-/tmp/skylane-fuzz}"
 data="$root/tests/data"
+shopt -s nullglob  # a pattern that matches nothing is no file (not the pattern itself)
+
+# Copies the files given (those that exist) into the corpus folder; says so when there is none.
+copy_seeds() {  # corpus-dir file...
+  local c="$1" f n=0
+  shift
+  for f in "$@"; do
+    [ -f "$f" ] || continue
+    cp "$f" "$c"/
+    n=$((n + 1))
+  done
+  [ $n -gt 0 ] || echo "   note: no seed files for $(basename "$(dirname "$c")"); it starts from an empty corpus" >&2
+}
 
 # Header plus the first `records` lines after END OF HEADER: small seeds mutate faster.
 head_after_header() {  # file lines-after-header
   local n
-  n=$(grep -n "END OF HEADER" "$1" | head -1 | cut -d: -f1)
+  n=$(grep -n "END OF HEADER" "$1" | head -1 | cut -d: -f1 || true)
+  [ -n "$n" ] || return 0
   head -n $(( n + $2 )) "$1"
 }
 
@@ -29,41 +45,40 @@ seed() {  # target corpus-dir
   local t="$1" c="$2" f
   case "$t" in
     yuma)
-      cp "$data"/gnss/*.txt "$c"/
+      copy_seeds "$c" "$data"/gnss/*.txt
       for f in "$data"/gnss/*.txt; do head -n 28 "$f" > "$c/2rec_$(basename "$f")"; done ;;
-    sem) cp "$root"/fuzz/corpus/sem/* "$c"/ ;;
     rinex_nav)
+      copy_seeds "$c" "$data"/gnss/*.05n "$data"/gnss/*.06N "$data"/gnss/*.10n "$data"/rinex3/*MN.rnx
       for f in "$data"/gnss/*.05n "$data"/gnss/*.06N "$data"/gnss/*.10n "$data"/rinex3/*MN.rnx; do
-        cp "$f" "$c"/
         head_after_header "$f" 24 > "$c/3rec_$(basename "$f")"
       done ;;
     rinex_obs)
+      copy_seeds "$c" "$data"/gnss/*.05o "$data"/rinex3/*MO.rnx
       for f in "$data"/gnss/*.05o "$data"/rinex3/*MO.rnx; do
-        cp "$f" "$c"/
         head_after_header "$f" 40 > "$c/short_$(basename "$f")"
       done ;;
-    geometry) cp "$root"/fuzz/corpus/geometry/* "$c"/ ;;
-    text_fields) cp "$root"/fuzz/corpus/text_fields/* "$c"/ ;;
-    zones) cp "$data"/geozones/*.json "$data"/geozones/*.geojson "$data"/geozones/*.plan "$c"/ ;;
-    buildings) cp "$root"/examples/skymask/*.geojson "$c"/ ;;
-    fence) cp "$root"/fuzz/corpus/fence/* "$c"/ ;;
-    scenario) cp "$root"/fuzz/corpus/scenario/* "$c"/ ;;
-    nmea) cp "$root"/fuzz/corpus/nmea/* "$c"/ ;;
-    mission) cp "$root"/fuzz/corpus/mission/* "$c"/ ;;
-    track) cp "$root"/fuzz/corpus/track/* "$c"/ ;;
-    mavlink) cp "$root"/fuzz/corpus/mavlink/* "$c"/ ;;
-    ubx) cp "$root"/fuzz/corpus/ubx/* "$c"/ ;;
-    *) echo "unknown target $t" >&2; exit 2 ;;
+    zones) copy_seeds "$c" "$data"/geozones/*.json "$data"/geozones/*.geojson "$data"/geozones/*.plan ;;
+    buildings) copy_seeds "$c" "$root"/fuzz/corpus/buildings/* "$root"/examples/skymask/*.geojson ;;
+    sem | geometry | text_fields | fence | scenario | nmea | mission | track | mavlink | ubx)
+      copy_seeds "$c" "$root"/fuzz/corpus/"$t"/* ;;
+    *) echo "unknown target $t" >&2; return 1 ;;
   esac
 }
 
 status=0
 for t in "${targets[@]}"; do
   exe="$build/fuzz/fuzz_$t"
-  [ -x "$exe" ] || { echo "missing $exe (build it first)" >&2; exit 2; }
+  if [ ! -x "$exe" ]; then
+    echo "== fuzz_$t: missing $exe (build it first); the other targets go on" >&2
+    status=1
+    continue
+  fi
   rm -rf "${work:?}/$t"
   mkdir -p "$work/$t/corpus" "$work/$t/artifacts"
-  seed "$t" "$work/$t/corpus"
+  if ! seed "$t" "$work/$t/corpus"; then
+    status=1
+    continue
+  fi
   echo "== fuzz_$t: $seconds s, $(find "$work/$t/corpus" -type f | wc -l) seeds"
   extra=()
   [ "$t" = geometry ] && extra+=(-dict="$root/fuzz/geometry.dict")
