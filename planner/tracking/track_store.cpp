@@ -6,6 +6,7 @@
 
 #include <sqlite3.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
@@ -62,6 +63,7 @@ void TrackStore::open() {
   // against a process kill (the case a restart resumes from), not against power loss.
   exec("PRAGMA journal_mode=WAL");
   exec("PRAGMA synchronous=NORMAL");
+  verify();
   exec("CREATE TABLE IF NOT EXISTS flights (id TEXT PRIMARY KEY, report TEXT NOT NULL, approval TEXT NOT NULL, "
        "state TEXT NOT NULL, route TEXT NOT NULL)");
   exec("CREATE TABLE IF NOT EXISTS events (seq INTEGER PRIMARY KEY AUTOINCREMENT, flight TEXT, time TEXT, type TEXT NOT NULL, json TEXT NOT NULL)");
@@ -73,6 +75,77 @@ void TrackStore::open() {
   prepare("UPDATE flights SET state = ?, route = ? WHERE id = ?", &put_state_);
   prepare("INSERT INTO events (flight, time, type, json) VALUES (?, ?, ?, ?)", &put_event_);
   prepare("INSERT OR REPLACE INTO inputs (name, line) VALUES (?, ?)", &put_input_);
+}
+
+namespace {
+
+/// The tables and their columns, in order, as open() creates them.
+const std::vector<std::pair<std::string, std::vector<std::string>>> kSchema = {
+    {"flights", {"id", "report", "approval", "state", "route"}},
+    {"events", {"seq", "flight", "time", "type", "json"}},
+    {"inputs", {"name", "line"}},
+};
+
+}  // namespace
+
+void TrackStore::verify() {
+  requireUndamaged();
+  requireSchema();
+  requireInputPositions();
+}
+
+void TrackStore::requireUndamaged() const {
+  // integrity_check reads every page, checks the b-trees and that the indexes match their
+  // tables: a damaged page in the middle of the file is found here, before a resumed run
+  // appends to it. It costs a read of the file (0.14 s for 200,000 events, 205 MB, on the
+  // development machine; quick_check, without the index checks, took as long).
+  Statement st;
+  if (sqlite3_prepare_v2(db_, "PRAGMA integrity_check(1)", -1, &st.s, nullptr) != SQLITE_OK) fail("cannot check the file");
+  const int rc = sqlite3_step(st.s);
+  if (rc != SQLITE_ROW) fail("cannot check the file");
+  const std::string verdict = columnText(st.s, 0);
+  if (verdict != "ok") {
+    throw maps::ParseError(path_, 0, "(tracker database)", "damaged (" + verdict + ")",
+                           "an undamaged skylane tracker database (SQLite 3): restore it or start a new one");
+  }
+}
+
+void TrackStore::requireSchema() const {
+  Statement tables;
+  if (sqlite3_prepare_v2(db_, "SELECT name FROM sqlite_master WHERE type = 'table' AND name != 'sqlite_sequence'", -1,
+                         &tables.s, nullptr) != SQLITE_OK) {
+    fail("cannot read the schema");
+  }
+  std::vector<std::string> present;
+  while (sqlite3_step(tables.s) == SQLITE_ROW) present.push_back(columnText(tables.s, 0));
+  if (present.empty()) return;  // a new database: open() creates the tables
+  for (const auto& [table, columns] : kSchema) {
+    std::vector<std::string> got;
+    if (std::find(present.begin(), present.end(), table) != present.end()) {
+      Statement info;
+      const std::string sql = "PRAGMA table_info(" + table + ")";
+      if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &info.s, nullptr) != SQLITE_OK) fail("cannot read the schema");
+      while (sqlite3_step(info.s) == SQLITE_ROW) got.push_back(columnText(info.s, 1));
+    }
+    if (got != columns) {
+      std::string expected;
+      for (const std::string& c : columns) expected += (expected.empty() ? "" : ", ") + c;
+      throw maps::ParseError(path_, 0, "(tracker database) table " + table, got.empty() ? "missing" : "other columns",
+                             "a skylane tracker database, whose table " + table + " has the columns " + expected);
+    }
+  }
+}
+
+void TrackStore::requireInputPositions() const {
+  Statement st;
+  if (sqlite3_prepare_v2(db_, "SELECT name, line, typeof(line) FROM inputs WHERE typeof(line) != 'integer' OR line < 0 LIMIT 1",
+                         -1, &st.s, nullptr) != SQLITE_OK) {
+    return;  // no inputs table yet (a new database)
+  }
+  if (sqlite3_step(st.s) == SQLITE_ROW) {
+    throw maps::ParseError(path_, 0, "(tracker database) inputs[" + columnText(st.s, 0) + "].line", columnText(st.s, 1),
+                           "a line number ≥ 0 (the database is damaged)");
+  }
 }
 
 TrackStore::~TrackStore() {

@@ -7,7 +7,9 @@
 /// of the batch that was not committed is processed again).
 ///
 /// Tables: flights(id, report file, approval report JSON, state JSON, route JSON),
-/// events(seq, flight, time, type, JSON), inputs(name, line).
+/// events(seq, flight, time, type, JSON), inputs(name, line). An existing file is verified when
+/// opened (no damaged page, these tables and columns, input positions ≥ 0) and refused with a
+/// ParseError otherwise; the session refuses a stored position beyond the end of its input.
 
 #include "planner/tracking/event_sink.hpp"
 
@@ -68,6 +70,13 @@ class TrackStore final : public EventSink {
 
  private:
   void open();
+  /// \brief An existing database checked before use (issue 23): no damaged page (PRAGMA
+  /// integrity_check), the tables and columns of a tracker database, input positions ≥ 0.
+  /// \throws maps::ParseError naming the file and what is wrong.
+  void verify();
+  void requireUndamaged() const;
+  void requireSchema() const;
+  void requireInputPositions() const;
   void close() noexcept;
   void exec(const char* sql) const;
   [[noreturn]] void fail(const std::string& what) const;

@@ -1,5 +1,7 @@
 #include "planner/tracking/tracking_session.hpp"
 
+#include "maps/parse_error.hpp"
+
 #include "maps/text_file.hpp"
 
 #include <algorithm>
@@ -132,6 +134,16 @@ void TrackingSession::tick() {
   }
 }
 
+void TrackingSession::requirePositionWithinInput(const FixSource& source, std::size_t resume_line) const {
+  // Read to its end without reaching the stored position: the input is shorter than the one the
+  // database was written for (another file, a cut one) or the position is damaged; resuming
+  // would skip every fix of it for good.
+  if (stop_ || resume_line == 0 || source.checkpointLine() >= resume_line) return;
+  throw maps::ParseError(store_->path(), 0, "(tracker database) inputs[" + source.name() + "].line", std::to_string(resume_line),
+                         "a line within " + source.name() + " (which has " + std::to_string(source.checkpointLine()) +
+                             "): the database belongs to a longer input or is damaged");
+}
+
 SessionSummary TrackingSession::run(FixSource& source) {
   source_ = &source;
   // A rereadable input (not stdin, a FIFO or UDP) resumes where the last committed batch left it.
@@ -158,6 +170,7 @@ SessionSummary TrackingSession::run(FixSource& source) {
       submit(r.fix);
     }
   }
+  requirePositionWithinInput(source, resume_line);
   summary_.stopped = stop_ && !summary_.output_closed;
   finish();
   source_ = nullptr;

@@ -79,6 +79,8 @@ class TrackingSession {
   [[nodiscard]] const SessionSummary& summary() const { return summary_; }
 
  private:
+  /// \brief A ParseError naming the database when `source` ended before `resume_line`.
+  void requirePositionWithinInput(const FixSource& source, std::size_t resume_line) const;
   void emit(const std::vector<TrackEvent>& events);
   void checkpoint(bool force);
   void sweepWhileQuiet(double quiet_s);

@@ -195,6 +195,25 @@ TEST_F(CliOutputs, NumbersBeyondTheirRangeNameTheOptionOrTheField) {
   }
 }
 
+TEST_F(CliOutputs, AStoredPositionBeyondTheInputIsRefusedNotSkippedForGood) {
+  const std::string fixes = *dir_ + "/resume_fixes.jsonl", db = *dir_ + "/resume.sqlite";
+  std::filesystem::remove(db);
+  ASSERT_EQ(run("fly " + report() + " --out " + fixes).status, 0);
+  const std::string track = "track --approval " + report() + " --input " + fixes + " --no-replan --db " + db + " --out /dev/null";
+  ASSERT_EQ(run(track).status, 0);
+  // GIVEN the stored position damaged to INT64_MAX
+  test::runCommand("sqlite3 " + db + " 'UPDATE inputs SET line = 9223372036854775807'");
+  const std::string shown = test::runCommand("sqlite3 " + db + " 'SELECT line FROM inputs'").out;
+  if (shown != "9223372036854775807\n") GTEST_SKIP() << "needs the sqlite3 shell: " << shown;
+  // THEN a restart says so naming the database, the input and the value, and exits 2
+  const RunResult r = run(track);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("skylane: error: " + db + ": field '(tracker database) inputs[" + fixes +
+                       "].line': got '9223372036854775807', expected a line within " + fixes + " (which has "),
+            std::string::npos)
+      << r.out;
+}
+
 TEST_F(CliOutputs, AWriteErrorOnStandardOutputExitsTwo) {
   const RunResult r = test::runCommand(kBin + " integrity pl --geometry " + kExamples + "/predict/geometry.json 2>&1 > /dev/full");
   EXPECT_EQ(r.status, 2) << r.out;

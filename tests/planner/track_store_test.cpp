@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sqlite3.h>
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -74,6 +76,67 @@ TEST(TrackStore, AFullDiskAtACommitIsAnOutputErrorNamingTheDatabase) {
   });
   EXPECT_EQ(msg.rfind(path + ": cannot write: tracker database: ", 0), 0u) << msg;
   EXPECT_NE(msg.find("database or disk is full"), std::string::npos) << msg;
+}
+
+/// Runs SQL on a database file outside the store (what damage or another program would do).
+void runSql(const std::string& path, const std::string& sql) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  char* err = nullptr;
+  EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &err), SQLITE_OK) << (err ? err : "");
+  sqlite3_free(err);
+  sqlite3_close(db);
+}
+
+/// A tracker database with `events` events of 500 bytes and one input position, closed.
+std::string filledDatabase(const std::string& name, int events) {
+  const std::string path = test::scratchPath(name);
+  std::filesystem::remove(path);
+  TrackStore store(path);
+  store.begin();
+  for (int k = 0; k < events; ++k) store.appendEvent("fix", "f", "2020-01-01T00:00:00Z", "{\"pad\":\"" + std::string(500, 'a' + k % 26) + "\"}");
+  store.setInputLine("fixes.jsonl", static_cast<std::size_t>(events));
+  store.commit();
+  return path;
+}
+
+TEST(TrackStore, ADamagedPageInTheMiddleIsFoundBeforeTheDatabaseIsUsed) {
+  // GIVEN a database of ~40 pages (closed: its WAL is checkpointed into the file)
+  const std::string path = filledDatabase("damaged.sqlite", 300);
+  ASSERT_EQ(TrackStore(path).events().size(), 300u);
+  // WHEN page 20 is overwritten with garbage
+  {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(19 * 4096 + 100);
+    f << std::string(3000, '\x5a');
+  }
+  // THEN opening it is a ParseError naming the file and the damage
+  const std::string msg = test::messageOf<maps::ParseError>([&] { TrackStore s(path); });
+  EXPECT_EQ(msg.rfind(path + ": field '(tracker database)': got '", 0), 0u) << msg;
+  EXPECT_NE(msg.find("expected an undamaged skylane tracker database"), std::string::npos) << msg;
+}
+
+TEST(TrackStore, AMissingTableOrAnotherProgramsDatabaseIsRefusedNotRecreated) {
+  const std::string path = filledDatabase("dropped.sqlite", 3);
+  runSql(path, "DROP TABLE events");
+  EXPECT_EQ(test::messageOf<maps::ParseError>([&] { TrackStore s(path); }),
+            path + ": field '(tracker database) table events': got 'missing', expected a skylane tracker database, whose "
+                   "table events has the columns seq, flight, time, type, json");
+  const std::string other = test::scratchPath("other_program.sqlite");
+  std::filesystem::remove(other);
+  runSql(other, "CREATE TABLE photos (id INTEGER, jpeg BLOB)");
+  EXPECT_NE(test::messageOf<maps::ParseError>([&] { TrackStore s(other); }).find("table flights': got 'missing'"),
+            std::string::npos);
+}
+
+TEST(TrackStore, ANegativeInputPositionIsRefused) {
+  const std::string path = filledDatabase("negative.sqlite", 3);
+  runSql(path, "UPDATE inputs SET line = -5");
+  EXPECT_EQ(test::messageOf<maps::ParseError>([&] { TrackStore s(path); }),
+            path + ": field '(tracker database) inputs[fixes.jsonl].line': got '-5', expected a line number ≥ 0 (the "
+                   "database is damaged)");
+  // An undamaged database opens as before.
+  EXPECT_EQ(TrackStore(filledDatabase("fine.sqlite", 3)).inputLine("fixes.jsonl"), 3u);
 }
 
 }  // namespace
