@@ -17,6 +17,7 @@
 #include "maps/text_file.hpp"
 #include "planner/report_formats.hpp"
 #include "planner/rehearsal/flight_sim.hpp"
+#include "planner/tracking/event_file_sink.hpp"
 #include "planner/tracking/tracker.hpp"
 #include "planner/tracking/tracking_session.hpp"
 
@@ -29,6 +30,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -321,6 +323,33 @@ void requireOutputWritten(const planner::JsonLinesSink& out, const std::string& 
   }
 }
 
+/// The event stream: with --out and --db a file kept in step with the database (every event
+/// exactly once across kills and restarts: planner/tracking/event_file_sink.hpp); otherwise JSON
+/// lines appended to --out or written to standard output as they come.
+struct EventOutput {
+  std::unique_ptr<planner::EventFileSink> file;
+  std::ofstream stream_file;
+  std::unique_ptr<planner::JsonLinesSink> lines;
+  planner::EventSink& sink() { return file ? static_cast<planner::EventSink&>(*file) : *lines; }
+};
+
+void openEventOutput(EventOutput& out, const TrackOptions& o, planner::TrackingSession& session,
+                     const std::function<void(const std::string&)>& log) {
+  if (!o.out.empty() && session.store()) {
+    out.file = std::make_unique<planner::EventFileSink>(o.out, *session.store());
+    if (out.file->repairedLines() > 0) {
+      log(o.out + ": its last batch was cut short; written again from the database (" +
+          std::to_string(out.file->repairedLines()) + " events)");
+    }
+    return;
+  }
+  if (!o.out.empty()) {
+    out.stream_file.open(o.out, std::ios::app);
+    if (!out.stream_file) throw maps::OutputError(o.out, "--out", maps::systemReason(errno));
+  }
+  out.lines = std::make_unique<planner::JsonLinesSink>(o.out.empty() ? std::cout : out.stream_file);
+}
+
 void runTrack(const TrackOptions& o) {
   if (o.format != "jsonl" && o.format != "nmea" && o.format != "rinex" && o.format != "mavlink" && o.format != "ubx") {
     throw ParseError("--format", 0, "--format", o.format, "jsonl, nmea, rinex, mavlink or ubx");
@@ -335,13 +364,9 @@ void runTrack(const TrackOptions& o) {
   // The map is staged before the run (a path that cannot be written fails at once) and
   // replaces an earlier one when the run has ended (maps/atomic_file.hpp).
   std::unique_ptr<maps::AtomicFile> map_file = o.map.empty() ? nullptr : std::make_unique<maps::AtomicFile>(o.map, "--map");
-  std::ofstream out_file;
-  if (!o.out.empty()) {
-    out_file.open(o.out, std::ios::app);
-    if (!out_file) throw maps::OutputError(o.out, "--out", maps::systemReason(errno));
-  }
-  planner::JsonLinesSink out(o.out.empty() ? std::cout : out_file);
-  session.addSink(out);
+  EventOutput out;
+  openEventOutput(out, o, session, log);
+  session.addSink(out.sink());
   if (!o.map.empty()) session.addSink(track_map);
   installStopSignals(session.stopFlag());
   const std::unique_ptr<planner::FixSource> source = openFixSource(o, session.tracker());
@@ -358,7 +383,7 @@ void runTrack(const TrackOptions& o) {
     session.addSink(*plans);
   }
   const planner::SessionSummary sum = session.run(*source);
-  requireOutputWritten(out, o.out);
+  if (out.lines) requireOutputWritten(*out.lines, o.out);
   if (map_file) {
     map_file->stream() << track_map.svg(session.tracker());
     map_file->commit();

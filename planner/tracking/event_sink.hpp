@@ -18,6 +18,9 @@ class EventSink {
   virtual ~EventSink() = default;
   /// \brief One event and its JSON line.
   virtual void write(const TrackEvent& event, const std::string& json_line) = 0;
+  /// \brief The end of a batch with a database, before it commits the batch (a sink that keeps
+  /// its own position in the database writes it here, in the same transaction).
+  virtual void beforeCommit() {}
   /// \brief The end of a batch (a checkpoint, the end of the stream): what was written is handed on.
   virtual void flush() {}
   /// \brief Whether the sink's reader has gone (the session then stops as on a stop request).

@@ -68,6 +68,8 @@ void TrackStore::open() {
        "state TEXT NOT NULL, route TEXT NOT NULL)");
   exec("CREATE TABLE IF NOT EXISTS events (seq INTEGER PRIMARY KEY AUTOINCREMENT, flight TEXT, time TEXT, type TEXT NOT NULL, json TEXT NOT NULL)");
   exec("CREATE TABLE IF NOT EXISTS inputs (name TEXT PRIMARY KEY, line INTEGER NOT NULL)");
+  exec("CREATE TABLE IF NOT EXISTS outputs (name TEXT PRIMARY KEY, bytes_before INTEGER NOT NULL, bytes_after INTEGER NOT NULL, "
+       "first_seq INTEGER NOT NULL, last_seq INTEGER NOT NULL)");
   auto prepare = [this](const char* sql, sqlite3_stmt** out) {
     if (sqlite3_prepare_v2(db_, sql, -1, out, nullptr) != SQLITE_OK) fail("cannot prepare a statement");
   };
@@ -75,16 +77,21 @@ void TrackStore::open() {
   prepare("UPDATE flights SET state = ?, route = ? WHERE id = ?", &put_state_);
   prepare("INSERT INTO events (flight, time, type, json) VALUES (?, ?, ?, ?)", &put_event_);
   prepare("INSERT OR REPLACE INTO inputs (name, line) VALUES (?, ?)", &put_input_);
+  prepare("INSERT OR REPLACE INTO outputs (name, bytes_before, bytes_after, first_seq, last_seq) VALUES (?, ?, ?, ?, ?)",
+          &put_output_);
 }
 
 namespace {
 
-/// The tables and their columns, in order, as open() creates them.
+/// The tables and their columns, in order, as open() creates them; `outputs` came later (a
+/// database written before it has none and gets it).
 const std::vector<std::pair<std::string, std::vector<std::string>>> kSchema = {
     {"flights", {"id", "report", "approval", "state", "route"}},
     {"events", {"seq", "flight", "time", "type", "json"}},
     {"inputs", {"name", "line"}},
+    {"outputs", {"name", "bytes_before", "bytes_after", "first_seq", "last_seq"}},
 };
+const std::string kOptionalTable = "outputs";
 
 }  // namespace
 
@@ -127,7 +134,7 @@ void TrackStore::requireSchema() const {
       if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &info.s, nullptr) != SQLITE_OK) fail("cannot read the schema");
       while (sqlite3_step(info.s) == SQLITE_ROW) got.push_back(columnText(info.s, 1));
     }
-    if (got != columns) {
+    if (got != columns && !(got.empty() && table == kOptionalTable)) {
       std::string expected;
       for (const std::string& c : columns) expected += (expected.empty() ? "" : ", ") + c;
       throw maps::ParseError(path_, 0, "(tracker database) table " + table, got.empty() ? "missing" : "other columns",
@@ -156,7 +163,7 @@ TrackStore::~TrackStore() {
 }
 
 void TrackStore::close() noexcept {
-  for (sqlite3_stmt** s : {&put_flight_, &put_state_, &put_event_, &put_input_}) {
+  for (sqlite3_stmt** s : {&put_flight_, &put_state_, &put_event_, &put_input_, &put_output_}) {
     sqlite3_finalize(*s);
     *s = nullptr;
   }
@@ -270,5 +277,46 @@ void TrackStore::setInputLine(const std::string& name, std::size_t line) {
 void TrackStore::write(const TrackEvent& event, const std::string& json_line) {
   appendEvent(event.type, event.flight, event.time ? maps::formatRfc3339(*event.time, 3) : std::string(), json_line);
 }
+
+void TrackStore::setOutputMark(const std::string& name, const OutputMark& mark) {
+  sqlite3_reset(put_output_);
+  bindText(put_output_, 1, name);
+  sqlite3_bind_int64(put_output_, 2, static_cast<sqlite3_int64>(mark.bytes_before));
+  sqlite3_bind_int64(put_output_, 3, static_cast<sqlite3_int64>(mark.bytes_after));
+  sqlite3_bind_int64(put_output_, 4, mark.first_seq);
+  sqlite3_bind_int64(put_output_, 5, mark.last_seq);
+  if (sqlite3_step(put_output_) != SQLITE_DONE) fail("cannot store the event file's position");
+}
+
+std::optional<OutputMark> TrackStore::outputMark(const std::string& name) const {
+  Statement st;
+  if (sqlite3_prepare_v2(db_, "SELECT bytes_before, bytes_after, first_seq, last_seq FROM outputs WHERE name = ?", -1, &st.s,
+                         nullptr) != SQLITE_OK) {
+    fail("cannot read outputs");
+  }
+  bindText(st.s, 1, name);
+  if (sqlite3_step(st.s) != SQLITE_ROW) return std::nullopt;
+  const sqlite3_int64 before = sqlite3_column_int64(st.s, 0), after = sqlite3_column_int64(st.s, 1);
+  if (before < 0 || after < before) {
+    throw maps::ParseError(path_, 0, "(tracker database) outputs[" + name + "]", std::to_string(before) + "…" + std::to_string(after),
+                           "byte positions 0 ≤ before ≤ after (the database is damaged)");
+  }
+  return OutputMark{static_cast<std::uint64_t>(before), static_cast<std::uint64_t>(after), sqlite3_column_int64(st.s, 2),
+                    sqlite3_column_int64(st.s, 3)};
+}
+
+std::vector<std::string> TrackStore::eventLines(std::int64_t first_seq, std::int64_t last_seq) const {
+  std::vector<std::string> out;
+  Statement st;
+  if (sqlite3_prepare_v2(db_, "SELECT json FROM events WHERE seq BETWEEN ? AND ? ORDER BY seq", -1, &st.s, nullptr) != SQLITE_OK) {
+    fail("cannot read events");
+  }
+  sqlite3_bind_int64(st.s, 1, first_seq);
+  sqlite3_bind_int64(st.s, 2, last_seq);
+  while (sqlite3_step(st.s) == SQLITE_ROW) out.push_back(columnText(st.s, 0));
+  return out;
+}
+
+std::int64_t TrackStore::lastEventSeq() const { return sqlite3_last_insert_rowid(db_); }
 
 }  // namespace skylane::planner

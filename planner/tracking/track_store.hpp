@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,6 +32,12 @@ struct StoredFlight {
   nlohmann::json approval;  ///< the report itself (a restart does not need the file)
   nlohmann::json state;
   nlohmann::json route;
+};
+
+/// \brief Where the last committed batch of an event file goes in it (event_file_sink.hpp).
+struct OutputMark {
+  std::uint64_t bytes_before = 0, bytes_after = 0;  ///< the file's length before and after the batch
+  std::int64_t first_seq = 0, last_seq = 0;          ///< the batch's events (events.seq)
 };
 
 /// \brief The database of one tracker; as an event sink it logs every event in the batch.
@@ -60,6 +67,14 @@ class TrackStore final : public EventSink {
   /// \brief An event as written to the stream (one JSON line) with its type, flight and time.
   void appendEvent(const std::string& type, const std::string& flight, const std::string& time, const std::string& line);
   void setInputLine(const std::string& name, std::size_t line);
+  /// \brief The last committed batch's place in the event file `name` (in the open batch).
+  void setOutputMark(const std::string& name, const OutputMark& mark);
+  /// \brief The mark of event file `name`, if one was stored.
+  [[nodiscard]] std::optional<OutputMark> outputMark(const std::string& name) const;
+  /// \brief The JSON lines of events first_seq…last_seq, in order, as they were streamed.
+  [[nodiscard]] std::vector<std::string> eventLines(std::int64_t first_seq, std::int64_t last_seq) const;
+  /// \brief The seq of the event stored last by this connection.
+  [[nodiscard]] std::int64_t lastEventSeq() const;
   /// \brief appendEvent() of the event (EventSink).
   void write(const TrackEvent& event, const std::string& json_line) override;
   /// \brief Commits the batch.
@@ -86,6 +101,7 @@ class TrackStore final : public EventSink {
   sqlite3_stmt* put_state_ = nullptr;
   sqlite3_stmt* put_event_ = nullptr;
   sqlite3_stmt* put_input_ = nullptr;
+  sqlite3_stmt* put_output_ = nullptr;
   bool in_batch_ = false;
 };
 

@@ -79,6 +79,9 @@ void TrackingSession::checkpoint(bool force) {
     for (const std::string& id : touched_) store_->putState(id, flightStateJson(tracker_.state(id)), tracker_.routeJson(id));
     touched_.clear();
     if (source_ && resumable_) store_->setInputLine(source_->name(), source_->checkpointLine());
+    for (EventSink* sink : sinks_) {
+      if (sink != store_.get()) sink->beforeCommit();
+    }
     store_->commit();
   }
   // The other sinks see each batch too, and a quiet live input's last events at once.

@@ -54,6 +54,8 @@ class TrackingSession {
   std::string addApprovalFile(const std::string& report_path, const std::string& id = {});
   /// \brief Events go to `sink` too (not owned; it outlives the session's runs).
   void addSink(EventSink& sink) { sinks_.push_back(&sink); }
+  /// \brief The database (null without one).
+  [[nodiscard]] TrackStore* store() { return store_.get(); }
   /// \brief Work that runs beside the stream (a link's mission upload): called after every
   /// record and whenever the input is quiet; the events it returns are the session's.
   using Ticker = std::function<std::vector<TrackEvent>()>;

@@ -376,6 +376,44 @@ TEST_F(TrackCli, KilledAndRestartedTrackerLosesNoAcceptedFix) {
   EXPECT_TRUE(planner::TrackStore(db).events("rejected_input").empty());
 }
 
+TEST_F(TrackCli, KilledTwiceTheOutFileHoldsEveryEventOnceAsTheDatabaseDoes) {
+  // GIVEN a long file of good fixes, the tracker writing its events to --out and its database
+  constexpr int kFixes = 60000;
+  const std::string db = *dir_ + "/out_kill.sqlite", all = *dir_ + "/out_kill_fixes.jsonl", out = *dir_ + "/out_kill.jsonl";
+  std::filesystem::remove(db);
+  std::filesystem::remove(out);
+  {
+    std::ofstream f(all);
+    for (int k = 0; k < kFixes; ++k) f << goodFix(k).dump() << "\n";
+  }
+  const std::string cmd =
+      kBin + " track --approval " + approval() + " --input " + all + " --db " + db + " --out " + out + " --batch 50 --no-replan";
+  // WHEN it is killed (SIGKILL) twice mid-stream and run to the end
+  ASSERT_NE(killOnceStoring(cmd, db).out.find("status=137"), std::string::npos);
+  // (the second kill, half a second into the resumed run, may find it done: then it is a restart)
+  sh(cmd + " > /dev/null 2>&1 & pid=$!; sleep 0.5; kill -9 $pid 2>/dev/null; wait $pid");
+  const RunResult last = sh(cmd + " 2>&1; echo status=$?");
+  ASSERT_NE(last.out.find("status=0"), std::string::npos) << last.out;
+  // THEN every line of the file is whole JSON, and its events are the database's, in order, once
+  std::vector<std::string> file_lines;
+  {
+    std::ifstream in(out);
+    std::string line;
+    while (std::getline(in, line)) file_lines.push_back(line);
+  }
+  std::vector<std::string> stored;
+  for (const json& e : planner::TrackStore(db).events()) stored.push_back(e.dump());
+  std::vector<std::string> written;
+  for (const std::string& l : file_lines) {
+    json e;
+    ASSERT_NO_THROW(e = json::parse(l)) << "a torn line: " << l;
+    written.push_back(e.dump());
+  }
+  EXPECT_EQ(written.size(), stored.size());
+  EXPECT_TRUE(written == stored);
+  EXPECT_EQ(ofType(readEvents(out), "fix").size(), static_cast<std::size_t>(kFixes));
+}
+
 TEST_F(TrackCli, KilledNmeaTrackerRestartedWithoutAnIdLosesNoEpoch) {
   // GIVEN 150 NMEA epochs (RMC, GGA, GST) along the route through a FIFO, the approval given
   // without an ID (the flight takes the mission's name)

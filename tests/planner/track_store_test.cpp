@@ -3,17 +3,22 @@
 // file (the CLI's exit 2), and a failed open releases the SQLite connection.
 #include "planner/tracking/track_store.hpp"
 
+#include "planner/tracking/event_file_sink.hpp"
+
 #include "maps/atomic_file.hpp"
 #include "maps/parse_error.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <sqlite3.h>
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace skylane {
 namespace {
@@ -137,6 +142,114 @@ TEST(TrackStore, ANegativeInputPositionIsRefused) {
                    "database is damaged)");
   // An undamaged database opens as before.
   EXPECT_EQ(TrackStore(filledDatabase("fine.sqlite", 3)).inputLine("fixes.jsonl"), 3u);
+}
+
+/// One batch as the session makes it: each event stored, then handed to the file sink; the mark
+/// written and the batch committed; the file written only when `written`.
+void batch(TrackStore& store, planner::EventFileSink& sink, int first, int count, bool written = true) {
+  store.begin();
+  for (int k = first; k < first + count; ++k) {
+    const std::string line = "{\"event\":\"fix\",\"k\":" + std::to_string(k) + "}";
+    store.appendEvent("fix", "f", "", line);
+    sink.write(planner::TrackEvent{}, line);
+  }
+  sink.beforeCommit();
+  store.commit();
+  if (written) sink.flush();
+}
+
+/// The file's lines' k values.
+std::vector<int> ks(const std::string& path) {
+  std::vector<int> out;
+  std::istringstream in(test::readFile(path));
+  std::string line;
+  while (std::getline(in, line)) out.push_back(nlohmann::json::parse(line).at("k").get<int>());
+  return out;
+}
+
+std::vector<int> range(int n) {
+  std::vector<int> out;
+  for (int k = 0; k < n; ++k) out.push_back(k);
+  return out;
+}
+
+TEST(EventFileSink, AKillBetweenTheCommitAndTheWriteLosesNoEventOnRestart) {
+  const std::string db = test::scratchPath("efs_lost.sqlite"), out = test::scratchPath("efs_lost.jsonl");
+  std::filesystem::remove(db);
+  std::filesystem::remove(out);
+  TrackStore store(db);
+  {
+    planner::EventFileSink sink(out, store);
+    batch(store, sink, 0, 5);
+    batch(store, sink, 5, 5, false);  // committed, then killed before the file was written
+  }
+  EXPECT_EQ(ks(out), range(5));
+  planner::EventFileSink again(out, store);
+  EXPECT_EQ(again.repairedLines(), 5u);
+  EXPECT_EQ(ks(out), range(10));  // every committed event once
+  batch(store, again, 10, 3);
+  EXPECT_EQ(ks(out), range(13));
+}
+
+TEST(EventFileSink, ATornLineIsCutAndItsBatchWrittenAgainWhole) {
+  const std::string db = test::scratchPath("efs_torn.sqlite"), out = test::scratchPath("efs_torn.jsonl");
+  std::filesystem::remove(db);
+  std::filesystem::remove(out);
+  TrackStore store(db);
+  {
+    planner::EventFileSink sink(out, store);
+    batch(store, sink, 0, 4);
+    batch(store, sink, 4, 4);
+  }
+  // GIVEN a kill in the middle of the last batch's write: the file ends inside a line
+  const std::uint64_t whole = std::filesystem::file_size(out);
+  std::filesystem::resize_file(out, whole - 30);
+  // WHEN the tracker restarts THEN the torn line is gone and the batch is there once
+  planner::EventFileSink again(out, store);
+  EXPECT_EQ(ks(out), range(8));
+  EXPECT_EQ(std::filesystem::file_size(out), whole);
+}
+
+TEST(EventFileSink, AnUncommittedBatchNeverReachesTheFile) {
+  const std::string db = test::scratchPath("efs_open.sqlite"), out = test::scratchPath("efs_open.jsonl");
+  std::filesystem::remove(db);
+  std::filesystem::remove(out);
+  {
+    TrackStore store(db);
+    planner::EventFileSink sink(out, store);
+    batch(store, sink, 0, 3);
+    store.begin();  // a batch in progress when the process is killed: rolled back
+    store.appendEvent("fix", "f", "", "{\"event\":\"fix\",\"k\":3}");
+    sink.write(planner::TrackEvent{}, "{\"event\":\"fix\",\"k\":3}");
+  }
+  EXPECT_EQ(ks(out), range(3));
+  TrackStore store(db);
+  planner::EventFileSink again(out, store);
+  EXPECT_EQ(again.repairedLines(), 0u);
+  EXPECT_EQ(ks(out), range(3));
+  EXPECT_EQ(store.events().size(), 3u);
+}
+
+TEST(EventFileSink, AFileLongerThanTheDatabaseRecordedIsRefusedAndANewOneIsStarted) {
+  const std::string db = test::scratchPath("efs_other.sqlite"), out = test::scratchPath("efs_other.jsonl");
+  std::filesystem::remove(db);
+  std::filesystem::remove(out);
+  TrackStore store(db);
+  {
+    planner::EventFileSink sink(out, store);
+    batch(store, sink, 0, 3);
+    batch(store, sink, 3, 3);
+  }
+  std::ofstream(out, std::ios::app) << "{\"written by\":\"someone else\"}\n";
+  const std::string msg = test::messageOf<maps::ParseError>([&] { planner::EventFileSink s(out, store); });
+  EXPECT_NE(msg.find(out + ": field '--out': got '"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("another program wrote to it"), std::string::npos) << msg;
+  // A removed (rotated) file, shorter than the last batch's start, is a new one: the events go
+  // on from there.
+  std::filesystem::remove(out);
+  planner::EventFileSink fresh(out, store);
+  batch(store, fresh, 6, 2);
+  EXPECT_EQ(ks(out), (std::vector<int>{6, 7}));
 }
 
 }  // namespace
