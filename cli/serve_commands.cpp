@@ -7,6 +7,7 @@
 #include <memory>
 #include <thread>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 namespace skylane::cli {
@@ -28,8 +29,18 @@ std::string selfExecutable() {
   return std::string(buf, static_cast<std::size_t>(n));
 }
 
+/// Open files up to the hard limit: every connection and event stream holds a socket.
+void raiseOpenFileLimit() {
+  rlimit r{};
+  if (getrlimit(RLIMIT_NOFILE, &r) == 0 && r.rlim_cur < r.rlim_max) {
+    r.rlim_cur = r.rlim_max;
+    setrlimit(RLIMIT_NOFILE, &r);
+  }
+}
+
 void runServe(service::ServeOptions o, bool quiet) {
   o.program = selfExecutable();
+  raiseOpenFileLimit();
   if (o.web_dir == "none") o.web_dir.clear();
   auto log = [quiet](const std::string& m) {
     if (!quiet) std::cerr << "skylane: serve: " << m << "\n";
@@ -71,8 +82,16 @@ void addServeCommands(CLI::App& app) {
   c->add_option("--approval-queue", o->approval_queue, "approvals waiting at most (then 429; default 16)")->check(CLI::Range(1, 100000));
   c->add_option("--rate", o->rate_per_s, "requests per second per token (default 200)")->check(CLI::Range(0.01, 1e7));
   c->add_option("--burst", o->rate_burst, "requests a token may send at once (default 400)")->check(CLI::Range(1.0, 1e7));
+  c->add_option("--max-body", o->limits.body_bytes, "largest request body in bytes (then 413; default 16 MiB)")
+      ->check(CLI::Range(std::size_t{1024}, std::size_t{1} << 30));
+  auto timeout_s = std::make_shared<int>(30);
+  c->add_option("--request-timeout", *timeout_s, "seconds a client has to send a whole request (default 30)")->check(CLI::Range(1, 3600));
+  c->add_option("--max-connections", o->limits.max_connections, "open connections at most (default 10000)")->check(CLI::Range(1, 1000000));
   c->add_flag("--quiet", *quiet, "no log lines on stderr");
-  c->callback([o, quiet] { runServe(*o, *quiet); });
+  c->callback([o, quiet, timeout_s] {
+    o->limits.request_timeout = std::chrono::seconds(*timeout_s);
+    runServe(*o, *quiet);
+  });
 }
 
 }  // namespace skylane::cli
