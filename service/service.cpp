@@ -95,7 +95,8 @@ HttpResponse fileResponse(const fs::path& p, const std::string& content_type) {
 namespace {
 
 fs::path filesFolder(const std::string& db) {
-  fs::path p = fs::path(db);
+  // Absolute: missions written into an approval's folder name the zone set files by path.
+  fs::path p = fs::absolute(fs::path(db));
   p += ".files";
   return p;
 }
