@@ -35,7 +35,7 @@ function basemapGeojson(modules) {
 function build({ out, modules }) {
   const maplibre = join(modules, 'maplibre-gl', 'dist');
   if (!existsSync(maplibre)) throw new Error(`build.mjs: ${maplibre} is missing: run npm ci in web/ (or pass --modules)`);
-  rmSync(out, { recursive: true, force: true });
+  for (const entry of ['index.html', 'style.css', 'js', 'vendor', 'basemap']) rmSync(join(out, entry), { recursive: true, force: true });
   mkdirSync(join(out, 'vendor'), { recursive: true });
   mkdirSync(join(out, 'basemap'), { recursive: true });
   cpSync(join(here, 'src'), out, { recursive: true });

@@ -1,0 +1,316 @@
+// The operator's web map against a real `skylane serve`, in headless Chromium (playwright-core):
+// the authority uploads the example zones, an operator has the example mission approved and
+// starts its flight, the page loads with no console error and only loopback requests, its
+// layers hold the numbers of features the inputs give, a violating fix posted to the service
+// turns the flight red within 1 s, and screenshots go to the output folder for a person.
+//
+// node tests/web/map_test.mjs --skylane BIN --modules NODE_MODULES --out DIR [--source REPO]
+// (ctest runs it with the label `service`; the page itself is what the service serves at /).
+
+import { spawn, spawnSync } from 'node:child_process';
+import { createHash, randomBytes } from 'node:crypto';
+import { copyFileSync, mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { createServer } from 'node:net';
+import { tmpdir } from 'node:os';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+/** A violating fix must turn its flight red within this time of being posted [ms] (issue 20). */
+const kRedWithinMs = 1000;
+/** The service's start (database, tokens) [ms]. */
+const kServiceStartMs = 30000;
+/** An approval of the example mission (RRT* for 3 s, the PL prediction) [ms]. */
+const kApprovalMs = 180000;
+/** Lateral offset of the violating fix from the route [m]: far outside level 1 (±1.44 m), inside level 2 (±180 m). */
+const kViolationOffsetM = 12;
+/** Mean Earth radius [m] for the small offsets of the test's fixes. */
+const kEarthRadiusM = 6371008.8;
+/** The example's ground height above mean sea level [m] (examples/approve/mission.json, ground_amsl_m). */
+const kGroundAmslM = 408;
+
+const checks = [];
+function check(name, ok, detail = '') {
+  checks.push({ name, ok: !!ok });
+  console.log(`${ok ? 'PASS' : 'FAIL'} ${name}${detail ? `: ${detail}` : ''}`);
+}
+
+function parseArgs(argv) {
+  const here = dirname(fileURLToPath(import.meta.url));
+  const a = { source: resolve(here, '..', '..') };
+  for (let i = 0; i < argv.length; i += 2) {
+    if (!argv[i].startsWith('--') || i + 1 >= argv.length) throw new Error(`map_test: argument ${argv[i]}: expected --name value`);
+    a[argv[i].slice(2)] = resolve(argv[i + 1]);
+  }
+  for (const k of ['skylane', 'modules', 'out']) if (!a[k]) throw new Error(`map_test: --${k} is required`);
+  return a;
+}
+
+function freePort() {
+  return new Promise((res, rej) => {
+    const s = createServer();
+    s.once('error', rej);
+    s.listen(0, '127.0.0.1', () => { const { port } = s.address(); s.close(() => res(port)); });
+  });
+}
+
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+const sha256 = (s) => createHash('sha256').update(s).digest('hex');
+
+/** Starts `skylane serve` on a free loopback port with its own database and tokens. */
+async function startService(args, tmp) {
+  const tokens = { authority: randomBytes(24).toString('hex'), operator: randomBytes(24).toString('hex') };
+  writeFileSync(join(tmp, 'tokens.json'), JSON.stringify({ tokens: [
+    { sha256: sha256(tokens.operator), operator: 'acme' }, { sha256: sha256(tokens.authority), role: 'authority' }] }));
+  const orbits = join(tmp, 'orbits');
+  mkdirSync(orbits);
+  copyFileSync(join(args.source, 'tests/data/gnss/alm01jan2020.txt'), join(orbits, 'alm01jan2020.txt'));
+  const port = await freePort();
+  const proc = spawn(args.skylane, ['serve', '--tokens', join(tmp, 'tokens.json'), '--db', join(tmp, 'service.sqlite'),
+    '--port', String(port), '--orbits', orbits], { stdio: ['ignore', 'pipe', 'pipe'] });
+  let log = '';
+  proc.stdout.on('data', (d) => { log += d; });
+  proc.stderr.on('data', (d) => { log += d; });
+  const base = `http://127.0.0.1:${port}`;
+  const until = Date.now() + kServiceStartMs;
+  for (;;) {
+    if (proc.exitCode !== null) throw new Error(`skylane serve exited ${proc.exitCode}: ${log}`);
+    try {
+      if ((await fetch(`${base}/healthz`)).ok) break;
+    } catch (_) { /* not listening yet */ }
+    if (Date.now() > until) throw new Error(`skylane serve did not answer /healthz in ${kServiceStartMs} ms: ${log}`);
+    await sleep(100);
+  }
+  return { proc, base, tokens, log: () => log };
+}
+
+async function stopService(service) {
+  if (service.proc.exitCode !== null) return;
+  const exited = new Promise((r) => service.proc.once('exit', r));
+  service.proc.kill('SIGTERM');
+  if (await Promise.race([exited.then(() => true), sleep(10000).then(() => false)])) return;
+  service.proc.kill('SIGKILL');
+  await exited;
+}
+
+async function call(service, token, method, path, body, type = 'application/json') {
+  const headers = { Authorization: `Bearer ${token}` };
+  if (body !== undefined) headers['Content-Type'] = type;
+  const r = await fetch(service.base + path, { method, headers, body });
+  const text = await r.text();
+  let json = null;
+  try { json = JSON.parse(text); } catch (_) { /* a non-JSON body (mission.plan, svg) */ }
+  if (!r.ok) throw new Error(`${method} ${path}: HTTP ${r.status}: ${text}`);
+  return json;
+}
+
+/** The example mission, zones by zone set id, with nothing that names a file on the server. */
+function missionFor(args, zonesetId) {
+  const m = JSON.parse(readFileSync(join(args.source, 'examples/approve/mission.json'), 'utf8'));
+  delete m.zones;
+  delete m.buildings;
+  delete m.orbits;  // the service's --orbits directory gives the almanac
+  m.zonesets = [zonesetId];
+  return m;
+}
+
+async function approve(service, mission) {
+  const token = service.tokens.operator;
+  const { id } = await call(service, token, 'POST', '/v1/approvals', JSON.stringify(mission));
+  const until = Date.now() + kApprovalMs;
+  for (;;) {
+    const a = await call(service, token, 'GET', `/v1/approvals/${id}`);
+    if (a.status === 'approved') return id;
+    if (a.status === 'rejected' || a.status === 'failed') throw new Error(`approval ${id} ${a.status}: ${JSON.stringify(a)}`);
+    if (Date.now() > until) throw new Error(`approval ${id} still ${a.status} after ${kApprovalMs} ms`);
+    await sleep(250);
+  }
+}
+
+/**
+ * A fix `t_s` after departure on the route's first leg (its points' times, linear between them),
+ * moved `offset_m` to the left of the leg.
+ */
+function fixOnFirstLeg(report, flight, t_s, offset_m) {
+  const [a, b] = report.route;
+  const f = (t_s - a.eta_s) / (b.eta_s - a.eta_s);
+  const lat = a.lat + f * (b.lat - a.lat);
+  const lon = a.lon + f * (b.lon - a.lon);
+  const coslat = Math.cos((lat * Math.PI) / 180);
+  const e = (b.lon - a.lon) * coslat;
+  const n = b.lat - a.lat;
+  const len = Math.hypot(e, n);
+  const dLat = ((e / len) * offset_m / kEarthRadiusM) * (180 / Math.PI);
+  const dLon = ((-n / len) * offset_m / (kEarthRadiusM * coslat)) * (180 / Math.PI);
+  const time = new Date(Date.parse(report.departure) + t_s * 1000).toISOString();
+  return JSON.stringify({ flight, time, lat: lat + dLat, lon: lon + dLon, h_ell_m: a.h_ell_m + f * (b.h_ell_m - a.h_ell_m),
+    hpl_m: 0.5, vpl_m: 0.6 });
+}
+
+/** Zones of an ED-269 file that apply at t [ms]: permanent, or t in [start, end) (no schedules in the example). */
+function ed269ActiveAt(doc, t) {
+  return doc.UASZoneList.filter((z) => (z.applicability || []).length === 0 || z.applicability.some((a) =>
+    a.permanent === 'YES' || (Date.parse(a.startDateTime) <= t && t < Date.parse(a.endDateTime)))).length;
+}
+
+/** Chromium headless with software WebGL (SwiftShader), a fresh profile, no network of its own. */
+async function openBrowser(args, tmp) {
+  const { chromium } = await import(join(args.modules, 'playwright-core', 'index.mjs'));
+  return chromium.launchPersistentContext(join(tmp, 'chromium-profile'), {
+    executablePath: process.env.SKYLANE_CHROMIUM || '/usr/bin/chromium', headless: true,
+    viewport: { width: 1400, height: 900 },
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync',
+      '--use-gl=angle', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  });
+}
+
+/** Console errors, uncaught page errors and every request the page makes. */
+function watchPage(page) {
+  const seen = { errors: [], requests: [] };
+  page.on('console', (m) => { if (m.type() === 'error') seen.errors.push(`console: ${m.text()}`); });
+  page.on('pageerror', (e) => seen.errors.push(`page: ${e.message}`));
+  page.on('request', (r) => seen.requests.push(r.url()));
+  return seen;
+}
+
+async function expectedCounts(args, service, zonesetId, approvalId, report) {
+  const ed269 = JSON.parse(readFileSync(join(args.source, 'examples/approve/zones_ed269.json'), 'utf8'));
+  const zones = await call(service, service.tokens.operator, 'GET', `/v1/zonesets/${zonesetId}/geojson`);
+  const route = await call(service, service.tokens.operator, 'GET', `/v1/approvals/${approvalId}/route.geojson`);
+  const kind = (k) => route.features.filter((f) => f.properties.kind === k).length;
+  const departure = Date.parse(report.departure);
+  return {
+    zones: zones.features.length, zonesActive: ed269ActiveAt(ed269, departure), routes: 1, routePoints: kind('route_point'),
+    level1Boxes: kind('corridor'), level2Boxes: kind('airspace'), flights: 1, segments: report.route.length - 1,
+    sourceZones: ed269.UASZoneList.length, activeAt10: ed269ActiveAt(ed269, Date.parse('2020-01-01T10:00:00Z')),
+  };
+}
+
+async function checkLoaded(page, expected) {
+  const counts = await page.evaluate(() => window.skylaneMap.counts());
+  for (const k of ['zones', 'zonesActive', 'routes', 'routePoints', 'level1Boxes', 'level2Boxes', 'flights']) {
+    check(`layer count ${k}`, counts[k] === expected[k], `page ${counts[k]}, expected ${expected[k]}`);
+  }
+  check('one zone drawn per zone of the ED-269 file (no multi-volume zones there)', expected.zones === expected.sourceZones,
+    `${expected.zones} features, ${expected.sourceZones} zones in the file`);
+  check('one box per route segment at each level', expected.level1Boxes === expected.segments && expected.level2Boxes === expected.segments,
+    `${expected.level1Boxes} / ${expected.level2Boxes} boxes, ${expected.segments} segments`);
+  const rendered = {};
+  for (const layer of ['zones-outline', 'route-line', 'level1-boxes', 'level2-boxes', 'flight-points']) {
+    rendered[layer] = await page.evaluate((l) => window.skylaneMap.renderedCount(l), layer);
+  }
+  check('every active zone drawn in the fitted view', rendered['zones-outline'] === expected.zonesActive, JSON.stringify(rendered));
+  check('the route, its level-1 and level-2 boxes and the flight drawn', rendered['route-line'] === 1 &&
+    rendered['level2-boxes'] === expected.level2Boxes && rendered['level1-boxes'] >= 1 && rendered['flight-points'] === 1);
+}
+
+/** Posts the violating fix and measures how long the page takes to show the flight red. */
+async function checkViolationTurnsRed(page, service, flight, report) {
+  const token = service.tokens.operator;
+  const t0 = Date.now();
+  const answer = await call(service, token, 'POST', `/v1/flights/${flight}/fixes`,
+    fixOnFirstLeg(report, flight, 4, kViolationOffsetM), 'application/x-ndjson');
+  let red = true;
+  try {
+    await page.waitForFunction((id) => window.skylaneMap.flightColour(id) === 'red', flight, { timeout: kRedWithinMs, polling: 10 });
+  } catch (_) {
+    red = false;
+  }
+  const elapsed = Date.now() - t0;
+  check(`a violating fix turns its flight red within ${kRedWithinMs} ms`, red && elapsed <= kRedWithinMs,
+    `${elapsed} ms; service answered ${JSON.stringify(answer).slice(0, 200)}`);
+  await page.waitForFunction((id) => window.skylaneMap.renderedCount('violations') >= 1, flight, { timeout: 5000 }).catch(() => {});
+  const shown = await page.evaluate(() => window.skylaneMap.map.queryRenderedFeatures({ layers: ['flight-points'] })
+    .map((f) => f.properties.verdict_colour));
+  check('the drawn flight dot is red', shown.length === 1 && shown[0] === 'red', JSON.stringify(shown));
+}
+
+async function checkPopupAndTime(page, flight, expected, out) {
+  const at = await page.evaluate((id) => {
+    const f = window.skylaneMap.map.queryRenderedFeatures({ layers: ['flight-points'] })[0];
+    const p = window.skylaneMap.map.project(f.geometry.coordinates);
+    return [p.x, p.y];
+  }, flight);
+  await page.mouse.click(at[0], at[1]);
+  const popup = await page.waitForSelector('.maplibregl-popup', { timeout: 5000 }).then((e) => e.textContent()).catch(() => '');
+  check('a click on the flight shows its details', popup.includes(`flight ${flight}`) && popup.includes('hpl_m'), popup.slice(0, 120));
+  await page.screenshot({ path: join(out, 'map_popup.png') });
+  await page.evaluate(() => window.skylaneMap.setTime('2020-01-01T10:00:00Z'));
+  const active = await page.evaluate(() => window.skylaneMap.counts().zonesActive);
+  check('the time slider at 10:00Z shows the zones active then', active === expected.activeAt10, `${active} vs ${expected.activeAt10}`);
+  await page.screenshot({ path: join(out, 'map_at_1000Z.png') });
+}
+
+function checkOffline(seen, base) {
+  const away = seen.requests.filter((u) => !u.startsWith(`${base}/`) && !u.startsWith('data:') && !u.startsWith('blob:'));
+  check('every request the page makes goes to the loopback service', seen.requests.length > 0 && away.length === 0,
+    `${seen.requests.length} requests${away.length ? `, away: ${away.slice(0, 5).join(' ')}` : ''}`);
+  check('no console error and no uncaught page error', seen.errors.length === 0, seen.errors.slice(0, 5).join(' | '));
+}
+
+/** The service's side: zones, an approval, a flight with one fix inside its corridor. */
+async function prepareService(args, service) {
+  const zones = readFileSync(join(args.source, 'examples/approve/zones_ed269.json'));
+  const set = await call(service, service.tokens.authority, 'POST', '/v1/zonesets?name=zurich-example', zones);
+  const approvalId = await approve(service, missionFor(args, set.id));
+  const report = await call(service, service.tokens.operator, 'GET', `/v1/approvals/${approvalId}/report.json`);
+  const flight = (await call(service, service.tokens.operator, 'POST', '/v1/flights',
+    JSON.stringify({ approval: approvalId, id: 'zrh-web' }))).id;
+  await call(service, service.tokens.operator, 'POST', `/v1/flights/${flight}/fixes`, fixOnFirstLeg(report, flight, 2, 0),
+    'application/x-ndjson');
+  return { zonesetId: set.id, approvalId, report, flight };
+}
+
+async function run(args, tmp) {
+  mkdirSync(args.out, { recursive: true });
+  const service = await startService(args, tmp);
+  let browser = null;
+  try {
+    const s = await prepareService(args, service);
+    const expected = await expectedCounts(args, service, s.zonesetId, s.approvalId, s.report);
+    browser = await openBrowser(args, tmp);
+    const page = browser.pages()[0] || (await browser.newPage());
+    const seen = watchPage(page);
+    await page.goto(`${service.base}/#token=${service.tokens.operator}&ground=${kGroundAmslM}`);
+    await page.waitForFunction(() => window.skylaneMap && window.skylaneMap.ready, null, { timeout: 60000 });
+    await page.waitForFunction(() => document.getElementById('stream').dataset.state === 'open', null, { timeout: 10000 });
+    await page.waitForTimeout(1000);  // the sources' data reach the map's worker and are drawn
+    check('the flight starts green (its fix inside every level)', (await page.evaluate((id) => window.skylaneMap.flightColour(id), s.flight)) === 'green');
+    await checkLoaded(page, expected);
+    await page.screenshot({ path: join(args.out, 'map_loaded.png') });
+    await checkViolationTurnsRed(page, service, s.flight, s.report);
+    await page.screenshot({ path: join(args.out, 'map_violation.png') });
+    await checkPopupAndTime(page, s.flight, expected, args.out);
+    checkOffline(seen, service.base);
+  } finally {
+    if (browser) await browser.close();
+    await stopService(service);
+    writeFileSync(join(args.out, 'service.log'), service.log());
+  }
+}
+
+/** ctest's SKIP_RETURN_CODE for this test: a skylane built without the `serve` command. */
+const kSkip = 77;
+
+async function main() {
+  const args = parseArgs(process.argv.slice(2));
+  const help = spawnSync(args.skylane, ['--help'], { encoding: 'utf8' }).stdout || '';
+  if (!/^\s+serve\s/m.test(help)) {
+    console.log(`SKIP: ${args.skylane} has no serve command`);
+    process.exitCode = kSkip;
+    return;
+  }
+  const tmp = mkdtempSync(join(tmpdir(), 'skylane-web-'));
+  try {
+    await run(args, tmp);
+  } catch (err) {
+    check('the run completes', false, err.stack || String(err));
+  } finally {
+    rmSync(tmp, { recursive: true, force: true });
+  }
+  const failed = checks.filter((c) => !c.ok).length;
+  console.log(`web map: ${checks.length - failed} passed, ${failed} failed (screenshots in ${args.out})`);
+  process.exitCode = failed === 0 ? 0 : 1;
+}
+
+main();
