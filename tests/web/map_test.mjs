@@ -4,13 +4,12 @@
 // layers hold the numbers of features the inputs give, a violating fix posted to the service
 // turns the flight red within 1 s, and screenshots go to the output folder for a person.
 //
-// node tests/web/map_test.mjs --skylane BIN --modules NODE_MODULES --out DIR [--source REPO]
-// (ctest runs it with the label `service`; the page itself is what the service serves at /).
+// node tests/web/map_test.mjs --skylane BIN --web BUILT_PAGE --modules NODE_MODULES --out DIR [--source REPO]
+// (ctest runs it with the label `service`; the service serves the built page at /).
 
 import { spawn, spawnSync } from 'node:child_process';
 import { createHash, randomBytes } from 'node:crypto';
 import { copyFileSync, mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
-import { createServer } from 'node:net';
 import { tmpdir } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -41,16 +40,8 @@ function parseArgs(argv) {
     if (!argv[i].startsWith('--') || i + 1 >= argv.length) throw new Error(`map_test: argument ${argv[i]}: expected --name value`);
     a[argv[i].slice(2)] = resolve(argv[i + 1]);
   }
-  for (const k of ['skylane', 'modules', 'out']) if (!a[k]) throw new Error(`map_test: --${k} is required`);
+  for (const k of ['skylane', 'web', 'modules', 'out']) if (!a[k]) throw new Error(`map_test: --${k} is required`);
   return a;
-}
-
-function freePort() {
-  return new Promise((res, rej) => {
-    const s = createServer();
-    s.once('error', rej);
-    s.listen(0, '127.0.0.1', () => { const { port } = s.address(); s.close(() => res(port)); });
-  });
 }
 
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
@@ -64,19 +55,20 @@ async function startService(args, tmp) {
   const orbits = join(tmp, 'orbits');
   mkdirSync(orbits);
   copyFileSync(join(args.source, 'tests/data/gnss/alm01jan2020.txt'), join(orbits, 'alm01jan2020.txt'));
-  const port = await freePort();
+  // --port 0: the service takes a free port and prints it ("skylane: serving on http://HOST:PORT/").
   const proc = spawn(args.skylane, ['serve', '--tokens', join(tmp, 'tokens.json'), '--db', join(tmp, 'service.sqlite'),
-    '--port', String(port), '--orbits', orbits], { stdio: ['ignore', 'pipe', 'pipe'] });
+    '--host', '127.0.0.1', '--port', '0', '--orbits', orbits, '--web', args.web], { stdio: ['ignore', 'pipe', 'pipe'] });
   let log = '';
   proc.stdout.on('data', (d) => { log += d; });
   proc.stderr.on('data', (d) => { log += d; });
-  const base = `http://127.0.0.1:${port}`;
   const until = Date.now() + kServiceStartMs;
+  let base = null;
   for (;;) {
     if (proc.exitCode !== null) throw new Error(`skylane serve exited ${proc.exitCode}: ${log}`);
+    base = base || (/serving on (http:\/\/127\.0\.0\.1:\d+)\//.exec(log) || [])[1];
     try {
-      if ((await fetch(`${base}/healthz`)).ok) break;
-    } catch (_) { /* not listening yet */ }
+      if (base && (await fetch(`${base}/healthz`)).ok) break;
+    } catch (_) { /* not answering yet */ }
     if (Date.now() > until) throw new Error(`skylane serve did not answer /healthz in ${kServiceStartMs} ms: ${log}`);
     await sleep(100);
   }
