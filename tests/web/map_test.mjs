@@ -138,10 +138,11 @@ function fixOnFirstLeg(report, flight, t_s, offset_m) {
     hpl_m: 0.5, vpl_m: 0.6 });
 }
 
-/** Zones of an ED-269 file that apply at t [ms]: permanent, or t in [start, end) (no schedules in the example). */
+/** Identifiers of an ED-269 file's zones that apply at t [ms]: permanent, or t in [start, end) (no schedules in the example). */
 function ed269ActiveAt(doc, t) {
   return doc.UASZoneList.filter((z) => (z.applicability || []).length === 0 || z.applicability.some((a) =>
-    a.permanent === 'YES' || (Date.parse(a.startDateTime) <= t && t < Date.parse(a.endDateTime)))).length;
+    a.permanent === 'YES' || (Date.parse(a.startDateTime) <= t && t < Date.parse(a.endDateTime))))
+    .map((z) => z.identifier).sort();
 }
 
 /** Chromium headless with software WebGL (SwiftShader), a fresh profile, no network of its own. */
@@ -172,7 +173,7 @@ async function expectedCounts(args, service, zonesetId, approvalId, report) {
   const kind = (k) => route.features.filter((f) => f.properties.kind === k).length;
   const departure = Date.parse(report.departure);
   return {
-    zones: zones.features.length, zonesActive: ed269ActiveAt(ed269, departure), routes: 1, routePoints: kind('route_point'),
+    zones: zones.features.length, zonesActive: ed269ActiveAt(ed269, departure).length, activeAtDeparture: ed269ActiveAt(ed269, departure), routes: 1, routePoints: kind('route_point'),
     level1Boxes: kind('corridor'), level2Boxes: kind('airspace'), flights: 1, segments: report.route.length - 1,
     sourceZones: ed269.UASZoneList.length, activeAt10: ed269ActiveAt(ed269, Date.parse('2020-01-01T10:00:00Z')),
   };
@@ -183,6 +184,9 @@ async function checkLoaded(page, expected) {
   for (const k of ['zones', 'zonesActive', 'routes', 'routePoints', 'level1Boxes', 'level2Boxes', 'flights']) {
     check(`layer count ${k}`, counts[k] === expected[k], `page ${counts[k]}, expected ${expected[k]}`);
   }
+  const active = await page.evaluate(() => window.skylaneMap.activeZones());
+  check('the zones shown at the departure are those the ED-269 file makes active then',
+    JSON.stringify(active) === JSON.stringify(expected.activeAtDeparture), active.join(' '));
   check('one zone drawn per zone of the ED-269 file (no multi-volume zones there)', expected.zones === expected.sourceZones,
     `${expected.zones} features, ${expected.sourceZones} zones in the file`);
   check('one box per route segment at each level', expected.level1Boxes === expected.segments && expected.level2Boxes === expected.segments,
@@ -228,8 +232,9 @@ async function checkPopupAndTime(page, flight, expected, out) {
   check('a click on the flight shows its details', popup.includes(`flight ${flight}`) && popup.includes('hpl_m'), popup.slice(0, 120));
   await page.screenshot({ path: join(out, 'map_popup.png') });
   await page.evaluate(() => window.skylaneMap.setTime('2020-01-01T10:00:00Z'));
-  const active = await page.evaluate(() => window.skylaneMap.counts().zonesActive);
-  check('the time slider at 10:00Z shows the zones active then', active === expected.activeAt10, `${active} vs ${expected.activeAt10}`);
+  const active = await page.evaluate(() => window.skylaneMap.activeZones());
+  check('the time slider at 10:00Z shows the zones active then', JSON.stringify(active) === JSON.stringify(expected.activeAt10),
+    `${active.join(' ')} vs ${expected.activeAt10.join(' ')}`);
   await page.screenshot({ path: join(out, 'map_at_1000Z.png') });
 }
 
@@ -240,7 +245,7 @@ function checkOffline(seen, base) {
   check('no console error and no uncaught page error', seen.errors.length === 0, seen.errors.slice(0, 5).join(' | '));
 }
 
-/** The service's side: zones, an approval, a flight with one fix inside its corridor. */
+/** The service's side: zones, an approval and a flight (its first fix is posted with the page open). */
 async function prepareService(args, service) {
   const zones = readFileSync(join(args.source, 'examples/approve/zones_ed269.json'));
   const set = await call(service, service.tokens.authority, 'POST', '/v1/zonesets?name=zurich-example', zones);
@@ -248,8 +253,6 @@ async function prepareService(args, service) {
   const report = await call(service, service.tokens.operator, 'GET', `/v1/approvals/${approvalId}/report.json`);
   const flight = (await call(service, service.tokens.operator, 'POST', '/v1/flights',
     JSON.stringify({ approval: approvalId, id: 'zrh-web' }))).id;
-  await call(service, service.tokens.operator, 'POST', `/v1/flights/${flight}/fixes`, fixOnFirstLeg(report, flight, 2, 0),
-    'application/x-ndjson');
   return { zonesetId: set.id, approvalId, report, flight };
 }
 
@@ -266,8 +269,14 @@ async function run(args, tmp) {
     await page.goto(`${service.base}/#token=${service.tokens.operator}&ground=${kGroundAmslM}`);
     await page.waitForFunction(() => window.skylaneMap && window.skylaneMap.ready, null, { timeout: 60000 });
     await page.waitForFunction(() => document.getElementById('stream').dataset.state === 'open', null, { timeout: 10000 });
+    // The first fix, on the route: it reaches the page through the event stream.
+    await call(service, service.tokens.operator, 'POST', `/v1/flights/${s.flight}/fixes`, fixOnFirstLeg(s.report, s.flight, 2, 0),
+      'application/x-ndjson');
+    const green = await page.waitForFunction((id) => window.skylaneMap.flightColour(id) === 'green', s.flight, { timeout: 5000 })
+      .then(() => true, () => false);
+    check('the flight appears green (its fix inside every level)', green,
+      String(await page.evaluate((id) => window.skylaneMap.flightColour(id), s.flight)));
     await page.waitForTimeout(1000);  // the sources' data reach the map's worker and are drawn
-    check('the flight starts green (its fix inside every level)', (await page.evaluate((id) => window.skylaneMap.flightColour(id), s.flight)) === 'green');
     await checkLoaded(page, expected);
     await page.screenshot({ path: join(args.out, 'map_loaded.png') });
     await checkViolationTurnsRed(page, service, s.flight, s.report);

@@ -22,6 +22,7 @@ const state = {
   api: null, map: null, zones: [], zonesets: [], activeKeys: new Set(), time: Date.now(),
   routes: new RouteStore(), flights: new FlightStore(), labels: new Map(), approvals: new Map(),
   ground: { amsl_m: 0, undulation_m: 0, given: false }, stream: null, events: 0, redraw: null, ready: false,
+  discovered: new Set(),
 };
 
 function hashParam(name) {
@@ -128,6 +129,8 @@ function redrawNow() {
   setData('trails', state.flights.trails());
   setData('violations', state.flights.violations());
   updateLabels();
+  setStatus(`${state.zones.length} zones in ${state.zonesets.length} sets, ${state.routes.count('route')} routes, ` +
+    `${state.flights.count()} flights, ${state.flights.violationCount()} violations`);
 }
 
 function redrawSoon() {
@@ -151,7 +154,10 @@ function onEvent(message) {
   else if (type === 'replan' && e.decision === 'approved') {
     loadFlightRoute(e.flight, e.route_version).catch((err) => setStatus(String(err.message), true));
   }
-  if (type === 'fix' && !state.flights.get(e.flight).approval) discoverSoon();
+  if (type === 'fix' && !state.flights.get(e.flight).approval && !state.discovered.has(e.flight)) {
+    state.discovered.add(e.flight);
+    discoverSoon();
+  }
   redrawSoon();
 }
 
@@ -238,6 +244,7 @@ function exposeHook() {
       flights: state.flights.count(), violations: state.flights.violationCount(), events: state.events,
     }),
     renderedCount,
+    activeZones: () => state.zones.filter((z) => state.activeKeys.has(z.properties.key)).map((z) => z.properties.identifier).sort(),
     flightColour: (id) => state.flights.colour(id),
     setTime: (t) => applyTime(typeof t === 'number' ? t : Date.parse(t)),
     lastEventId: () => state.stream?.lastEventId ?? '',
@@ -274,7 +281,6 @@ async function main() {
   fitToContent();
   openStream();
   document.getElementById('reload').onclick = () => loadAll().then(redrawNow, (err) => setStatus(String(err.message), true));
-  setStatus(`${state.zones.length} zones in ${state.zonesets.length} sets, ${state.routes.count('route')} routes, ${state.flights.count()} flights`);
   state.ready = true;
 }
 

@@ -11,7 +11,9 @@ const kKinds = ['route', 'route_point', 'corridor', 'airspace', 'reason'];
 export function routeFeatures(geojson, owner) {
   const out = [];
   for (const f of geojson.features || []) {
-    const p = f.properties || {};
+    const p = { ...(f.properties || {}) };
+    // A route given as a bare line (a flight's current route without its boxes) is a route.
+    if (p.kind === undefined && f.geometry && f.geometry.type === 'LineString') p.kind = 'route';
     if (!kKinds.includes(p.kind)) continue;
     const properties = { ...p, owner: owner.key, approval: owner.approval || '', flight: owner.flight || '',
       route_version: owner.route_version ?? 1, current: owner.flight ? 'replanned' : 'approved' };

@@ -57,8 +57,9 @@ const kWeekdays = ['MON', 'TUE', 'WED', 'THU', 'FRI', 'SAT', 'SUN'];
 function scheduleCovers(schedule, t) {
   if (!schedule || schedule.length === 0) return true;
   const today = Math.floor(t / kDayMs);
-  // A period starting yesterday may run past midnight into today.
-  for (let d = today - 1; d <= today; ++d) {
+  // A period may run past midnight, and a local period shifted to UTC may start up to a day
+  // before or after its day (start_utc_s < 0 or > 86400): the days around t are all tried.
+  for (let d = today - 2; d <= today + 1; ++d) {
     const weekday = kWeekdays[(((d + 3) % 7) + 7) % 7];  // 1970-01-01 was a Thursday
     for (const p of schedule) {
       const days = p.day || [];
