@@ -221,6 +221,28 @@ async function checkViolationTurnsRed(page, service, flight, report) {
   check('the drawn flight dot is red', shown.length === 1 && shown[0] === 'red', JSON.stringify(shown));
 }
 
+/**
+ * Two more fixes beside the route: level 1 violated by the position in 3 of the last 5 fixes,
+ * which the tracker replans (planner/tracking/tracker.hpp, step 6); the page draws the new route.
+ */
+async function checkReplanRedrawn(page, service, flight, report, out) {
+  let replans = [];
+  for (const t of [5, 6]) {
+    const answer = await call(service, service.tokens.operator, 'POST', `/v1/flights/${flight}/fixes`,
+      fixOnFirstLeg(report, flight, t, kViolationOffsetM), 'application/x-ndjson');
+    replans = replans.concat((answer.events || []).filter((e) => e.event === 'replan'));
+  }
+  check('the service replans after the persistent level-1 violation', replans.length === 1 && replans[0].decision === 'approved',
+    JSON.stringify(replans.map((e) => ({ decision: e.decision, route_version: e.route_version, error: e.error }))));
+  const drawn = await page.waitForFunction(() => window.skylaneMap.counts().routes === 2, null, { timeout: 10000 })
+    .then(() => true, () => false);
+  const logged = await page.textContent('#event-log');
+  check('the page draws the replanned route beside the approved one and logs the replan', drawn && logged.includes('replan'),
+    JSON.stringify(await page.evaluate(() => window.skylaneMap.counts())));
+  await page.waitForTimeout(500);
+  await page.screenshot({ path: join(out, 'map_replan.png') });
+}
+
 async function checkPopupAndTime(page, flight, expected, out) {
   const at = await page.evaluate((id) => {
     const f = window.skylaneMap.map.queryRenderedFeatures({ layers: ['flight-points'] })[0];
@@ -281,6 +303,7 @@ async function run(args, tmp) {
     await page.screenshot({ path: join(args.out, 'map_loaded.png') });
     await checkViolationTurnsRed(page, service, s.flight, s.report);
     await page.screenshot({ path: join(args.out, 'map_violation.png') });
+    await checkReplanRedrawn(page, service, s.flight, s.report, args.out);
     await checkPopupAndTime(page, s.flight, expected, args.out);
     checkOffline(seen, service.base);
   } finally {
