@@ -22,7 +22,7 @@ const state = {
   api: null, map: null, zones: [], zonesets: [], activeKeys: new Set(), time: Date.now(),
   routes: new RouteStore(), flights: new FlightStore(), labels: new Map(), approvals: new Map(),
   ground: { amsl_m: 0, undulation_m: 0, given: false }, stream: null, events: 0, redraw: null, ready: false,
-  discovered: new Set(),
+  discovered: new Set(), slider: null, zonesDrawn: null, routesDrawn: -1,
 };
 
 function hashParam(name) {
@@ -122,8 +122,15 @@ function redrawNow() {
   clearTimeout(state.redraw);
   state.redraw = null;
   const groundH_ell = state.ground.amsl_m + state.ground.undulation_m;
-  setData('zones', state.zones.map(({ type, id, geometry, properties }) => ({ type, id, geometry, properties })));
-  setData('routes', state.routes.all());
+  // Zones and routes change rarely (a load, a replan); fixes only move the flights' layers.
+  if (state.zonesDrawn !== state.zones) {
+    setData('zones', state.zones.map(({ type, id, geometry, properties }) => ({ type, id, geometry, properties })));
+    state.zonesDrawn = state.zones;
+  }
+  if (state.routesDrawn !== state.routes.version) {
+    setData('routes', state.routes.all());
+    state.routesDrawn = state.routes.version;
+  }
   setData('cylinders', state.flights.cylinders(groundH_ell));
   setData('flight_points', state.flights.points());
   setData('trails', state.flights.trails());
@@ -193,7 +200,7 @@ function initSlider() {
   const initialAt = Number.isFinite(Date.parse(hashParam('time'))) ? Date.parse(hashParam('time'))
     : departures.length ? departures[0] : Date.now();
   all.push(initialAt);
-  initTimeSlider(Math.min(...all) - kSliderMarginMs, Math.max(...all) + kSliderMarginMs, initialAt, applyTime);
+  state.slider = initTimeSlider(Math.min(...all) - kSliderMarginMs, Math.max(...all) + kSliderMarginMs, initialAt, applyTime);
 }
 
 /** A click shows the details of the most specific feature there (kClickableLayers' order). */
@@ -246,7 +253,7 @@ function exposeHook() {
     renderedCount,
     activeZones: () => state.zones.filter((z) => state.activeKeys.has(z.properties.key)).map((z) => z.properties.identifier).sort(),
     flightColour: (id) => state.flights.colour(id),
-    setTime: (t) => applyTime(typeof t === 'number' ? t : Date.parse(t)),
+    setTime: (t) => state.slider.set(typeof t === 'number' ? t : Date.parse(t)),  // as a move of the slider
     lastEventId: () => state.stream?.lastEventId ?? '',
   };
 }
@@ -280,7 +287,10 @@ async function main() {
   initSlider();
   fitToContent();
   openStream();
-  document.getElementById('reload').onclick = () => loadAll().then(redrawNow, (err) => setStatus(String(err.message), true));
+  document.getElementById('reload').onclick = () => loadAll().then(() => {
+    redrawNow();
+    applyTime(state.time);  // the reloaded zones' applicability
+  }, (err) => setStatus(String(err.message), true));
   state.ready = true;
 }
 

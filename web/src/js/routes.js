@@ -27,9 +27,15 @@ export function routeFeatures(geojson, owner) {
 
 /** Routes held by owner key: set() replaces one owner's features, all() lists every feature. */
 export class RouteStore {
-  constructor() { this.byOwner_ = new Map(); }
+  constructor() {
+    this.byOwner_ = new Map();
+    this.version = 0;  // counts changes, so that a redraw knows whether the routes changed
+  }
 
-  set(key, features) { this.byOwner_.set(key, features); }
+  set(key, features) {
+    this.byOwner_.set(key, features);
+    this.version += 1;
+  }
 
   has(key) { return this.byOwner_.has(key); }
 
