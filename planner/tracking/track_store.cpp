@@ -111,6 +111,23 @@ std::vector<nlohmann::json> TrackStore::events(const std::string& type) const {
   return out;
 }
 
+std::vector<TrackStore::LoggedEvent> TrackStore::eventsAfter(std::int64_t after, std::size_t limit) const {
+  std::vector<LoggedEvent> out;
+  Statement st;
+  if (sqlite3_prepare_v2(db_, "SELECT seq, flight, type, json FROM events WHERE seq > ? ORDER BY seq LIMIT ?", -1, &st.s,
+                         nullptr) != SQLITE_OK) {
+    fail("cannot read events");
+  }
+  sqlite3_bind_int64(st.s, 1, after);
+  sqlite3_bind_int64(st.s, 2, static_cast<sqlite3_int64>(limit));
+  while (sqlite3_step(st.s) == SQLITE_ROW) {
+    out.push_back({sqlite3_column_int64(st.s, 0), columnText(st.s, 1), columnText(st.s, 2), columnText(st.s, 3)});
+  }
+  return out;
+}
+
+std::int64_t TrackStore::lastEventSeq() const { return sqlite3_last_insert_rowid(db_); }
+
 void TrackStore::begin() {
   if (in_batch_) return;
   exec("BEGIN");

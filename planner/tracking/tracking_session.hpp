@@ -73,6 +73,11 @@ class TrackingSession {
   void reject(const std::string& where, std::size_t line, const std::string& why, const std::string& flight = {});
   /// \brief The stale sweep at the stream time and a checkpoint (the end of a run).
   void finish();
+  /// \brief A checkpoint now: what was submitted is committed and handed to the sinks (a
+  /// service answers a request only after this, so an acknowledged fix is never lost).
+  void commit() { checkpoint(true); }
+  /// \brief The database, when there is one.
+  [[nodiscard]] TrackStore* store() { return store_.get(); }
 
   [[nodiscard]] Tracker& tracker() { return tracker_; }
   [[nodiscard]] const Tracker& tracker() const { return tracker_; }
