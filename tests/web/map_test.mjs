@@ -260,6 +260,18 @@ async function checkPopupAndTime(page, flight, expected, out) {
   await page.screenshot({ path: join(out, 'map_at_1000Z.png') });
 }
 
+/** A page opened after the replan: the token from the tab's session, the flight's current route from the service. */
+async function checkReopened(page, out) {
+  await page.reload();
+  const ready = await page.waitForFunction(() => window.skylaneMap && window.skylaneMap.ready, null, { timeout: 60000 })
+    .then(() => true, () => false);
+  const counts = ready ? await page.evaluate(() => window.skylaneMap.counts()) : {};
+  check('reopened with the session\'s token, the page shows the approved and the replanned route', ready && counts.routes === 2,
+    JSON.stringify(counts));
+  await page.waitForTimeout(500);
+  await page.screenshot({ path: join(out, 'map_reopened.png') });
+}
+
 function checkOffline(seen, base) {
   const away = seen.requests.filter((u) => !u.startsWith(`${base}/`) && !u.startsWith('data:') && !u.startsWith('blob:'));
   check('every request the page makes goes to the loopback service', seen.requests.length > 0 && away.length === 0,
@@ -305,6 +317,7 @@ async function run(args, tmp) {
     await page.screenshot({ path: join(args.out, 'map_violation.png') });
     await checkReplanRedrawn(page, service, s.flight, s.report, args.out);
     await checkPopupAndTime(page, s.flight, expected, args.out);
+    await checkReopened(page, args.out);
     checkOffline(seen, service.base);
   } finally {
     if (browser) await browser.close();
