@@ -38,14 +38,7 @@ HttpResponse ServiceImpl::flightsRoute(const HttpRequest& r, const Principal& wh
   if (part.empty()) return flightJson(f);
   if (part == "events") return eventStream(r, who, f.id);
   if (part == "route") {
-    const json route = session->tracker().routeJson(f.id);
-    json line = json::array();
-    for (const json& p : route["route"]) line.push_back({p["lon"], p["lat"], p["alt_amsl_m"]});
-    const json feature = {{"type", "Feature"},
-                          {"geometry", {{"type", "LineString"}, {"coordinates", line}}},
-                          {"properties", {{"flight", f.id}, {"route_version", session->tracker().state(f.id).route_version},
-                                          {"departure", route["departure"]}, {"points", route["route"]}}}};
-    HttpResponse res = jsonBody(200, {{"type", "FeatureCollection"}, {"features", json::array({feature})}});
+    HttpResponse res = jsonBody(200, session->tracker().routeGeoJson(f.id));
     res.content_type = "application/geo+json";
     return res;
   }
@@ -86,7 +79,9 @@ HttpResponse ServiceImpl::startFlight(const HttpRequest& r, const Principal& who
 
 HttpResponse ServiceImpl::flightJson(const FlightRow& f) const {
   const planner::FlightState& st = session->tracker().state(f.id);
-  return jsonBody(200, {{"id", f.id}, {"approval", f.approval}, {"created", f.created}, {"state", planner::flightStateJson(st)}});
+  nlohmann::json j = {{"id", f.id}, {"approval", f.approval}, {"created", f.created}, {"state", planner::flightStateJson(st)}};
+  if (const auto it = last_fix.find(f.id); it != last_fix.end()) j["last_fix"] = nlohmann::json::parse(it->second);
+  return jsonBody(200, j);
 }
 
 HttpResponse ServiceImpl::postFixes(const HttpRequest& r, const FlightRow& f) {

@@ -119,7 +119,10 @@ ServiceImpl::ServiceImpl(ServeOptions o, Service::Log l)
   session->addSink(*hub);
   hub->observers.push_back([this](const HubEvent& e) {
     ++metrics.events;
-    if (e.type == "fix") ++metrics.fixes_accepted;
+    if (e.type == "fix") {
+      ++metrics.fixes_accepted;
+      last_fix[e.flight] = e.line;
+    }
     if (e.type == "rejected_input") ++metrics.inputs_rejected;
   });
   server = std::make_unique<HttpServer>(options.host, options.port, [this](const HttpRequest& r) { return handle(r); }, options.limits);
@@ -156,6 +159,7 @@ void ServiceImpl::restore() {
     if (st.row.status == "queued" || st.row.status == "running") queueApproval(st);
   }
   for (FlightRow& f : store->flights()) flights[f.id] = std::move(f);
+  last_fix = store->lastFixes();
   session->resumeFlights();
   log("serving " + std::to_string(zonesets.size()) + " zone sets, " + std::to_string(approvals.size()) + " approvals, " +
       std::to_string(flights.size()) + " flights from " + options.db);

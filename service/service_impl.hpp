@@ -59,6 +59,7 @@ class ServiceImpl {
   std::map<std::string, LoadedZoneSet> zonesets;
   std::map<std::string, ApprovalState> approvals;
   std::map<std::string, FlightRow> flights;
+  std::map<std::string, std::string> last_fix;  ///< each flight's last `fix` event (its JSON line)
   std::unique_ptr<ApprovalPool> pool;
   std::unique_ptr<HttpServer> server;
 

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,6 +60,8 @@ class ServiceStore {
 
   void addFlight(const FlightRow& f);
   [[nodiscard]] std::vector<FlightRow> flights() const;
+  /// \brief Each flight's last `fix` event in the tracker's event log (flight → JSON line).
+  [[nodiscard]] std::map<std::string, std::string> lastFixes() const;
 
  private:
   void exec(const std::string& sql) const;

@@ -94,6 +94,18 @@ class HttpClient {
     }
     return streamed_;
   }
+  /// \brief Takes what the stream has sent so far without waiting.
+  const std::string& readAvailable() {
+    char buf[65536];
+    for (;;) {
+      pollfd p{fd_, POLLIN, 0};
+      if (fd_ < 0 || poll(&p, 1, 0) <= 0) break;
+      const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+      if (n <= 0) break;
+      streamed_.append(buf, static_cast<std::size_t>(n));
+    }
+    return streamed_;
+  }
   /// \brief Reads until `needle` appears in the stream or `ms` pass; whether it did.
   bool waitFor(const std::string& needle, int ms) {
     const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);

@@ -86,10 +86,11 @@ class Service : public ::testing::Test {
   }
   /// A fix k seconds after departure on the flight's route, shifted `off_m` metres north.
   json fixAt(const std::string& flight, int k, double off_m = 0.0, double pl_m = 0.5) {
-    if (route_.is_null()) {
-      route_ = json::parse(call("GET", "/v1/flights/" + flight + "/route", TestTokens::kAcme).body)["features"][0]["properties"];
+    if (route_.is_null()) {  // the approved route, from the flight's approval report
+      const json f = json::parse(call("GET", "/v1/flights/" + flight, TestTokens::kAcme).body);
+      route_ = json::parse(call("GET", "/v1/approvals/" + f.at("approval").get<std::string>() + "/report.json", TestTokens::kAcme).body);
     }
-    const json& pts = route_.at("points");
+    const json& pts = route_.at("route");
     std::size_t i = 1;
     while (i + 1 < pts.size() && k > pts[i].at("eta_s").get<double>()) ++i;
     const json &a = pts[i - 1], &b = pts[i];
@@ -255,6 +256,21 @@ TEST_F(Service, TrackingThroughTheServiceGivesTheEventsOfSkylaneTrack) {
   const std::string ap = approve(TestTokens::kAcme, zs);
   ASSERT_EQ(json::parse(call("GET", "/v1/approvals/" + ap, TestTokens::kAcme).body).at("status"), "approved");
   const std::string fl = startFlight(TestTokens::kAcme, ap);
+  // Before any replan the flight's route is the approved one: the same boxes as the approval's
+  // route.geojson (made from the report's map positions; the flight's from its lat/lon).
+  const json approved = json::parse(call("GET", "/v1/approvals/" + ap + "/route.geojson", TestTokens::kAcme).body);
+  const json current = json::parse(call("GET", "/v1/flights/" + fl + "/route", TestTokens::kAcme).body);
+  ASSERT_EQ(current.at("features").size(), approved.at("features").size() - 0u) << current.dump();
+  for (std::size_t i = 0; i < current["features"].size(); ++i) {
+    const json &a = approved["features"][i], &b = current["features"][i];
+    EXPECT_EQ(a["properties"]["kind"], b["properties"]["kind"]);
+    if (a["geometry"]["type"] != "Polygon") continue;
+    for (std::size_t v = 0; v < a["geometry"]["coordinates"][0].size(); ++v) {
+      for (int c = 0; c < 2; ++c) {
+        EXPECT_NEAR(a["geometry"]["coordinates"][0][v][c].get<double>(), b["geometry"]["coordinates"][0][v][c].get<double>(), 2e-8);
+      }
+    }
+  }
   // On the route, then 40 m off it (a level-1 violation, held: a replan), then a bad line.
   std::string body;
   for (int k = 0; k < 30; ++k) body += fixAt(fl, k, k >= 12 && k < 20 ? 40.0 : 0.0).dump() + "\n";
@@ -277,7 +293,9 @@ TEST_F(Service, TrackingThroughTheServiceGivesTheEventsOfSkylaneTrack) {
   }
   std::vector<json> actual;
   for (const json& e : got.at("events")) {
-    if (e.at("event") == "rejected_input") EXPECT_EQ(e.at("flight"), fl);
+    if (e.at("event") == "rejected_input") {
+      EXPECT_EQ(e.at("flight"), fl);
+    }
     actual.push_back(comparable(e));
   }
   ASSERT_EQ(actual.size(), expected.size()) << cli.out;
@@ -287,6 +305,16 @@ TEST_F(Service, TrackingThroughTheServiceGivesTheEventsOfSkylaneTrack) {
   };
   EXPECT_GE(count("violation"), 1);
   EXPECT_GE(count("replan"), 1);
+  // The flight's route is now the last replan's, and the list shows its last fix.
+  const json after = json::parse(call("GET", "/v1/flights/" + fl + "/route", TestTokens::kAcme).body);
+  EXPECT_EQ(after["features"][0]["properties"]["route_version"], count("replan"));
+  EXPECT_GT(std::count_if(after["features"].begin(), after["features"].end(), [](const json& f) { return f["properties"]["kind"] == "corridor"; }), 0);
+  const json listed = json::parse(call("GET", "/v1/flights", TestTokens::kAcme).body).at("flights").at(0);
+  json last_fix;
+  for (const json& e : got.at("events")) {
+    if (e.at("event") == "fix") last_fix = e;
+  }
+  EXPECT_EQ(listed.at("last_fix"), last_fix);
   EXPECT_EQ(count("rejected_input"), 1);
 }
 

@@ -74,7 +74,8 @@ async function loadFlights() {
   const list = (await state.api.flights()).flights || [];
   for (const f of list) {
     state.flights.upsert(f);
-    const version = f.last_fix?.route_version ?? f.state?.route_version ?? 0;
+    // The state's version counts a replan that came after the last fix event.
+    const version = Math.max(f.last_fix?.route_version ?? 0, f.state?.route_version ?? 0);
     if (version > 0 && !state.routes.has(`flight:${f.id}`)) await loadFlightRoute(f.id, version);
   }
 }
