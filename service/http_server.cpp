@@ -351,6 +351,11 @@ unsigned short HttpServer::port() const { return impl_->acceptor.local_endpoint(
 
 void HttpServer::run() { impl_->ioc.run(); }
 
+void HttpServer::poll() {
+  impl_->ioc.restart();
+  impl_->ioc.poll();
+}
+
 void HttpServer::stop() { impl_->ioc.stop(); }
 
 void HttpServer::post(std::function<void()> work) { net::post(impl_->ioc, std::move(work)); }

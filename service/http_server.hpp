@@ -41,6 +41,9 @@ class HttpServer {
   [[nodiscard]] unsigned short port() const;
   /// \brief Runs the event loop on this thread until stop().
   void run();
+  /// \brief Runs the handlers that are ready now, without waiting (a caller driving the service
+  /// without run(): tests, the fuzz target).
+  void poll();
   /// \brief Ends run() (thread-safe, async-signal-unsafe).
   void stop();
   /// \brief Runs `work` on the server's thread (thread-safe).
