@@ -1,5 +1,11 @@
 #include "cli/serve_commands.hpp"
 
+#include "link/byte_link.hpp"
+#include "link/mavlink/fix_source.hpp"
+#include "link/ubx/fix_source.hpp"
+#include "maps/parse_error.hpp"
+#include "planner/tracking/fix_source.hpp"
+#include "planner/tracking/line_input.hpp"
 #include "service/service.hpp"
 
 #include <csignal>
@@ -38,7 +44,25 @@ void raiseOpenFileLimit() {
   }
 }
 
-void runServe(service::ServeOptions o, bool quiet) {
+/// One --input: FORMAT:ADDRESS[#FLIGHT] → its source and the flight it feeds (empty: named per record).
+std::pair<std::unique_ptr<planner::FixSource>, std::string> openInput(const std::string& spec) {
+  const std::size_t colon = spec.find(':');
+  const std::size_t hash = spec.rfind('#');
+  const std::string format = spec.substr(0, colon);
+  const std::string flight = hash == std::string::npos ? std::string() : spec.substr(hash + 1);
+  const std::string address = colon == std::string::npos ? std::string() : spec.substr(colon + 1, hash == std::string::npos ? std::string::npos : hash - colon - 1);
+  const char* expected = "FORMAT:ADDRESS[#FLIGHT]: jsonl:udp://IP:PORT (lines name their flight), mavlink:ADDRESS#FLIGHT or ubx:ADDRESS#FLIGHT";
+  if (address.empty()) throw maps::ParseError("--input", 0, "--input", spec, expected);
+  if (format == "jsonl") return {std::make_unique<planner::JsonLinesFixSource>(planner::openLineInput(address)), flight};
+  if ((format == "mavlink" || format == "ubx") && !flight.empty()) {
+    auto link = link::openByteLink(address, 57600);
+    if (format == "ubx") return {std::make_unique<link::ubx::UbxFixSource>(std::move(link), flight), flight};
+    return {std::make_unique<link::mavlink::MavlinkFixSource>(std::move(link), flight), flight};
+  }
+  throw maps::ParseError("--input", 0, "--input", spec, expected);
+}
+
+void runServe(service::ServeOptions o, const std::vector<std::string>& inputs, bool quiet) {
   o.program = selfExecutable();
   raiseOpenFileLimit();
   if (o.web_dir == "none") o.web_dir.clear();
@@ -52,6 +76,10 @@ void runServe(service::ServeOptions o, bool quiet) {
     throw std::invalid_argument(e.what());
   }
   service::Service& s = *made;
+  for (const std::string& spec : inputs) {
+    auto [source, flight] = openInput(spec);
+    s.addInput(std::move(source), flight);
+  }
   g_service = &s;
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
@@ -87,10 +115,14 @@ void addServeCommands(CLI::App& app) {
   auto timeout_s = std::make_shared<int>(30);
   c->add_option("--request-timeout", *timeout_s, "seconds a client has to send a whole request (default 30)")->check(CLI::Range(1, 3600));
   c->add_option("--max-connections", o->limits.max_connections, "open connections at most (default 10000)")->check(CLI::Range(1, 1000000));
+  auto inputs = std::make_shared<std::vector<std::string>>();
+  c->add_option("--input", *inputs,
+                "a fix input besides HTTP, judged by the same engine: jsonl:udp://IP:PORT (or a file or FIFO; each line names "
+                "its flight), mavlink:ADDRESS#FLIGHT, ubx:ADDRESS#FLIGHT (ADDRESS: udp://IP:PORT or a serial device)");
   c->add_flag("--quiet", *quiet, "no log lines on stderr");
-  c->callback([o, quiet, timeout_s] {
+  c->callback([o, quiet, timeout_s, inputs] {
     o->limits.request_timeout = std::chrono::seconds(*timeout_s);
-    runServe(*o, *quiet);
+    runServe(*o, *inputs, *quiet);
   });
 }
 

@@ -146,7 +146,39 @@ ServiceImpl::ServiceImpl(ServeOptions o, Service::Log l)
 }
 
 ServiceImpl::~ServiceImpl() {
+  stopping = true;
+  for (auto& in : inputs) {
+    if (in->thread.joinable()) in->thread.join();
+  }
   pool.reset();  // the workers stop before what their callbacks touch goes
+}
+
+void ServiceImpl::startInput(Input& in) {
+  in.thread = std::thread([this, &in] {
+    while (!stopping) {
+      planner::SourceRecord r = in.source->next(250);
+      if (r.kind == planner::SourceRecord::Kind::kEnd) break;
+      if (r.kind == planner::SourceRecord::Kind::kIdle) continue;
+      server->post([this, r = std::move(r), flight = in.flight] { takeRecord(r, flight); });
+    }
+    const std::string name = in.source->name();
+    server->post([this, name] { log("input " + name + " ended"); });
+  });
+}
+
+void ServiceImpl::takeRecord(const planner::SourceRecord& r, const std::string& input_flight) {
+  if (r.kind == planner::SourceRecord::Kind::kBad) {
+    session->reject(r.where, r.line, r.error, r.flight.empty() ? input_flight : r.flight);
+  } else {
+    planner::TrackFix fix = r.fix;
+    if (!input_flight.empty()) fix.flight = input_flight;
+    if (fix.flight.empty() || !flights.count(fix.flight)) {
+      session->reject(fix.source, fix.line, "no flight \"" + fix.flight.substr(0, 64) + "\" is tracked by this service", fix.flight);
+    } else {
+      session->submit(fix);
+    }
+  }
+  session->commit();
 }
 
 void ServiceImpl::restore() {
@@ -280,7 +312,18 @@ HttpResponse ServiceImpl::serveStatic(const HttpRequest& r) const {
 Service::Service(ServeOptions options, Log log) : impl_(std::make_unique<ServiceImpl>(std::move(options), std::move(log))) {}
 Service::~Service() = default;
 unsigned short Service::port() const { return impl_->server->port(); }
-void Service::run() { impl_->server->run(); }
-void Service::stop() { impl_->server->stop(); }
+void Service::addInput(std::unique_ptr<planner::FixSource> source, const std::string& flight) {
+  impl_->inputs.push_back(std::make_unique<ServiceImpl::Input>(ServiceImpl::Input{std::move(source), flight, {}}));
+}
+void Service::run() {
+  for (auto& in : impl_->inputs) {
+    if (!in->thread.joinable()) impl_->startInput(*in);
+  }
+  impl_->server->run();
+}
+void Service::stop() {
+  impl_->stopping = true;
+  impl_->server->stop();
+}
 
 }  // namespace skylane::service

@@ -14,6 +14,10 @@
 #include <memory>
 #include <string>
 
+namespace skylane::planner {
+class FixSource;
+}
+
 namespace skylane::service {
 
 /// \brief How the service runs.
@@ -46,6 +50,12 @@ class Service {
   Service(const Service&) = delete;
   Service& operator=(const Service&) = delete;
   [[nodiscard]] unsigned short port() const;
+  /// \brief A fix input besides HTTP (a UDP port of JSON lines, a MAVLink or UBX link): read on
+  /// a thread of its own, each record judged by the service's engine on the service's thread
+  /// and committed. `flight`: the flight every fix of it belongs to (a MAVLink or UBX link is one
+  /// vehicle), or empty when each record names its flight. An input given on the command line
+  /// is the provider's own and may feed any flight.
+  void addInput(std::unique_ptr<planner::FixSource> source, const std::string& flight);
   /// \brief Serves until stop().
   void run();
   /// \brief Ends run() (thread-safe).

@@ -6,6 +6,7 @@
 /// workers, which hand their results over with HttpServer::post().
 
 #include "airspace/zone.hpp"
+#include "planner/tracking/fix_source.hpp"
 #include "planner/tracking/tracking_session.hpp"
 #include "service/approval_pool.hpp"
 #include "service/auth.hpp"
@@ -16,7 +17,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <atomic>
 #include <chrono>
+#include <thread>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -61,6 +64,16 @@ class ServiceImpl {
   std::map<std::string, FlightRow> flights;
   std::map<std::string, std::string> last_fix;  ///< each flight's last `fix` event (its JSON line)
   std::unique_ptr<ApprovalPool> pool;
+  /// Fix inputs besides HTTP, each read on its own thread (Service::addInput).
+  struct Input {
+    std::unique_ptr<planner::FixSource> source;
+    std::string flight;
+    std::thread thread;
+  };
+  std::vector<std::unique_ptr<Input>> inputs;
+  std::atomic<bool> stopping{false};
+  void startInput(Input& in);
+  void takeRecord(const planner::SourceRecord& r, const std::string& input_flight);
   std::unique_ptr<HttpServer> server;
 
   // service.cpp

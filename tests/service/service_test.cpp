@@ -436,3 +436,64 @@ TEST_F(Service, KilledMidStreamOfFixesItLosesNoAcknowledgedFixAndDoublesNone) {
 
 }  // namespace
 }  // namespace skylane
+
+namespace skylane {
+namespace {
+
+/// A free UDP port on the loopback (bound and released; the service binds it next).
+int freeUdpPort() {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  socklen_t n = sizeof a;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n);
+  ::close(fd);
+  return ntohs(a.sin_port);
+}
+
+void sendUdp(int port, const std::string& datagram) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::sendto(fd, datagram.data(), datagram.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  ::close(fd);
+}
+
+class ServiceUdpInput : public Service {
+ protected:
+  std::vector<std::string> extraOptions() const override {
+    udp_port_ = freeUdpPort();
+    return {"--input", "jsonl:udp://127.0.0.1:" + std::to_string(udp_port_)};
+  }
+  mutable int udp_port_ = 0;
+};
+
+TEST_F(ServiceUdpInput, FixesFromAUdpInputAreJudgedByTheSameEngineAndStream) {
+  const std::string zs = publishZones();
+  const std::string fl = startFlight(TestTokens::kAcme, approve(TestTokens::kAcme, zs));
+  HttpClient stream(server_->port());
+  stream.openStream("/v1/flights/" + fl + "/events", {auth(TestTokens::kAcme)});
+  ASSERT_TRUE(stream.waitFor("retry: 1000", 2000));
+  json f1 = fixAt(fl, 1), f2 = fixAt(fl, 2, 40.0);
+  f1["flight"] = fl, f2["flight"] = fl;
+  sendUdp(udp_port_, f1.dump() + "\n" + f2.dump() + "\n");
+  sendUdp(udp_port_, R"({"flight": "fl-nobody", "time": "2020-01-01T14:00:03Z", "lat": 47, "lon": 8, "h_ell_m": 500, "hpl_m": 1, "vpl_m": 1})");
+  ASSERT_TRUE(stream.waitFor("event: violation", 3000)) << stream.streamed();
+  EXPECT_TRUE(stream.waitFor("id: 3\n", 3000)) << stream.streamed();  // fix, violation, fix
+  const json st = json::parse(call("GET", "/v1/flights/" + fl, TestTokens::kAcme).body).at("state");
+  EXPECT_EQ(st.at("fixes"), 2);
+  // The record for a flight the service does not track is a rejected input naming it.
+  HttpClient all(server_->port());
+  all.openStream("/v1/flights/" + fl + "/events", {auth(TestTokens::kAcme), "Last-Event-ID: 0"});
+  all.readFor(300);
+  EXPECT_EQ(all.streamed().find("fl-nobody"), std::string::npos);  // not this flight's
+  const HttpReply metrics = call("GET", "/metrics", TestTokens::kAuthority);
+  EXPECT_NE(metrics.body.find("skylane_inputs_rejected_total 1\n"), std::string::npos) << metrics.body;
+}
+
+}  // namespace
+}  // namespace skylane
