@@ -1,5 +1,7 @@
 #include "service/event_hub.hpp"
 
+#include <algorithm>
+
 namespace skylane::service {
 
 std::string sseMessage(const HubEvent& e) {
@@ -11,30 +13,53 @@ void EventHub::write(const planner::TrackEvent& event, const std::string& json_l
   pending_.push_back({store_.lastEventSeq(), event.flight, event.type, json_line});
 }
 
+void EventHub::deliver(std::vector<Subscriber>& list, const HubEvent& e, const std::string& text) {
+  list.erase(std::remove_if(list.begin(), list.end(),
+                            [&](Subscriber& s) { return s.stream->closed() || ((!s.wants || s.wants(e.flight)) && !s.stream->push(text)); }),
+             list.end());
+}
+
 void EventHub::flush() {
   std::vector<HubEvent> batch = std::move(pending_);
   pending_.clear();
   for (const HubEvent& e : batch) {
     for (const auto& observe : observers) observe(e);
-    for (auto it = subscribers_.begin(); it != subscribers_.end();) {
-      Subscriber& s = it->second;
-      const bool open = !s.stream->closed() && (!s.wants(e.flight) || s.stream->push(sseMessage(e)));
-      it = open ? std::next(it) : subscribers_.erase(it);
+    const auto it = by_flight_.find(e.flight);
+    if (it == by_flight_.end() && filtered_.empty()) continue;
+    const std::string text = sseMessage(e);
+    if (it != by_flight_.end()) {
+      deliver(it->second, e, text);
+      if (it->second.empty()) by_flight_.erase(it);
     }
+    deliver(filtered_, e, text);
   }
 }
 
-void EventHub::subscribe(std::shared_ptr<EventStream> stream, Filter wants) {
+void EventHub::subscribe(std::shared_ptr<EventStream> stream, const std::string& flight, Filter wants) {
   // A closed stream is dropped at the next event or keep-alive (not from its close callback, which
-  // may run inside the loops below).
-  subscribers_[next_id_++] = {std::move(stream), std::move(wants)};
+  // may run inside the loops here).
+  if (flight.empty()) {
+    filtered_.push_back({std::move(stream), std::move(wants)});
+  } else {
+    by_flight_[flight].push_back({std::move(stream), nullptr});
+  }
 }
 
 void EventHub::keepAlive() {
-  for (auto it = subscribers_.begin(); it != subscribers_.end();) {
-    const bool open = !it->second.stream->closed() && it->second.stream->push(": keep-alive\n\n");
-    it = open ? std::next(it) : subscribers_.erase(it);
+  const HubEvent none;
+  for (auto it = by_flight_.begin(); it != by_flight_.end();) {
+    deliver(it->second, none, ": keep-alive\n\n");
+    it = it->second.empty() ? by_flight_.erase(it) : std::next(it);
   }
+  filtered_.erase(std::remove_if(filtered_.begin(), filtered_.end(),
+                                 [](Subscriber& s) { return s.stream->closed() || !s.stream->push(": keep-alive\n\n"); }),
+                  filtered_.end());
+}
+
+std::size_t EventHub::streams() const {
+  std::size_t n = filtered_.size();
+  for (const auto& [flight, list] : by_flight_) n += list.size();
+  return n;
 }
 
 }  // namespace skylane::service

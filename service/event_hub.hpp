@@ -37,13 +37,14 @@ class EventHub final : public planner::EventSink {
   /// \brief The batch is committed: its events go to the subscribers and the observers.
   void flush() override;
 
-  /// \brief A stream gets the events whose flight `wants` accepts.
+  /// \brief A stream gets the events of one flight (`flight`), or, with `flight` empty, those
+  /// whose flight `wants` accepts (all of an operator's flights).
   using Filter = std::function<bool(const std::string& flight)>;
-  void subscribe(std::shared_ptr<EventStream> stream, Filter wants);
+  void subscribe(std::shared_ptr<EventStream> stream, const std::string& flight, Filter wants);
   /// \brief Sends a comment line to every stream (keeps proxies and readers from timing out, and
   /// finds streams whose reader has gone).
   void keepAlive();
-  [[nodiscard]] std::size_t streams() const { return subscribers_.size(); }
+  [[nodiscard]] std::size_t streams() const;
   /// \brief Called with every committed event (metrics, a request collecting its own events).
   std::vector<std::function<void(const HubEvent&)>> observers;
 
@@ -54,8 +55,10 @@ class EventHub final : public planner::EventSink {
   };
   const planner::TrackStore& store_;
   std::vector<HubEvent> pending_;
-  std::map<std::uint64_t, Subscriber> subscribers_;
-  std::uint64_t next_id_ = 0;
+  /// Sends `e` to the streams of `list`, dropping the closed ones.
+  static void deliver(std::vector<Subscriber>& list, const HubEvent& e, const std::string& text);
+  std::map<std::string, std::vector<Subscriber>> by_flight_;  ///< one flight's streams (no filter call per event)
+  std::vector<Subscriber> filtered_;                          ///< streams of several flights
 };
 
 }  // namespace skylane::service

@@ -154,7 +154,7 @@ HttpResponse ServiceImpl::eventStream(const HttpRequest& r, const Principal& who
       if (res.body.size() > (64u << 20)) return errorResponse(413, "more than 64 MiB of events after " + last + "; resume from a later id");
     }
   }
-  hub->subscribe(res.stream, wants);
+  hub->subscribe(res.stream, flight, wants);
   return res;
 }
 
