@@ -497,3 +497,29 @@ TEST_F(ServiceUdpInput, FixesFromAUdpInputAreJudgedByTheSameEngineAndStream) {
 
 }  // namespace
 }  // namespace skylane
+
+namespace skylane {
+namespace {
+
+TEST(ServiceStart, ADamagedDatabaseOrTokensFileIsAClearErrorExit2) {
+  const std::filesystem::path dir = test::scratchPath("service-start");
+  std::filesystem::create_directories(dir);
+  const std::string tokens = TestTokens::write(dir);
+  std::ofstream(dir / "garbage.sqlite") << std::string(4096, '\x5a');
+  const std::string bin = SKYLANE_BINARY;
+  test::CommandResult r = test::runCommand(bin + " serve --db " + (dir / "garbage.sqlite").string() + " --tokens " + tokens +
+                                           " --port 0 --web none 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("garbage.sqlite"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("not a database"), std::string::npos) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+  std::ofstream(dir / "empty_tokens.json") << R"({"tokens": [{"sha256": "abc", "operator": "x"}]})";
+  r = test::runCommand(bin + " serve --db " + (dir / "ok.sqlite").string() + " --tokens " + (dir / "empty_tokens.json").string() +
+                       " --port 0 --web none 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("$.tokens[0].sha256"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("64 lower-case hex"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace skylane
