@@ -72,19 +72,19 @@ json ServiceImpl::resolveMission(const json& body, const Principal& who) {
   m.erase("zonesets");
   m["zones"] = zones;
   json orbits = json::array();
-  if (options.orbits_dir.empty()) throw BadRequest{"$.orbits: this service has no orbits folder (start it with --orbits DIR)"};
   if (body.contains("orbits")) {
     const json& names = body["orbits"];
-    if (!names.is_array()) throw BadRequest{"$.orbits: expected an array of file names of the service's orbits folder"};
+    if (!names.is_array()) throw BadRequest{"$.orbits: expected an array of names of orbit files (GET /v1/orbits lists them)"};
     for (std::size_t i = 0; i < names.size(); ++i) {
-      const std::string field = "$.orbits[" + std::to_string(i) + "]";
-      const std::string name = names[i].is_string() ? names[i].get<std::string>() : std::string();
-      if (name.empty() || name.find('/') != std::string::npos || name.front() == '.' || !fs::is_regular_file(fs::path(options.orbits_dir) / name)) {
-        throw BadRequest{field + ": expected the name of an almanac or ephemeris file of the service's orbits folder"};
+      const std::optional<fs::path> p = names[i].is_string() ? orbitFile(who, names[i].get<std::string>()) : std::nullopt;
+      if (!p) {
+        throw BadRequest{"$.orbits[" + std::to_string(i) + "]: expected the name of an almanac or ephemeris file uploaded to /v1/orbits or of the "
+                         "service's orbits folder (GET /v1/orbits lists them)"};
       }
-      orbits.push_back((fs::absolute(options.orbits_dir) / name).string());
+      orbits.push_back(p->string());
     }
   } else {
+    if (options.orbits_dir.empty()) throw BadRequest{"$.orbits: expected the names of orbit files (this service has no default orbits folder)"};
     std::vector<std::string> all;
     for (const auto& e : fs::directory_iterator(options.orbits_dir)) {
       if (e.is_regular_file() && e.path().filename().string().front() != '.') all.push_back(fs::absolute(e.path()).string());

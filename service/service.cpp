@@ -282,6 +282,7 @@ HttpResponse ServiceImpl::routeV1(const HttpRequest& r, const Principal& who, co
     return zonesQuery(r, who);
   }
   if (what == "approvals") return approvalsRoute(r, who, s);
+  if (what == "orbits") return orbitsRoute(r, who, s);
   if (what == "flights") return flightsRoute(r, who, s);
   if (what == "events" && s.size() == 2) {
     if (r.method != "GET") return methodNotAllowed("GET");

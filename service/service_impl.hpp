@@ -104,6 +104,12 @@ class ServiceImpl {
   void queueApproval(ApprovalState& a);
   void approvalDone(const std::string& id, const ApprovalOutcome& outcome);
 
+  // orbit_routes.cpp
+  HttpResponse orbitsRoute(const HttpRequest& r, const Principal& who, const Segments& s);
+  /// The file a mission's orbit name means for `who`: its own upload, the authority's, or the
+  /// service's orbits folder.
+  [[nodiscard]] std::optional<std::filesystem::path> orbitFile(const Principal& who, const std::string& name) const;
+
   // flight_routes.cpp
   HttpResponse flightsRoute(const HttpRequest& r, const Principal& who, const Segments& s);
   HttpResponse startFlight(const HttpRequest& r, const Principal& who);

@@ -114,7 +114,8 @@ TEST_F(Service, EveryApiRouteWithoutAValidTokenIs401AndHealthNeedsNone) {
       {"PUT", "/v1/zonesets/zs-1"},    {"GET", "/v1/zonesets/zs-1/geojson"}, {"GET", "/v1/zones?lat=1&lon=1&time=2020-01-01T00:00:00Z"},
       {"GET", "/v1/approvals"},        {"POST", "/v1/approvals"},      {"GET", "/v1/approvals/ap-1"},   {"GET", "/v1/approvals/ap-1/report.json"},
       {"GET", "/v1/flights"},          {"POST", "/v1/flights"},        {"GET", "/v1/flights/fl-1"},     {"GET", "/v1/flights/fl-1/route"},
-      {"POST", "/v1/flights/fl-1/fixes"}, {"GET", "/v1/flights/fl-1/events"}, {"GET", "/v1/events"},   {"GET", "/metrics"}};
+      {"POST", "/v1/flights/fl-1/fixes"}, {"GET", "/v1/flights/fl-1/events"}, {"GET", "/v1/events"},   {"GET", "/metrics"},
+      {"GET", "/v1/orbits"},           {"PUT", "/v1/orbits/alm.txt"}};
   for (const auto& [method, target] : routes) {
     const HttpReply none = call(method, target, nullptr, method == "GET" ? "" : "{}");
     EXPECT_EQ(none.status, 401) << method << " " << target;
@@ -211,6 +212,29 @@ TEST_F(Service, BadRequestsGetTheErrorContract) {
   const std::string ap = json::parse(call("POST", "/v1/approvals", TestTokens::kAcme, exampleMission(zs)).body).at("id");
   r = call("GET", "/v1/approvals/" + ap + "/report.json", TestTokens::kAcme);
   EXPECT_TRUE(r.status == 409 || r.status == 200) << r.status;  // 409 while the approval runs
+}
+
+TEST_F(Service, AnOperatorsUploadedAlmanacServesItsMissionsAndNoOneElses) {
+  const std::string zs = publishZones();
+  const std::string almanac = readFile(test::dataPath("gnss/alm01jan2020.txt"));
+  const std::string text = "Content-Type: text/plain";
+  HttpReply r = call("PUT", "/v1/orbits/acme-alm.txt", TestTokens::kAcme, almanac, text);
+  ASSERT_EQ(r.status, 201) << r.body;
+  r = call("PUT", "/v1/orbits/broken.txt", TestTokens::kAcme, "******** Week 42 almanac for PRN-01 ********\nID: x\n", text);
+  EXPECT_EQ(r.status, 400) << r.body;
+  EXPECT_NE(r.body.find("broken.txt"), std::string::npos) << r.body;
+  EXPECT_EQ(r.body.find(dir_), std::string::npos) << r.body;
+  EXPECT_EQ(call("PUT", "/v1/orbits/..hidden", TestTokens::kAcme, almanac, text).status, 400);
+  EXPECT_EQ(call("PUT", "/v1/orbits/a.txt", TestTokens::kAcme, almanac).status, 415);  // JSON is not an orbit file
+  const json listed = json::parse(call("GET", "/v1/orbits", TestTokens::kAcme).body).at("orbits");
+  EXPECT_TRUE(std::any_of(listed.begin(), listed.end(), [](const json& o) { return o["name"] == "acme-alm.txt" && o["from"] == "operator"; }));
+  json m = json::parse(exampleMission(zs));
+  m["orbits"] = {"acme-alm.txt"};
+  r = call("POST", "/v1/approvals", TestTokens::kAcme, m.dump());
+  ASSERT_EQ(r.status, 202) << r.body;
+  EXPECT_EQ(call("POST", "/v1/approvals", TestTokens::kOther, m.dump()).status, 400);  // not its file
+  const json other = json::parse(call("GET", "/v1/orbits", TestTokens::kOther).body).at("orbits");
+  EXPECT_FALSE(std::any_of(other.begin(), other.end(), [](const json& o) { return o["name"] == "acme-alm.txt"; }));
 }
 
 TEST_F(Service, ZonesAreQueriedAtAPointAndTimeAndInABox) {
