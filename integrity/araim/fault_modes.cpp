@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <map>
 #include <stdexcept>
+#include <string>
 
 namespace skylane::integrity {
 namespace {
@@ -12,11 +12,29 @@ namespace {
 /// More simultaneous events than this are never enumerated: with any realistic ISM the
 /// probability of four independent faults is far below every P_THRES (1e-20 for P = 1e-5).
 constexpr int kMaxEnumeratedEvents = 3;
+/// MAAST enumerates at least the pairs of events, even when N_fault,max is 1, so that the
+/// selection can add the strongest of them when the singles alone leave too much unmonitored.
+constexpr int kMinEnumeratedEvents = 2;
 
 struct Event {
-  std::vector<int> removes;
+  std::vector<int> removes;  ///< satellite indices, ascending
   double p = 0.0;
 };
+
+/// One combination of events, before merging by removed set.
+struct Combination {
+  std::vector<int> events;   ///< event indices, ascending
+  std::vector<int> removed;  ///< union of the events' satellites, ascending
+  double prior = 0.0;        ///< ∏_{e∈E} p_e ∏_{e∉E} (1 − p_e)
+  double event_prior = 0.0;  ///< ∏_{e∈E} p_e
+};
+
+std::vector<double> probabilities(const std::vector<Event>& events) {
+  std::vector<double> p;
+  p.reserve(events.size());
+  for (const Event& e : events) p.push_back(e.p);
+  return p;
+}
 
 int nFaultMax(const std::vector<double>& p, double p_thres) {
   int r = 0;
@@ -24,41 +42,180 @@ int nFaultMax(const std::vector<double>& p, double p_thres) {
   return r;
 }
 
-/// Adds every combination of 1 … r events from `events` to `out` (merged by removed set).
-void enumerate(const std::vector<Event>& events, int r, double p_nf, std::map<std::vector<int>, FaultMode>& out) {
-  const int n = static_cast<int>(events.size());
-  std::vector<int> pick;
-  // Iterative combination walk: pick holds increasing event indices.
-  std::function<void(int, double, double)> rec = [&](int start, double u_prod, double p_prod) {
-    if (!pick.empty()) {
-      std::vector<int> removed;
-      for (int e : pick) removed.insert(removed.end(), events[e].removes.begin(), events[e].removes.end());
-      std::sort(removed.begin(), removed.end());
-      removed.erase(std::unique(removed.begin(), removed.end()), removed.end());
-      FaultMode& m = out[removed];
-      if (m.removed.empty()) {
-        m.removed = removed;
-        m.events = static_cast<int>(pick.size());
-      }
-      m.prior += p_nf * u_prod;  // ∏_{e∈E} p_e ∏_{e∉E} (1 − p_e)
-      m.event_prior += p_prod;
-      m.events = std::min(m.events, static_cast<int>(pick.size()));
-    }
-    if (static_cast<int>(pick.size()) == r) return;
-    for (int e = start; e < n; ++e) {
-      if (!(events[e].p > 0.0)) continue;
-      pick.push_back(e);
-      rec(e + 1, u_prod * events[e].p / (1.0 - events[e].p), p_prod * events[e].p);
-      pick.pop_back();
-    }
-  };
-  rec(0, 1.0, 1.0);
+double noFault(const std::vector<Event>& events) {
+  double log_nf = 0.0;
+  for (const Event& e : events) log_nf += std::log1p(-e.p);
+  return std::exp(log_nf);
 }
 
-double noFault(const std::vector<Event>& events) {
-  double p = 1.0;
-  for (const Event& e : events) p *= 1.0 - e.p;
-  return p;
+/// P(at least one event) = 1 − ∏(1 − p_e), without the cancellation of 1 − (a number near 1).
+double anyFault(const std::vector<Event>& events) {
+  double log_nf = 0.0;
+  for (const Event& e : events) log_nf += std::log1p(-e.p);
+  return -std::expm1(log_nf);
+}
+
+/// Every combination of exactly k events with nonzero probability, in lexicographic order of
+/// the event indices (MAAST's order), appended to `out`.
+void combinationsOfSize(const std::vector<Event>& events, int k, double p_nf, std::vector<Combination>& out) {
+  std::vector<int> usable;
+  for (int e = 0; e < static_cast<int>(events.size()); ++e) {
+    if (events[static_cast<std::size_t>(e)].p > 0.0) usable.push_back(e);
+  }
+  const int n = static_cast<int>(usable.size());
+  if (k > n) return;
+  std::vector<int> idx(static_cast<std::size_t>(k));
+  for (int i = 0; i < k; ++i) idx[static_cast<std::size_t>(i)] = i;
+  while (true) {
+    Combination c;
+    c.prior = p_nf;
+    c.event_prior = 1.0;
+    for (int i : idx) {
+      const Event& e = events[static_cast<std::size_t>(usable[static_cast<std::size_t>(i)])];
+      c.events.push_back(usable[static_cast<std::size_t>(i)]);
+      c.removed.insert(c.removed.end(), e.removes.begin(), e.removes.end());
+      c.prior *= e.p / (1.0 - e.p);
+      c.event_prior *= e.p;
+    }
+    std::sort(c.removed.begin(), c.removed.end());
+    c.removed.erase(std::unique(c.removed.begin(), c.removed.end()), c.removed.end());
+    out.push_back(std::move(c));
+    int i = k - 1;  // next combination: bump the last index that can move
+    while (i >= 0 && idx[static_cast<std::size_t>(i)] == n - k + i) --i;
+    if (i < 0) return;
+    ++idx[static_cast<std::size_t>(i)];
+    for (int j = i + 1; j < k; ++j) idx[static_cast<std::size_t>(j)] = idx[static_cast<std::size_t>(j - 1)] + 1;
+  }
+}
+
+std::vector<Combination> combinationsUpTo(const std::vector<Event>& events, int max_events, double p_nf) {
+  std::vector<Combination> out;
+  for (int k = 1; k <= max_events; ++k) combinationsOfSize(events, k, p_nf, out);
+  return out;
+}
+
+/// MAAST's fault consolidation: within each constellation, the combinations removing only its
+/// satellites with a prior below fc_thres × the constellation fault's are folded into the
+/// constellation mode.
+void consolidateIntoConstellations(std::vector<Combination>& combos, int first_const_event, double fc_thres) {
+  if (!(fc_thres > 0.0)) return;
+  for (std::size_t c = 0; c < combos.size(); ++c) {
+    if (combos[c].events.size() != 1 || combos[c].events[0] < first_const_event) continue;
+    const std::vector<int> own = combos[c].removed;
+    const double limit = fc_thres * combos[c].prior;
+    double prior_in = 0.0, event_prior_in = 0.0;
+    std::vector<Combination> kept;
+    kept.reserve(combos.size());
+    std::size_t c_kept = 0;  // the constellation mode's position after the removals
+    for (std::size_t k = 0; k < combos.size(); ++k) {
+      const Combination& m = combos[k];
+      const bool inside = std::includes(own.begin(), own.end(), m.removed.begin(), m.removed.end());
+      if (k != c && inside && m.prior < limit) {
+        prior_in += m.prior;
+        event_prior_in += m.event_prior;
+        continue;
+      }
+      if (k == c) c_kept = kept.size();
+      kept.push_back(m);
+    }
+    kept[c_kept].prior += prior_in;
+    kept[c_kept].event_prior += event_prior_in;
+    combos = std::move(kept);
+    c = c_kept;
+  }
+}
+
+/// The reference selection: fewest removed satellites first; priors above PHMI always kept,
+/// the others added while P_not_monitored > P_THRES. Returns P_not_monitored.
+double selectUntilThreshold(std::vector<Combination>& combos, double p_any, const FaultModeOptions& o) {
+  std::stable_sort(combos.begin(), combos.end(),
+                   [](const Combination& a, const Combination& b) { return a.removed.size() < b.removed.size(); });
+  double p_nm = p_any;
+  for (const Combination& c : combos) {
+    if (c.prior > o.phmi) p_nm -= c.prior;
+  }
+  std::vector<Combination> kept;
+  for (Combination& c : combos) {
+    if (c.prior > o.phmi) {
+      kept.push_back(std::move(c));
+    } else if (p_nm > o.p_thres) {
+      p_nm -= c.prior;
+      kept.push_back(std::move(c));
+    }
+  }
+  combos = std::move(kept);
+  return std::max(0.0, p_nm);
+}
+
+/// Merges combinations by removed set; fewest removed satellites first.
+std::vector<FaultMode> mergeByRemovedSet(const std::vector<Combination>& combos) {
+  std::map<std::vector<int>, FaultMode> merged;
+  for (const Combination& c : combos) {
+    FaultMode& m = merged[c.removed];
+    const int events = static_cast<int>(c.events.size());
+    if (m.removed.empty()) {
+      m.removed = c.removed;
+      m.events = events;
+    }
+    m.prior += c.prior;
+    m.event_prior += c.event_prior;
+    m.events = std::min(m.events, events);
+  }
+  std::vector<FaultMode> out;
+  out.reserve(merged.size());
+  for (auto& [k, m] : merged) out.push_back(std::move(m));
+  std::stable_sort(out.begin(), out.end(),
+                   [](const FaultMode& a, const FaultMode& b) { return a.removed.size() < b.removed.size(); });
+  return out;
+}
+
+struct Events {
+  std::vector<Event> all;  ///< satellites first (in satellite order), then constellations
+  int first_const = 0;
+};
+
+Events buildEvents(const std::vector<Constellation>& sats, const std::vector<double>& p_sat,
+                   const std::vector<double>& p_const) {
+  if (sats.size() != p_sat.size()) throw std::invalid_argument("determineFaultModes: one P_sat per satellite");
+  if (p_const.size() < static_cast<std::size_t>(kNumConstellations)) {
+    throw std::invalid_argument("determineFaultModes: one P_const per constellation");
+  }
+  Events ev;
+  for (std::size_t i = 0; i < sats.size(); ++i) ev.all.push_back({{static_cast<int>(i)}, p_sat[i]});
+  ev.first_const = static_cast<int>(ev.all.size());
+  for (Constellation c : kAllConstellations) {
+    Event e;
+    for (std::size_t i = 0; i < sats.size(); ++i) {
+      if (sats[i] == c) e.removes.push_back(static_cast<int>(i));
+    }
+    if (e.removes.empty()) continue;
+    e.p = p_const[static_cast<std::size_t>(c)];
+    ev.all.push_back(e);
+  }
+  for (const Event& e : ev.all) {
+    if (!(e.p >= 0.0 && e.p < 1.0)) throw std::invalid_argument("determineFaultModes: a prior outside [0, 1)");
+  }
+  return ev;
+}
+
+/// ION GNSS 2012: satellite and constellation combinations counted and enumerated apart.
+FaultModeSet blanch2012Modes(const Events& ev, const FaultModeOptions& o) {
+  const std::vector<Event> sat_events(ev.all.begin(), ev.all.begin() + ev.first_const);
+  const std::vector<Event> const_events(ev.all.begin() + ev.first_const, ev.all.end());
+  const std::vector<double> ps = probabilities(sat_events), pc = probabilities(const_events);
+  const int n_sat = nFaultMax(ps, o.p_thres), n_const = nFaultMax(pc, o.p_thres);
+  FaultModeSet out;
+  out.n_fault_max = std::max(n_sat, n_const);
+  out.p_not_monitored = probabilityOfAtLeast(ps, n_sat + 1) + probabilityOfAtLeast(pc, n_const + 1);
+  std::vector<Combination> combos = combinationsUpTo(sat_events, n_sat, noFault(sat_events));
+  std::vector<Combination> cc = combinationsUpTo(const_events, n_const, noFault(const_events));
+  for (Combination& c : cc) {
+    for (int& e : c.events) e += ev.first_const;
+    combos.push_back(std::move(c));
+  }
+  consolidateIntoConstellations(combos, ev.first_const, o.fc_thres);
+  out.modes = mergeByRemovedSet(combos);
+  return out;
 }
 
 }  // namespace
@@ -83,56 +240,35 @@ double probabilityOfAtLeast(const std::vector<double>& p, int r) {
 }
 
 FaultModeSet determineFaultModes(const std::vector<Constellation>& sats, const std::vector<double>& p_sat,
-                                 const std::vector<double>& p_const, double p_thres, FaultModeRule rule) {
-  if (sats.size() != p_sat.size()) throw std::invalid_argument("determineFaultModes: one P_sat per satellite");
-  std::vector<Event> sat_events, const_events;
-  for (std::size_t i = 0; i < sats.size(); ++i) sat_events.push_back({{static_cast<int>(i)}, p_sat[i]});
-  for (Constellation c : kAllConstellations) {
-    Event e;
-    for (std::size_t i = 0; i < sats.size(); ++i) {
-      if (sats[i] == c) e.removes.push_back(static_cast<int>(i));
-    }
-    if (e.removes.empty()) continue;
-    e.p = p_const.at(static_cast<std::size_t>(c));
-    const_events.push_back(e);
+                                 const std::vector<double>& p_const, const FaultModeOptions& o) {
+  if (!(o.p_thres > 0.0 && o.p_thres < 1.0) || !(o.phmi > 0.0 && o.phmi < 1.0)) {
+    throw std::invalid_argument("determineFaultModes: P_THRES and PHMI must be in (0, 1)");
   }
-  auto probs = [](const std::vector<Event>& ev) {
-    std::vector<double> p;
-    for (const Event& e : ev) p.push_back(e.p);
-    return p;
-  };
+  if (!(o.fc_thres >= 0.0 && o.fc_thres < 1.0)) {
+    throw std::invalid_argument("determineFaultModes: fc_thres must be in [0, 1), got " + std::to_string(o.fc_thres));
+  }
+  const Events ev = buildEvents(sats, p_sat, p_const);
+  if (o.rule == FaultModeRule::kBlanch2012) return blanch2012Modes(ev, o);
+  const std::vector<double> p = probabilities(ev.all);
   FaultModeSet out;
-  std::map<std::vector<int>, FaultMode> modes;
-  if (rule == FaultModeRule::kJointEvents) {
-    std::vector<Event> all = sat_events;
-    all.insert(all.end(), const_events.begin(), const_events.end());
-    const std::vector<double> p = probs(all);
-    out.n_fault_max = nFaultMax(p, p_thres);
-    out.p_not_monitored = probabilityOfAtLeast(p, out.n_fault_max + 1);
-    enumerate(all, out.n_fault_max, noFault(all), modes);
-  } else {
-    const std::vector<double> ps = probs(sat_events), pc = probs(const_events);
-    const int n_sat = nFaultMax(ps, p_thres), n_const = nFaultMax(pc, p_thres);
-    out.n_fault_max = std::max(n_sat, n_const);
-    out.p_not_monitored = probabilityOfAtLeast(ps, n_sat + 1) + probabilityOfAtLeast(pc, n_const + 1);
-    enumerate(sat_events, n_sat, noFault(sat_events), modes);
-    std::map<std::vector<int>, FaultMode> cmodes;
-    enumerate(const_events, n_const, noFault(const_events), cmodes);
-    for (auto& [k, m] : cmodes) {
-      FaultMode& dst = modes[k];
-      if (dst.removed.empty()) {
-        dst = m;
-      } else {
-        dst.prior += m.prior;
-        dst.event_prior += m.event_prior;
-      }
-    }
-  }
-  for (auto& [k, m] : modes) out.modes.push_back(m);
-  // Fewest removed satellites first (singles, then pairs, then constellations …).
-  std::stable_sort(out.modes.begin(), out.modes.end(),
-                   [](const FaultMode& a, const FaultMode& b) { return a.removed.size() < b.removed.size(); });
+  out.n_fault_max = nFaultMax(p, o.p_thres);
+  const bool adds = o.rule == FaultModeRule::kAddsUntilThreshold;
+  const int depth = adds ? std::min(kMaxEnumeratedEvents, std::max(out.n_fault_max, kMinEnumeratedEvents))
+                         : out.n_fault_max;
+  std::vector<Combination> combos = combinationsUpTo(ev.all, depth, noFault(ev.all));
+  consolidateIntoConstellations(combos, ev.first_const, o.fc_thres);
+  out.p_not_monitored = adds ? selectUntilThreshold(combos, anyFault(ev.all), o)
+                             : probabilityOfAtLeast(p, out.n_fault_max + 1);
+  out.modes = mergeByRemovedSet(combos);
   return out;
+}
+
+FaultModeSet determineFaultModes(const std::vector<Constellation>& sats, const std::vector<double>& p_sat,
+                                 const std::vector<double>& p_const, double p_thres, FaultModeRule rule) {
+  FaultModeOptions o;
+  o.rule = rule;
+  o.p_thres = p_thres;
+  return determineFaultModes(sats, p_sat, p_const, o);
 }
 
 }  // namespace skylane::integrity

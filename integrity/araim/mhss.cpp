@@ -123,7 +123,12 @@ FaultModeSet faultModes(const Geometry& g, const ErrorModel& model, const AraimC
   }
   std::vector<double> p_const(kNumConstellations);
   for (Constellation c : kAllConstellations) p_const[static_cast<std::size_t>(c)] = model.of(c).pconst;
-  return determineFaultModes(cons, p_sat, p_const, cfg.requirements.p_thres, cfg.rule);
+  FaultModeOptions o;
+  o.rule = cfg.rule;
+  o.p_thres = cfg.requirements.p_thres;
+  o.phmi = cfg.requirements.phmi_vert + cfg.requirements.phmi_hor;
+  o.fc_thres = cfg.fc_thres;
+  return determineFaultModes(cons, p_sat, p_const, o);
 }
 
 /// One subset solution per monitorable fault mode; an unmonitorable mode's prior goes to the
@@ -180,20 +185,25 @@ bool solveProtectionLevels(AraimResult& out, const Requirements& req) {
     terms.reserve(out.subsets.size() + 1);
     terms.push_back({2.0, 0.0, out.bias0[q], out.sigma0[q]});
     for (const SubsetSolution& s : out.subsets) terms.push_back({s.prior, s.threshold[q], s.bias[q], s.sigma[q]});
-    pl[q] = solveProtectionLevel(terms, q == 2 ? budget_v : budget_h, req.tol_pl_m, &pl_eq[q]);
+    pl[q] = solveProtectionLevel(terms, q == 2 ? budget_v : budget_h, req.tol_pl_m, &pl_eq[q],
+                                 &out.initial_bracket[static_cast<std::size_t>(q)]);
   }
   out.hpl_axis_m = {pl[0], pl[1]};
   out.hpl_m = std::hypot(pl[0], pl[1]);
   out.vpl_m = pl[2];
   out.hpl_equal_allocation_m = std::hypot(pl_eq[0], pl_eq[1]);
   out.vpl_equal_allocation_m = pl_eq[2];
-  // EMT (ADD Eq. 35): the largest vertical threshold among modes whose probability is at least
-  // P_EMT. The ISM rate ∏p_e is compared (a single-satellite mode at P_sat = P_EMT = 1e-5 counts;
-  // its exclusive prior, 1e-5·∏(1 − p), is a hair below and would not).
-  for (const SubsetSolution& s : out.subsets) {
-    if (s.event_prior >= req.p_emt) out.emt_m = std::max(out.emt_m, s.threshold[2]);
-  }
   return true;
+}
+
+/// EMT (ADD Eq. 35): the largest vertical threshold among monitored modes whose probability is
+/// at least P_EMT — by default the mode's own prior, as MAAST for ARAIM compares it.
+void setEffectiveMonitorThreshold(AraimResult& out, const AraimConfig& cfg) {
+  out.emt_m = 0.0;
+  for (const SubsetSolution& s : out.subsets) {
+    const double p = cfg.emt_probability == EmtProbability::kModePrior ? s.prior : s.event_prior;
+    if (p >= cfg.requirements.p_emt) out.emt_m = std::max(out.emt_m, s.threshold[2]);
+  }
 }
 
 /// Available when the levels are within the alert limits (and, unless horizontal only, the EMT
@@ -223,7 +233,8 @@ double integrityRisk(const std::vector<RiskTerm>& terms, double pl) {
   return r;
 }
 
-double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, double tol, double* equal_allocation) {
+double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, double tol, double* equal_allocation,
+                            PlBracket* initial) {
   const double n1 = static_cast<double>(terms.size());
   double low = -1e300, high = -1e300;
   for (const RiskTerm& t : terms) {
@@ -234,6 +245,7 @@ double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, d
   }
   if (equal_allocation) *equal_allocation = high;
   low = std::min(low, high);
+  if (initial) *initial = {low, high};
   // ADD Appendix B: at `low` the largest single term already uses the whole budget; at `high`
   // every term uses at most budget/(N+1). The risk decreases with PL in between.
   while (high - low > tol) {
@@ -259,6 +271,8 @@ AraimResult araimProtectionLevels(const Geometry& g, const ErrorModel& model, co
   setAllInViewErrors(out, g, all, c_acc);
   monitorFaultModes(out, g, aiv, faultModes(g, model, cfg), c_acc);
   setThresholds(out, cfg.requirements);
+  setEffectiveMonitorThreshold(out, cfg);
+  out.accuracy_computed = true;
   if (!solveProtectionLevels(out, cfg.requirements)) return out;
   out.pl_computed = std::isfinite(out.hpl_m) && std::isfinite(out.vpl_m);
   if (!out.pl_computed) {
