@@ -144,6 +144,7 @@ void monitorFaultModes(AraimResult& out, const Geometry& g, const AllInView& aiv
     s.event_prior = mode.event_prior;
     if (!subsetSolution(g, aiv, mode.removed, s)) {
       out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
+      ++out.unmonitorable_modes;
       continue;
     }
     const Eigen::MatrixXd dS = s.S - out.S0;

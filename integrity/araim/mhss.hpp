@@ -74,6 +74,7 @@ struct AraimResult {
   double emt_m = 0;
   double sigma_acc_v_m = 0;  ///< √(S⁰ C_acc S⁰ᵀ)_UU
   int fault_modes = 0;       ///< monitored (and monitorable) fault modes, fault-free excluded
+  int unmonitorable_modes = 0;  ///< selected modes whose subset is singular (prior added to P_not_monitored)
   int n_fault_max = 0;
   double p_not_monitored = 0;
   double k_fa_h = 0, k_fa_v = 0;
