@@ -15,6 +15,8 @@ constexpr int kMaxEnumeratedEvents = 3;
 /// MAAST enumerates at least the pairs of events, even when N_fault,max is 1, so that the
 /// selection can add the strongest of them when the singles alone leave too much unmonitored.
 constexpr int kMinEnumeratedEvents = 2;
+/// Satellites + constellations an event list can hold (far above any sky: 4 constellations' full view).
+constexpr int kMaxEvents = 256;
 
 struct Event {
   std::vector<int> removes;  ///< satellite indices, ascending
@@ -55,37 +57,55 @@ double anyFault(const std::vector<Event>& events) {
   return -std::expm1(log_nf);
 }
 
-/// Every combination of exactly k events with nonzero probability, in lexicographic order of
-/// the event indices (MAAST's order), appended to `out`.
-void combinationsOfSize(const std::vector<Event>& events, int k, double p_nf, std::vector<Combination>& out) {
-  std::vector<int> usable;
-  for (int e = 0; e < static_cast<int>(events.size()); ++e) {
-    if (events[static_cast<std::size_t>(e)].p > 0.0) usable.push_back(e);
+/// Calls visit(indices, prior, event_prior) for every combination of exactly k events with
+/// nonzero probability, in lexicographic order of the event indices (MAAST's order); the
+/// indices are into `events`. No allocation per combination.
+template <class Visit>
+void forEachCombination(const std::vector<Event>& events, int k, double p_nf, Visit&& visit) {
+  int usable[kMaxEvents];
+  int n = 0;
+  for (int e = 0; e < static_cast<int>(events.size()) && n < kMaxEvents; ++e) {
+    if (events[static_cast<std::size_t>(e)].p > 0.0) usable[n++] = e;
   }
-  const int n = static_cast<int>(usable.size());
-  if (k > n) return;
-  std::vector<int> idx(static_cast<std::size_t>(k));
-  for (int i = 0; i < k; ++i) idx[static_cast<std::size_t>(i)] = i;
+  if (k > n || k > kMaxEnumeratedEvents) return;
+  int idx[kMaxEnumeratedEvents], pick[kMaxEnumeratedEvents];
+  for (int i = 0; i < k; ++i) idx[i] = i;
   while (true) {
-    Combination c;
-    c.prior = p_nf;
-    c.event_prior = 1.0;
-    for (int i : idx) {
-      const Event& e = events[static_cast<std::size_t>(usable[static_cast<std::size_t>(i)])];
-      c.events.push_back(usable[static_cast<std::size_t>(i)]);
-      c.removed.insert(c.removed.end(), e.removes.begin(), e.removes.end());
-      c.prior *= e.p / (1.0 - e.p);
-      c.event_prior *= e.p;
+    double prior = p_nf, event_prior = 1.0;
+    for (int i = 0; i < k; ++i) {
+      pick[i] = usable[idx[i]];
+      const double p = events[static_cast<std::size_t>(pick[i])].p;
+      prior *= p / (1.0 - p);
+      event_prior *= p;
     }
-    std::sort(c.removed.begin(), c.removed.end());
-    c.removed.erase(std::unique(c.removed.begin(), c.removed.end()), c.removed.end());
-    out.push_back(std::move(c));
+    visit(pick, k, prior, event_prior);
     int i = k - 1;  // next combination: bump the last index that can move
-    while (i >= 0 && idx[static_cast<std::size_t>(i)] == n - k + i) --i;
+    while (i >= 0 && idx[i] == n - k + i) --i;
     if (i < 0) return;
-    ++idx[static_cast<std::size_t>(i)];
-    for (int j = i + 1; j < k; ++j) idx[static_cast<std::size_t>(j)] = idx[static_cast<std::size_t>(j - 1)] + 1;
+    ++idx[i];
+    for (int j = i + 1; j < k; ++j) idx[j] = idx[j - 1] + 1;
   }
+}
+
+Combination makeCombination(const std::vector<Event>& events, const int* pick, int k, double prior, double event_prior) {
+  Combination c;
+  c.prior = prior;
+  c.event_prior = event_prior;
+  for (int i = 0; i < k; ++i) {
+    const Event& e = events[static_cast<std::size_t>(pick[i])];
+    c.events.push_back(pick[i]);
+    c.removed.insert(c.removed.end(), e.removes.begin(), e.removes.end());
+  }
+  std::sort(c.removed.begin(), c.removed.end());
+  c.removed.erase(std::unique(c.removed.begin(), c.removed.end()), c.removed.end());
+  return c;
+}
+
+/// Every combination of exactly k events with nonzero probability, in MAAST's order, appended to `out`.
+void combinationsOfSize(const std::vector<Event>& events, int k, double p_nf, std::vector<Combination>& out) {
+  forEachCombination(events, k, p_nf, [&](const int* pick, int kk, double prior, double event_prior) {
+    out.push_back(makeCombination(events, pick, kk, prior, event_prior));
+  });
 }
 
 std::vector<Combination> combinationsUpTo(const std::vector<Event>& events, int max_events, double p_nf) {
@@ -147,6 +167,28 @@ double selectUntilThreshold(std::vector<Combination>& combos, double p_any, cons
   return std::max(0.0, p_nm);
 }
 
+/// The reference selection when the monitored-always combinations (prior > PHMI) alone leave
+/// P_nm ≤ P_THRES — the usual case with LPV-200 ISMs: then the loop adds nothing, and only those
+/// combinations are built. Returns false (and leaves `combos` empty) when more are needed.
+bool selectLargeOnly(const std::vector<Event>& events, int depth, double p_any, const FaultModeOptions& o,
+                     std::vector<Combination>& combos, double& p_nm) {
+  const double p_nf = noFault(events);
+  double p = p_any;
+  for (int k = 1; k <= depth; ++k) {
+    forEachCombination(events, k, p_nf, [&](const int* pick, int kk, double prior, double event_prior) {
+      if (prior <= o.phmi) return;
+      p -= prior;
+      combos.push_back(makeCombination(events, pick, kk, prior, event_prior));
+    });
+  }
+  if (p > o.p_thres) {
+    combos.clear();
+    return false;
+  }
+  p_nm = std::max(0.0, p);
+  return true;
+}
+
 /// Merges combinations by removed set; fewest removed satellites first.
 std::vector<FaultMode> mergeByRemovedSet(const std::vector<Combination>& combos) {
   std::map<std::vector<int>, FaultMode> merged;
@@ -194,6 +236,10 @@ Events buildEvents(const std::vector<Constellation>& sats, const std::vector<dou
   }
   for (const Event& e : ev.all) {
     if (!(e.p >= 0.0 && e.p < 1.0)) throw std::invalid_argument("determineFaultModes: a prior outside [0, 1)");
+  }
+  if (ev.all.size() > static_cast<std::size_t>(kMaxEvents)) {
+    throw std::invalid_argument("determineFaultModes: " + std::to_string(ev.all.size()) + " fault events, at most " +
+                                std::to_string(kMaxEvents));
   }
   return ev;
 }
@@ -255,7 +301,13 @@ FaultModeSet determineFaultModes(const std::vector<Constellation>& sats, const s
   const bool adds = o.rule == FaultModeRule::kAddsUntilThreshold;
   const int depth = adds ? std::min(kMaxEnumeratedEvents, std::max(out.n_fault_max, kMinEnumeratedEvents))
                          : out.n_fault_max;
-  std::vector<Combination> combos = combinationsUpTo(ev.all, depth, noFault(ev.all));
+  std::vector<Combination> combos;
+  // Consolidation can lift a constellation mode above PHMI, so the shortcut needs it off.
+  if (adds && !(o.fc_thres > 0.0) && selectLargeOnly(ev.all, depth, anyFault(ev.all), o, combos, out.p_not_monitored)) {
+    out.modes = mergeByRemovedSet(combos);
+    return out;
+  }
+  combos = combinationsUpTo(ev.all, depth, noFault(ev.all));
   consolidateIntoConstellations(combos, ev.first_const, o.fc_thres);
   out.p_not_monitored = adds ? selectUntilThreshold(combos, anyFault(ev.all), o)
                              : probabilityOfAtLeast(p, out.n_fault_max + 1);

@@ -32,21 +32,20 @@ struct AllInView {
 /// dropped. Returns false when the mode cannot be monitored.
 bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<int>& removed, SubsetSolution& out) {
   const int n = g.numSats(), m = g.numStates();
-  std::vector<bool> keep(static_cast<std::size_t>(n), true);
-  for (int i : removed) keep[static_cast<std::size_t>(i)] = false;
   if (m > kMaxStates) return false;
-  std::vector<int> cols = {0, 1, 2};
-  cols.reserve(static_cast<std::size_t>(m));
+  // `removed` is ascending: one walk over the satellites tells kept from removed, no allocation.
+  const auto isRemoved = [&removed](int i) { return std::binary_search(removed.begin(), removed.end(), i); };
+  std::array<int, kMaxStates> cols{0, 1, 2};
+  int mk = 3;
   for (int c = 3; c < m; ++c) {
     for (int i = 0; i < n; ++i) {
-      if (keep[static_cast<std::size_t>(i)] && g.G(i, c) != 0.0) {
-        cols.push_back(c);
+      if (g.G(i, c) != 0.0 && !isRemoved(i)) {
+        cols[static_cast<std::size_t>(mk++)] = c;
         break;
       }
     }
   }
   const int kept = n - static_cast<int>(removed.size());
-  const int mk = static_cast<int>(cols.size());
   if (kept < mk) return false;  // the subset cannot fix position and its clocks (Stanford: N ≥ unknowns)
   StateMatrix Nk = aiv.N;
   for (int i : removed) {
@@ -65,8 +64,11 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
   const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxStates, 3> X =
       ldlt.solve(Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxStates, 3>::Identity(mk, 3));  // columns q of N_k⁻¹
   out.S = Eigen::MatrixXd::Zero(3, n);
-  for (int i = 0; i < n; ++i) {
-    if (!keep[static_cast<std::size_t>(i)]) continue;
+  for (int i = 0, r = 0; i < n; ++i) {
+    if (r < static_cast<int>(removed.size()) && removed[static_cast<std::size_t>(r)] == i) {
+      ++r;
+      continue;
+    }
     for (int q = 0; q < 3; ++q) {
       double s = 0.0;
       for (int a = 0; a < mk; ++a) s += X(a, q) * aiv.A(cols[static_cast<std::size_t>(a)], i);
@@ -133,25 +135,32 @@ FaultModeSet faultModes(const Geometry& g, const ErrorModel& model, const AraimC
 
 /// One subset solution per monitorable fault mode; an unmonitorable mode's prior goes to the
 /// unmonitored probability.
-void monitorFaultModes(AraimResult& out, const Geometry& g, const AllInView& aiv, const FaultModeSet& fm,
+void monitorFaultModes(AraimResult& out, const Geometry& g, const AllInView& aiv, FaultModeSet&& fm,
                        const Eigen::VectorXd& c_acc) {
   out.n_fault_max = fm.n_fault_max;
   out.p_not_monitored = fm.p_not_monitored;
-  for (const FaultMode& mode : fm.modes) {
+  out.subsets.reserve(fm.modes.size());
+  for (FaultMode& mode : fm.modes) {
     SubsetSolution s;
-    s.removed = mode.removed;
+    s.removed = std::move(mode.removed);
     s.prior = mode.prior;
     s.event_prior = mode.event_prior;
-    if (!subsetSolution(g, aiv, mode.removed, s)) {
+    if (!subsetSolution(g, aiv, s.removed, s)) {
       out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
       ++out.unmonitorable_modes;
       continue;
     }
-    const Eigen::MatrixXd dS = s.S - out.S0;
     for (int q = 0; q < 3; ++q) {
-      s.sigma_ss[q] = std::sqrt(dS.row(q).cwiseAbs2().dot(c_acc));  // ADD Eq. 21 (C_acc)
-      s.bias[q] = s.S.row(q).cwiseAbs().dot(g.bnom);
-      s.sigma_acc[q] = std::sqrt(s.S.row(q).cwiseAbs2().dot(c_acc));
+      double ss = 0.0, b = 0.0, acc = 0.0;
+      for (int i = 0; i < g.numSats(); ++i) {
+        const double sk = s.S(q, i), d = sk - out.S0(q, i);
+        ss += d * d * c_acc[i];  // ADD Eq. 21 (C_acc)
+        b += std::abs(sk) * g.bnom[i];
+        acc += sk * sk * c_acc[i];
+      }
+      s.sigma_ss[q] = std::sqrt(ss);
+      s.bias[q] = b;
+      s.sigma_acc[q] = std::sqrt(acc);
     }
     out.subsets.push_back(std::move(s));
   }
@@ -181,9 +190,10 @@ bool solveProtectionLevels(AraimResult& out, const Requirements& req) {
   const double budget_v = req.phmi_vert * scale;
   const double budget_h = 0.5 * req.phmi_hor * scale;  // per horizontal axis
   std::array<double, 3> pl{}, pl_eq{};
+  std::vector<RiskTerm> terms;
+  terms.reserve(out.subsets.size() + 1);
   for (int q = 0; q < 3; ++q) {
-    std::vector<RiskTerm> terms;
-    terms.reserve(out.subsets.size() + 1);
+    terms.clear();
     terms.push_back({2.0, 0.0, out.bias0[q], out.sigma0[q]});
     for (const SubsetSolution& s : out.subsets) terms.push_back({s.prior, s.threshold[q], s.bias[q], s.sigma[q]});
     pl[q] = solveProtectionLevel(terms, q == 2 ? budget_v : budget_h, req.tol_pl_m, &pl_eq[q],
