@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -189,25 +188,26 @@ bool selectLargeOnly(const std::vector<Event>& events, int depth, double p_any, 
   return true;
 }
 
-/// Merges combinations by removed set; fewest removed satellites first.
-std::vector<FaultMode> mergeByRemovedSet(const std::vector<Combination>& combos) {
-  std::map<std::vector<int>, FaultMode> merged;
-  for (const Combination& c : combos) {
-    FaultMode& m = merged[c.removed];
+/// Merges combinations by removed set; fewest removed satellites first, then lexicographic.
+std::vector<FaultMode> mergeByRemovedSet(std::vector<Combination>& combos) {
+  std::stable_sort(combos.begin(), combos.end(), [](const Combination& a, const Combination& b) {
+    return a.removed.size() != b.removed.size() ? a.removed.size() < b.removed.size() : a.removed < b.removed;
+  });
+  std::vector<FaultMode> out;
+  out.reserve(combos.size());
+  for (Combination& c : combos) {
     const int events = static_cast<int>(c.events.size());
-    if (m.removed.empty()) {
-      m.removed = c.removed;
+    if (out.empty() || out.back().removed != c.removed) {
+      FaultMode m;
+      m.removed = std::move(c.removed);
       m.events = events;
+      out.push_back(std::move(m));
     }
+    FaultMode& m = out.back();
     m.prior += c.prior;
     m.event_prior += c.event_prior;
     m.events = std::min(m.events, events);
   }
-  std::vector<FaultMode> out;
-  out.reserve(merged.size());
-  for (auto& [k, m] : merged) out.push_back(std::move(m));
-  std::stable_sort(out.begin(), out.end(),
-                   [](const FaultMode& a, const FaultMode& b) { return a.removed.size() < b.removed.size(); });
   return out;
 }
 

@@ -2,8 +2,6 @@
 
 #include "integrity/stats.hpp"
 
-#include <Eigen/Cholesky>
-
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -26,6 +24,44 @@ struct AllInView {
   Eigen::MatrixXd A;  ///< Gᵀ W (m × n)
   StateMatrix N;      ///< Gᵀ W G
 };
+
+/// Columns 0..2 of N⁻¹ for the symmetric positive definite mk × mk matrix N (overwritten by
+/// its unit lower-triangular factor), by an unpivoted LDLᵀ factorisation and substitution —
+/// a fixed-capacity loop for these ≤ 7 × 7 systems, no allocation. False when a pivot is not
+/// above kMinPivotRatio × the largest (the subset's states are not fixed: unmonitorable).
+bool firstThreeInverseColumns(StateMatrix& N, int mk, double (&X)[kMaxStates][3]) {
+  double d[kMaxStates];
+  double d_max = 0.0;
+  for (int j = 0; j < mk; ++j) {
+    double dj = N(j, j);
+    for (int k = 0; k < j; ++k) dj -= N(j, k) * N(j, k) * d[k];
+    if (!(dj > 0.0)) return false;
+    d[j] = dj;
+    d_max = std::max(d_max, dj);
+    for (int i = j + 1; i < mk; ++i) {
+      double lij = N(i, j);
+      for (int k = 0; k < j; ++k) lij -= N(i, k) * N(j, k) * d[k];
+      N(i, j) = lij / dj;
+    }
+  }
+  for (int j = 0; j < mk; ++j) {
+    if (!(d[j] > kMinPivotRatio * d_max)) return false;
+  }
+  for (int q = 0; q < 3; ++q) {
+    double y[kMaxStates];
+    for (int i = 0; i < mk; ++i) {  // L y = e_q
+      double v = i == q ? 1.0 : 0.0;
+      for (int k = 0; k < i; ++k) v -= N(i, k) * y[k];
+      y[i] = v;
+    }
+    for (int i = mk - 1; i >= 0; --i) {  // D Lᵀ x = y
+      double v = y[i] / d[i];
+      for (int k = i + 1; k < mk; ++k) v -= N(k, i) * X[k][q];
+      X[i][q] = v;
+    }
+  }
+  return true;
+}
 
 /// Subset solution from the all-in-view normal matrix down-dated by the removed satellites
 /// (N_k = N − Σ_{i∈B} w_i g_i g_iᵀ; TAES §III-B), with the clocks of emptied constellations
@@ -58,11 +94,8 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
   for (int a = 0; a < mk; ++a) {
     for (int b = 0; b < mk; ++b) Nr(a, b) = Nk(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
   }
-  const Eigen::LDLT<StateMatrix> ldlt(Nr);
-  const auto d = ldlt.vectorD();
-  if (ldlt.info() != Eigen::Success || !(d.minCoeff() > kMinPivotRatio * d.maxCoeff())) return false;
-  const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxStates, 3> X =
-      ldlt.solve(Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxStates, 3>::Identity(mk, 3));  // columns q of N_k⁻¹
+  double X[kMaxStates][3];  // columns q of N_k⁻¹
+  if (!firstThreeInverseColumns(Nr, mk, X)) return false;
   out.S = Eigen::MatrixXd::Zero(3, n);
   for (int i = 0, r = 0; i < n; ++i) {
     if (r < static_cast<int>(removed.size()) && removed[static_cast<std::size_t>(r)] == i) {
@@ -71,11 +104,11 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
     }
     for (int q = 0; q < 3; ++q) {
       double s = 0.0;
-      for (int a = 0; a < mk; ++a) s += X(a, q) * aiv.A(cols[static_cast<std::size_t>(a)], i);
+      for (int a = 0; a < mk; ++a) s += X[a][q] * aiv.A(cols[static_cast<std::size_t>(a)], i);
       out.S(q, i) = s;
     }
   }
-  for (int q = 0; q < 3; ++q) out.sigma[q] = std::sqrt(X(q, q));
+  for (int q = 0; q < 3; ++q) out.sigma[q] = std::sqrt(X[q][q]);
   return std::isfinite(out.sigma[0]) && std::isfinite(out.sigma[2]);
 }
 
@@ -101,7 +134,13 @@ AllInView allInView(const Geometry& g) {
   AllInView aiv;
   const Eigen::VectorXd w = g.sigma_int.array().square().inverse();
   aiv.A = g.G.transpose() * w.asDiagonal();
-  aiv.N = aiv.A * g.G;
+  const int m = g.numStates();
+  aiv.N = StateMatrix::Zero(m, m);
+  for (int i = 0; i < g.numSats(); ++i) {  // N = Σ w_i g_i g_iᵀ, without Eigen's general product kernel
+    for (int a = 0; a < m; ++a) {
+      for (int b = 0; b < m; ++b) aiv.N(a, b) += aiv.A(a, i) * g.G(i, b);
+    }
+  }
   return aiv;
 }
 
@@ -238,6 +277,21 @@ void judgeAvailability(AraimResult& out, const AraimConfig& cfg) {
 
 }  // namespace
 
+RiskAndSlope integrityRiskAndSlope(const std::vector<RiskTerm>& terms, double pl) {
+  constexpr double kInvSqrt2Pi = 0.39894228040143267794;
+  RiskAndSlope out;
+  for (const RiskTerm& t : terms) {
+    const double z = (pl - t.threshold - t.bias) / t.sigma;
+    if (z < 0.0) {
+      out.risk += t.prior;  // Q̃ = 1, flat
+      continue;
+    }
+    out.risk += t.prior * normalTail(z);
+    out.slope -= t.prior * kInvSqrt2Pi * std::exp(-0.5 * z * z) / t.sigma;
+  }
+  return out;
+}
+
 double integrityRisk(const std::vector<RiskTerm>& terms, double pl) {
   double r = 0.0;
   for (const RiskTerm& t : terms) r += t.prior * modifiedTail((pl - t.threshold - t.bias) / t.sigma);
@@ -248,20 +302,41 @@ double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, d
                             PlBracket* initial) {
   const double n1 = static_cast<double>(terms.size());
   double low = -1e300, high = -1e300;
+  // Modes of one kind share a prior (every single satellite of a constellation …): the
+  // multipliers are reused while the prior repeats (the same values, not an approximation).
+  double last_prior = -1.0, k_low = 0.0, k_high = 0.0;
   for (const RiskTerm& t : terms) {
-    if (t.prior > budget) low = std::max(low, t.threshold + t.bias + normalTailInverse(budget / t.prior) * t.sigma);
-    const double share = budget / (n1 * t.prior);
-    const double k = share < 0.5 ? normalTailInverse(share) : 0.0;
-    high = std::max(high, t.threshold + t.bias + k * t.sigma);
+    if (t.prior != last_prior) {
+      last_prior = t.prior;
+      k_low = t.prior > budget ? normalTailInverse(budget / t.prior) : 0.0;
+      const double share = budget / (n1 * t.prior);
+      k_high = share < 0.5 ? normalTailInverse(share) : 0.0;
+    }
+    if (t.prior > budget) low = std::max(low, t.threshold + t.bias + k_low * t.sigma);
+    high = std::max(high, t.threshold + t.bias + k_high * t.sigma);
   }
   if (equal_allocation) *equal_allocation = high;
   low = std::min(low, high);
   if (initial) *initial = {low, high};
   // ADD Appendix B: at `low` the largest single term already uses the whole budget; at `high`
-  // every term uses at most budget/(N+1). The risk decreases with PL in between.
+  // every term uses at most budget/(N+1). The risk decreases with PL in between. The bracket is
+  // shrunk to ≤ tol by a safeguarded Newton iteration (each evaluated point replaces `low` or
+  // `high`; a Newton step that leaves the bracket is replaced by the midpoint), and the upper
+  // end returned — the same guarantee as plain bisection in fewer risk evaluations.
+  double x = high;
   while (high - low > tol) {
-    const double mid = 0.5 * (low + high);
-    (integrityRisk(terms, mid) > budget ? low : high) = mid;
+    const RiskAndSlope rs = integrityRiskAndSlope(terms, x);
+    (rs.risk > budget ? low : high) = x;
+    if (high - low <= tol) break;
+    double next = 0.5 * (low + high);
+    if (rs.slope < 0.0) {
+      const double step = (rs.risk - budget) / -rs.slope;
+      // Once the step is below tol/2 the estimate is that close to the root: the next point
+      // goes tol/2 past it, on the side whose end of the bracket has not moved yet.
+      const double newton = x + step + (std::abs(step) < 0.5 * tol ? std::copysign(0.5 * tol, step) : 0.0);
+      if (newton > low && newton < high) next = newton;
+    }
+    x = next;
   }
   return high;
 }

@@ -93,8 +93,16 @@ struct RiskTerm {
 /// \brief Total integrity risk Σ p·Q̃((PL − T − b)/σ) at PL, with Q̃(x) = 1 for x < 0 (ADD Eq. 7–8).
 [[nodiscard]] double integrityRisk(const std::vector<RiskTerm>& terms, double pl);
 
-/// \brief Solves integrityRisk(PL) = budget by bisection between the ADD's bounds (Appendix B),
-/// stopping when the bracket is ≤ tol; returns the upper end (conservative by ≤ tol).
+/// \brief The risk of integrityRisk and its derivative in PL (−Σ p φ(z)/σ over the terms with
+/// z ≥ 0; the Q̃ = 1 part is flat).
+struct RiskAndSlope {
+  double risk = 0.0, slope = 0.0;
+};
+[[nodiscard]] RiskAndSlope integrityRiskAndSlope(const std::vector<RiskTerm>& terms, double pl);
+
+/// \brief Solves integrityRisk(PL) = budget inside the ADD's bracket (Appendix B) by a
+/// safeguarded Newton iteration, stopping when the bracket is ≤ tol; returns the upper end
+/// (conservative by ≤ tol).
 /// `equal_allocation` receives the initial upper bound max_j(T_j + b_j + Q⁻¹(budget/((N+1)p_j))σ_j).
 [[nodiscard]] double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, double tol,
                                           double* equal_allocation = nullptr, PlBracket* initial = nullptr);
