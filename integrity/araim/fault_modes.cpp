@@ -1,6 +1,7 @@
 #include "integrity/araim/fault_modes.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -24,7 +25,8 @@ struct Event {
 
 /// One combination of events, before merging by removed set.
 struct Combination {
-  std::vector<int> events;   ///< event indices, ascending
+  std::array<int, kMaxEnumeratedEvents> events{};  ///< event indices, ascending (the first n_events)
+  int n_events = 0;
   std::vector<int> removed;  ///< union of the events' satellites, ascending
   double prior = 0.0;        ///< ∏_{e∈E} p_e ∏_{e∉E} (1 − p_e)
   double event_prior = 0.0;  ///< ∏_{e∈E} p_e
@@ -92,7 +94,7 @@ Combination makeCombination(const std::vector<Event>& events, const int* pick, i
   c.event_prior = event_prior;
   for (int i = 0; i < k; ++i) {
     const Event& e = events[static_cast<std::size_t>(pick[i])];
-    c.events.push_back(pick[i]);
+    c.events[static_cast<std::size_t>(c.n_events++)] = pick[i];
     c.removed.insert(c.removed.end(), e.removes.begin(), e.removes.end());
   }
   std::sort(c.removed.begin(), c.removed.end());
@@ -119,7 +121,7 @@ std::vector<Combination> combinationsUpTo(const std::vector<Event>& events, int 
 void consolidateIntoConstellations(std::vector<Combination>& combos, int first_const_event, double fc_thres) {
   if (!(fc_thres > 0.0)) return;
   for (std::size_t c = 0; c < combos.size(); ++c) {
-    if (combos[c].events.size() != 1 || combos[c].events[0] < first_const_event) continue;
+    if (combos[c].n_events != 1 || combos[c].events[0] < first_const_event) continue;
     const std::vector<int> own = combos[c].removed;
     const double limit = fc_thres * combos[c].prior;
     double prior_in = 0.0, event_prior_in = 0.0;
@@ -196,7 +198,7 @@ std::vector<FaultMode> mergeByRemovedSet(std::vector<Combination>& combos) {
   std::vector<FaultMode> out;
   out.reserve(combos.size());
   for (Combination& c : combos) {
-    const int events = static_cast<int>(c.events.size());
+    const int events = c.n_events;
     if (out.empty() || out.back().removed != c.removed) {
       FaultMode m;
       m.removed = std::move(c.removed);
@@ -256,7 +258,7 @@ FaultModeSet blanch2012Modes(const Events& ev, const FaultModeOptions& o) {
   std::vector<Combination> combos = combinationsUpTo(sat_events, n_sat, noFault(sat_events));
   std::vector<Combination> cc = combinationsUpTo(const_events, n_const, noFault(const_events));
   for (Combination& c : cc) {
-    for (int& e : c.events) e += ev.first_const;
+    for (int k = 0; k < c.n_events; ++k) c.events[static_cast<std::size_t>(k)] += ev.first_const;
     combos.push_back(std::move(c));
   }
   consolidateIntoConstellations(combos, ev.first_const, o.fc_thres);
