@@ -79,10 +79,12 @@ std::vector<Geometry> almanacSkies() {
   return out;
 }
 
+/// Arg 0: the default fault-mode rule (adds_until_threshold); 1: joint_events, side by side.
 void BM_AraimPlGpsGalileo(benchmark::State& state) {
   const auto skies = almanacSkies();
   const ErrorModel model;
-  const AraimConfig cfg;
+  AraimConfig cfg;
+  if (state.range(0) == 1) cfg.rule = FaultModeRule::kJointEvents;
   std::size_t k = 0, sats = 0, modes = 0;
   for (auto _ : state) {
     const Geometry& g = skies[k++ % skies.size()];
@@ -94,6 +96,6 @@ void BM_AraimPlGpsGalileo(benchmark::State& state) {
   state.counters["sats"] = benchmark::Counter(static_cast<double>(sats), benchmark::Counter::kAvgIterations);
   state.counters["modes"] = benchmark::Counter(static_cast<double>(modes), benchmark::Counter::kAvgIterations);
 }
-BENCHMARK(BM_AraimPlGpsGalileo)->Repetitions(5)->ReportAggregatesOnly(true);
+BENCHMARK(BM_AraimPlGpsGalileo)->Arg(0)->Arg(1)->Repetitions(5)->ReportAggregatesOnly(true);
 
 }  // namespace

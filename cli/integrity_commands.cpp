@@ -148,16 +148,19 @@ json araimJson(const integrity::AraimResult& r, bool verbose, const std::vector<
   j["vpl_m"] = ok ? r4(r.vpl_m) : json(nullptr);
   j["hpl_equal_allocation_m"] = ok ? r4(r.hpl_equal_allocation_m) : json(nullptr);
   j["vpl_equal_allocation_m"] = ok ? r4(r.vpl_equal_allocation_m) : json(nullptr);
-  j["emt_m"] = ok ? r4(r.emt_m) : json(nullptr);
-  j["sigma_acc_m"] = ok ? r4(r.sigma_acc_v_m) : json(nullptr);
+  // EMT and σ_acc need only the all-in-view solution and the thresholds: printed also when the
+  // PL is not computable (as MAAST for ARAIM reports them).
+  const bool acc = r.accuracy_computed;
+  j["emt_m"] = acc ? r4(r.emt_m) : json(nullptr);
+  j["sigma_acc_m"] = acc ? r4(r.sigma_acc_v_m) : json(nullptr);
   j["fault_modes"] = r.fault_modes;
   j["satellites"] = sats.size();
-  if (verbose && ok) {
+  if (verbose && acc) {
     j["n_fault_max"] = r.n_fault_max;
     j["p_not_monitored"] = r.p_not_monitored;
     j["k_fa_h"] = r4(r.k_fa_h);
     j["k_fa_v"] = r4(r.k_fa_v);
-    j["hpl_axis_m"] = {r4(r.hpl_axis_m[0]), r4(r.hpl_axis_m[1])};
+    j["hpl_axis_m"] = ok ? json{r4(r.hpl_axis_m[0]), r4(r.hpl_axis_m[1])} : json(nullptr);
     j["fault_free"] = {{"sigma_m", triple(r.sigma0)}, {"bias_m", triple(r.bias0)}};
     json subsets = json::array();
     for (const auto& s : r.subsets) {

@@ -5,6 +5,7 @@
 #include "cli/fence_commands.hpp"
 #include "cli/integrity_commands.hpp"
 #include "cli/plan_commands.hpp"
+#include "cli/serve_commands.hpp"
 #include "cli/simulate_commands.hpp"
 #include "cli/skymask_commands.hpp"
 #include "cli/track_commands.hpp"
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
   skylane::cli::addApproveCommands(app);
   skylane::cli::addTrackCommands(app);
   skylane::cli::addPlanCommands(app);
+  skylane::cli::addServeCommands(app);
   skylane::maps::watchStandardOutput();
   try {
     app.parse(argc, argv);

@@ -4,6 +4,7 @@
 #include "airspace/loaders.hpp"
 #include "airspace/validation.hpp"
 #include "airspace/vertical.hpp"
+#include "airspace/zone_export.hpp"
 #include "airspace/zone_geometry.hpp"
 #include "cli/json_numbers.hpp"
 #include "maps/geodesy.hpp"
@@ -58,36 +59,6 @@ maps::Terrain loadTerrain(const std::string& path) {
   return path.empty() ? maps::Terrain::flat(0.0) : maps::Terrain::fromRaster(path);
 }
 
-
-json limitJson(const airspace::VerticalLimit& l) {
-  json j;
-  j["as_given"] = l.as_given;
-  j["reference"] = std::string(airspace::referenceName(l.reference));
-  j["value_m"] = l.unlimited ? json(nullptr) : json(roundToMm(l.value_m));
-  j["unlimited"] = l.unlimited;
-  return j;
-}
-
-json applicabilityJson(const airspace::Zone& z) {
-  json list = json::array();
-  for (const airspace::Applicability& a : z.applicability) {
-    json j;
-    j["permanent"] = a.permanent;
-    if (a.start) j["start"] = maps::formatRfc3339(*a.start);
-    if (a.end) j["end"] = maps::formatRfc3339(*a.end);
-    json schedule = json::array();
-    for (const airspace::DailyPeriod& p : a.schedule) {
-      json days = json::array();
-      for (unsigned d = 0; d < 7; ++d) {
-        if (p.days & (1u << d)) days.push_back(airspace::weekdayName(d));
-      }
-      schedule.push_back({{"day", days}, {"start_utc_s", p.start_s}, {"end_utc_s", p.end_s}});
-    }
-    if (!schedule.empty()) j["schedule"] = schedule;
-    list.push_back(j);
-  }
-  return list;
-}
 
 void runValidate(const ValidateOptions& o) {
   bool all_ok = true;
@@ -173,8 +144,8 @@ void runAt(const AtOptions& o) {
         j["message"] = z.message;
         j["active"] = active;
         j["horizontal"] = side == airspace::Side::kInside ? "inside" : "on the boundary";
-        j["floor"] = limitJson(v.lower);
-        j["ceiling"] = limitJson(v.upper);
+        j["floor"] = airspace::limitJson(v.lower);
+        j["ceiling"] = airspace::limitJson(v.upper);
         j["floor_h_ell_m"] = floor ? metresOrNull(*floor) : json("unknown terrain");
         j["ceiling_h_ell_m"] = ceiling ? metresOrNull(*ceiling) : json("unknown terrain");
         const bool unknown = !floor || !ceiling;
@@ -200,19 +171,6 @@ void runAt(const AtOptions& o) {
   std::cout << out.dump(2) << "\n";
 }
 
-/// A limit's resolved range over the outline (airspace::limitRange), both references.
-json resolvedRange(const airspace::VerticalLimit& l, bool ceiling, const airspace::Outline& o,
-                   const airspace::VerticalModel& model) {
-  const auto r = airspace::limitRange(l, ceiling, o, model);
-  if (!r) return json("unknown terrain");
-  return {{"h_ell_m", {metresOrNull(r->h_ell_min_m), metresOrNull(r->h_ell_max_m)}},
-          {"alt_amsl_m", {metresOrNull(r->alt_amsl_min_m), metresOrNull(r->alt_amsl_max_m)}}};
-}
-
-json positionJson(const airspace::LatLon& p) {
-  return json::array({std::round(maps::rad2deg(p.lon_rad) * 1e9) / 1e9, std::round(maps::rad2deg(p.lat_rad) * 1e9) / 1e9});
-}
-
 void runExport(const ExportOptions& o) {
   if (o.to != "geojson") throw ParseError("--to", 0, "--to", o.to, "geojson");
   const maps::Terrain terrain = loadTerrain(o.terrain);
@@ -220,36 +178,7 @@ void runExport(const ExportOptions& o) {
   json features = json::array();
   for (const std::string& path : o.files) {
     for (const airspace::Zone& z : airspace::loadZones(path, zoneFormat(o.format), o.repair)) {
-      for (std::size_t vi = 0; vi < z.volumes.size(); ++vi) {
-        const airspace::Volume& v = z.volumes[vi];
-        json geometry;
-        json props;
-        if (v.outline.kind == airspace::Outline::Kind::kPolygon) {
-          json ring = json::array();
-          for (const airspace::LatLon& p : v.outline.ring) ring.push_back(positionJson(p));
-          ring.push_back(positionJson(v.outline.ring.front()));
-          geometry = {{"type", "Polygon"}, {"coordinates", json::array({ring})}};
-        } else {
-          geometry = {{"type", "Point"}, {"coordinates", positionJson(v.outline.centre)}};
-          props["radius_m"] = v.outline.radius_m;
-        }
-        props["identifier"] = z.identifier;
-        props["name"] = z.name;
-        props["restriction"] = std::string(airspace::restrictionLabel(z));
-        props["keep_in"] = z.keep_in;
-        props["reason"] = z.reasons;
-        props["message"] = z.message;
-        props["volume"] = vi;
-        props["source"] = z.source;
-        props["feature"] = z.feature;
-        props["lower"] = limitJson(v.lower);
-        props["upper"] = limitJson(v.upper);
-        props["lower_resolved"] = resolvedRange(v.lower, false, v.outline, model);
-        props["upper_resolved"] = resolvedRange(v.upper, true, v.outline, model);
-        props["applicability"] = applicabilityJson(z);
-        if (!z.notes.empty()) props["notes"] = z.notes;
-        features.push_back({{"type", "Feature"}, {"geometry", geometry}, {"properties", props}});
-      }
+      for (json& f : airspace::zoneFeatures(z, model)) features.push_back(std::move(f));
     }
   }
   const json out = {{"type", "FeatureCollection"},

@@ -171,11 +171,22 @@ void readRaim(const json& r, RaimConfig& raim, const std::string& src) {
 
 void readAraim(const json& a, AraimConfig& araim, const std::string& src) {
   if (!a.is_object()) throw ParseError(src, 0, "araim", shown(a), "an object");
-  requireKeys(a, {"fault_mode_rule", "horizontal_only"}, src, "araim");
+  requireKeys(a, {"fault_mode_rule", "fc_thres", "emt_probability", "horizontal_only"}, src, "araim");
   if (const auto f = a.find("fault_mode_rule"); f != a.end()) {
-    if (*f == "joint_events") araim.rule = FaultModeRule::kJointEvents;
+    if (*f == "adds_until_threshold") araim.rule = FaultModeRule::kAddsUntilThreshold;
+    else if (*f == "joint_events") araim.rule = FaultModeRule::kJointEvents;
     else if (*f == "blanch2012") araim.rule = FaultModeRule::kBlanch2012;
-    else throw ParseError(src, 0, "araim.fault_mode_rule", shown(*f), "\"joint_events\" or \"blanch2012\"");
+    else {
+      throw ParseError(src, 0, "araim.fault_mode_rule", shown(*f),
+                       "\"adds_until_threshold\", \"joint_events\" or \"blanch2012\"");
+    }
+  }
+  araim.fc_thres = number(a, "fc_thres", araim.fc_thres, src, "araim", 0.0, 1.0, "a fraction in [0, 1)");
+  if (araim.fc_thres >= 1.0) throw ParseError(src, 0, "araim.fc_thres", shown(a.at("fc_thres")), "a fraction in [0, 1)");
+  if (const auto e = a.find("emt_probability"); e != a.end()) {
+    if (*e == "mode_prior") araim.emt_probability = EmtProbability::kModePrior;
+    else if (*e == "event_product") araim.emt_probability = EmtProbability::kEventProduct;
+    else throw ParseError(src, 0, "araim.emt_probability", shown(*e), "\"mode_prior\" or \"event_product\"");
   }
   if (const auto h = a.find("horizontal_only"); h != a.end()) {
     if (!h->is_boolean()) throw ParseError(src, 0, "araim.horizontal_only", shown(*h), "true or false");

@@ -11,7 +11,8 @@
 ///                  "p_thres":8e-8,"p_emt":1e-5,"tol_pl_m":0.05,"val_m":35,"hal_m":40,
 ///                  "emt_m":15,"sigma_acc_m":1.87},
 ///  "raim":{"pfa":1e-6,"pmd":1e-3,"formula":"pbias_plus_noise"|"brown"},
-///  "araim":{"fault_mode_rule":"joint_events"|"blanch2012","horizontal_only":false},
+///  "araim":{"fault_mode_rule":"adds_until_threshold"|"joint_events"|"blanch2012",
+///           "fc_thres":0,"emt_probability":"mode_prior"|"event_product","horizontal_only":false},
 ///  "position":{"lat_deg":…,"lon_deg":…,"h_m":…},   // optional: single-frequency τ_vert
 ///  "iono_tau_vert_m": 9}                               // optional override
 /// ```

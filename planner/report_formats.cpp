@@ -228,37 +228,46 @@ std::vector<Eigen::Vector2d> segmentOutline(const Eigen::Vector3d& a, const Eige
   return {p0 - n * hal_m, p1 - n * hal_m, p1 + n * hal_m, p0 + n * hal_m};
 }
 
-nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission, const maps::PlaneFrame& frame) {
+namespace {
+
+/// What a route's GeoJSON is made of: an approval's report or a tracked flight's current route.
+struct RouteDrawing {
+  const std::vector<RoutePoint>& route;
+  maps::GpsTime departure;
+  const geofence::AlertLimits& level1;
+  const geofence::AlertLimits& level2;
+  nlohmann::json header;  ///< the route feature's properties
+  bool has_xyz = false;   ///< the points' map positions are set (a report's); else taken from lat/lon
+};
+
+/// The route line and its points.
+void addRouteLine(const RouteDrawing& d, nlohmann::json& features) {
   using nlohmann::json;
-  json features = json::array();
   json line = json::array();
-  for (const RoutePoint& p : report.route) {
-    line.push_back({deg(p.lon_rad), deg(p.lat_rad), roundToMm(p.alt_amsl_m)});
-  }
-  features.push_back({{"type", "Feature"},
-                      {"geometry", {{"type", "LineString"}, {"coordinates", line}}},
-                      {"properties",
-                       {{"kind", "route"},
-                        {"mission", mission.name},
-                        {"decision", report.approved ? "approved" : "rejected"},
-                        {"departure", maps::formatRfc3339(report.departure)},
-                        {"heights", "AMSL (EGM96) metres"}}}});
-  for (std::size_t i = 0; i < report.route.size(); ++i) {
-    const RoutePoint& p = report.route[i];
+  for (const RoutePoint& p : d.route) line.push_back({deg(p.lon_rad), deg(p.lat_rad), roundToMm(p.alt_amsl_m)});
+  features.push_back({{"type", "Feature"}, {"geometry", {{"type", "LineString"}, {"coordinates", line}}}, {"properties", d.header}});
+  for (std::size_t i = 0; i < d.route.size(); ++i) {
+    const RoutePoint& p = d.route[i];
     features.push_back(
         {{"type", "Feature"},
          {"geometry", {{"type", "Point"}, {"coordinates", {deg(p.lon_rad), deg(p.lat_rad), roundToMm(p.alt_amsl_m)}}}},
          {"properties",
-          {{"kind", "route_point"}, {"index", i}, {"eta", maps::formatRfc3339(report.departure.plus(p.eta_s), 1)},
+          {{"kind", "route_point"}, {"index", i}, {"eta", maps::formatRfc3339(d.departure.plus(p.eta_s), 1)},
            {"h_ell_m", roundToMm(p.h_ell_m)}, {"alt_amsl_m", roundToMm(p.alt_amsl_m)}}}});
   }
+}
+
+/// Both box levels, one polygon per segment (positions taken into the map frame from lat/lon).
+void addRouteBoxes(const RouteDrawing& d, const maps::PlaneFrame& frame, nlohmann::json& features) {
+  using nlohmann::json;
   for (int level : {2, 1}) {
-    const geofence::AlertLimits& lim = level == 1 ? report.limits.level1 : report.limits.level2;
-    for (std::size_t i = 1; i < report.route.size(); ++i) {
+    const geofence::AlertLimits& lim = level == 1 ? d.level1 : d.level2;
+    for (std::size_t i = 1; i < d.route.size(); ++i) {
+      const RoutePoint &a = d.route[i - 1], &b = d.route[i];
+      const Eigen::Vector2d pa = d.has_xyz ? Eigen::Vector2d(a.xyz.head<2>()) : frame.toPlane(a.lat_rad, a.lon_rad);
+      const Eigen::Vector2d pb = d.has_xyz ? Eigen::Vector2d(b.xyz.head<2>()) : frame.toPlane(b.lat_rad, b.lon_rad);
       json ring = json::array();
-      for (const Eigen::Vector2d& v : segmentOutline(report.route[i - 1].xyz, report.route[i].xyz, lim.hal_m)) {
-        ring.push_back(lonLat(frame, v));
-      }
+      for (const Eigen::Vector2d& v : segmentOutline({pa.x(), pa.y(), 0.0}, {pb.x(), pb.y(), 0.0}, lim.hal_m)) ring.push_back(lonLat(frame, v));
       ring.push_back(ring.front());
       features.push_back({{"type", "Feature"},
                           {"geometry", {{"type", "Polygon"}, {"coordinates", {ring}}}},
@@ -268,16 +277,45 @@ nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission
                             {"segment", i - 1},
                             {"hal_m", roundToMm(lim.hal_m)},
                             {"val_m", roundToMm(lim.val_m)},
-                            {"h_ell_lower_m", roundToMm(std::min(report.route[i - 1].h_ell_m, report.route[i].h_ell_m) - lim.val_m)},
-                            {"h_ell_upper_m", roundToMm(std::max(report.route[i - 1].h_ell_m, report.route[i].h_ell_m) + lim.val_m)}}}});
+                            {"h_ell_lower_m", roundToMm(std::min(a.h_ell_m, b.h_ell_m) - lim.val_m)},
+                            {"h_ell_upper_m", roundToMm(std::max(a.h_ell_m, b.h_ell_m) + lim.val_m)}}}});
     }
   }
+}
+
+nlohmann::json routeHeader(const Mission& mission, bool approved, const maps::GpsTime& departure) {
+  nlohmann::json h = {{"kind", "route"},
+                      {"mission", mission.name},
+                      {"decision", approved ? "approved" : "rejected"},
+                      {"departure", maps::formatRfc3339(departure)},
+                      {"heights", "AMSL (EGM96) metres"}};
+  if (mission.terrain_file.empty()) h["ground_amsl_m"] = roundToMm(mission.ground_amsl_m);
+  return h;
+}
+
+}  // namespace
+
+nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission, const maps::PlaneFrame& frame) {
+  using nlohmann::json;
+  json features = json::array();
+  const RouteDrawing d{report.route, report.departure, report.limits.level1, report.limits.level2,
+                       routeHeader(mission, report.approved, report.departure), true};
+  addRouteLine(d, features);
+  addRouteBoxes(d, frame, features);
   for (const Reason& r : report.reasons) {
     if (!r.lat_rad || !r.lon_rad) continue;
     features.push_back({{"type", "Feature"},
                         {"geometry", {{"type", "Point"}, {"coordinates", {deg(*r.lon_rad), deg(*r.lat_rad)}}}},
                         {"properties", {{"kind", "reason"}, {"reason", r.kind}, {"subject", r.subject}, {"message", r.message}}}});
   }
+  return {{"type", "FeatureCollection"}, {"features", features}};
+}
+
+nlohmann::json routeGeoJson(const ApprovedFlight& flight, const Mission& mission, const maps::PlaneFrame& frame) {
+  nlohmann::json features = nlohmann::json::array();
+  const RouteDrawing d{flight.route, flight.departure, flight.level1, flight.level2, routeHeader(mission, flight.approved, flight.departure)};
+  addRouteLine(d, features);
+  addRouteBoxes(d, frame, features);
   return {{"type", "FeatureCollection"}, {"features", features}};
 }
 

@@ -58,6 +58,9 @@ void from_json(const nlohmann::json& j, ApprovedFlight& f);
 /// box levels (one Polygon per segment), and every reason that has a place (Point).
 [[nodiscard]] nlohmann::json routeGeoJson(const ApprovalReport& report, const Mission& mission,
                                           const maps::PlaneFrame& frame);
+/// \brief The same (route, points, boxes; no reasons) for a flight's route as tracking holds it
+/// (after a replan, the new one).
+[[nodiscard]] nlohmann::json routeGeoJson(const ApprovedFlight& flight, const Mission& mission, const maps::PlaneFrame& frame);
 
 /// (The operational intent, ASTM F3548-21 Volume4D objects, is planner/operational_intent.hpp.)
 

@@ -22,4 +22,4 @@ export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1"
 # Left out here: the consumer project (it builds against an install, not a memory check). The
 # kill-and-resume tests run: they kill the tracker once its database holds some hundreds of fixes
 # (26 s and 21 s instrumented on the 2-core VM).
-ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -L 'unit|e2e|fuzz' -E 'Consumer\.'
+ctest --test-dir build-asan --output-on-failure -j "$(nproc)" -L 'unit|e2e|service|fuzz' -E 'Consumer\.'

@@ -2,8 +2,6 @@
 
 #include "integrity/stats.hpp"
 
-#include <Eigen/Cholesky>
-
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -27,26 +25,63 @@ struct AllInView {
   StateMatrix N;      ///< Gᵀ W G
 };
 
+/// Columns 0..2 of N⁻¹ for the symmetric positive definite mk × mk matrix N (overwritten by
+/// its unit lower-triangular factor), by an unpivoted LDLᵀ factorisation and substitution —
+/// a fixed-capacity loop for these ≤ 7 × 7 systems, no allocation. False when a pivot is not
+/// above kMinPivotRatio × the largest (the subset's states are not fixed: unmonitorable).
+bool firstThreeInverseColumns(StateMatrix& N, int mk, double (&X)[kMaxStates][3]) {
+  double d[kMaxStates];
+  double d_max = 0.0;
+  for (int j = 0; j < mk; ++j) {
+    double dj = N(j, j);
+    for (int k = 0; k < j; ++k) dj -= N(j, k) * N(j, k) * d[k];
+    if (!(dj > 0.0)) return false;
+    d[j] = dj;
+    d_max = std::max(d_max, dj);
+    for (int i = j + 1; i < mk; ++i) {
+      double lij = N(i, j);
+      for (int k = 0; k < j; ++k) lij -= N(i, k) * N(j, k) * d[k];
+      N(i, j) = lij / dj;
+    }
+  }
+  for (int j = 0; j < mk; ++j) {
+    if (!(d[j] > kMinPivotRatio * d_max)) return false;
+  }
+  for (int q = 0; q < 3; ++q) {
+    double y[kMaxStates];
+    for (int i = 0; i < mk; ++i) {  // L y = e_q
+      double v = i == q ? 1.0 : 0.0;
+      for (int k = 0; k < i; ++k) v -= N(i, k) * y[k];
+      y[i] = v;
+    }
+    for (int i = mk - 1; i >= 0; --i) {  // D Lᵀ x = y
+      double v = y[i] / d[i];
+      for (int k = i + 1; k < mk; ++k) v -= N(k, i) * X[k][q];
+      X[i][q] = v;
+    }
+  }
+  return true;
+}
+
 /// Subset solution from the all-in-view normal matrix down-dated by the removed satellites
 /// (N_k = N − Σ_{i∈B} w_i g_i g_iᵀ; TAES §III-B), with the clocks of emptied constellations
 /// dropped. Returns false when the mode cannot be monitored.
 bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<int>& removed, SubsetSolution& out) {
   const int n = g.numSats(), m = g.numStates();
-  std::vector<bool> keep(static_cast<std::size_t>(n), true);
-  for (int i : removed) keep[static_cast<std::size_t>(i)] = false;
   if (m > kMaxStates) return false;
-  std::vector<int> cols = {0, 1, 2};
-  cols.reserve(static_cast<std::size_t>(m));
+  // `removed` is ascending: one walk over the satellites tells kept from removed, no allocation.
+  const auto isRemoved = [&removed](int i) { return std::binary_search(removed.begin(), removed.end(), i); };
+  std::array<int, kMaxStates> cols{0, 1, 2};
+  int mk = 3;
   for (int c = 3; c < m; ++c) {
     for (int i = 0; i < n; ++i) {
-      if (keep[static_cast<std::size_t>(i)] && g.G(i, c) != 0.0) {
-        cols.push_back(c);
+      if (g.G(i, c) != 0.0 && !isRemoved(i)) {
+        cols[static_cast<std::size_t>(mk++)] = c;
         break;
       }
     }
   }
   const int kept = n - static_cast<int>(removed.size());
-  const int mk = static_cast<int>(cols.size());
   if (kept < mk) return false;  // the subset cannot fix position and its clocks (Stanford: N ≥ unknowns)
   StateMatrix Nk = aiv.N;
   for (int i : removed) {
@@ -59,21 +94,21 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
   for (int a = 0; a < mk; ++a) {
     for (int b = 0; b < mk; ++b) Nr(a, b) = Nk(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
   }
-  const Eigen::LDLT<StateMatrix> ldlt(Nr);
-  const auto d = ldlt.vectorD();
-  if (ldlt.info() != Eigen::Success || !(d.minCoeff() > kMinPivotRatio * d.maxCoeff())) return false;
-  const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxStates, 3> X =
-      ldlt.solve(Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxStates, 3>::Identity(mk, 3));  // columns q of N_k⁻¹
+  double X[kMaxStates][3];  // columns q of N_k⁻¹
+  if (!firstThreeInverseColumns(Nr, mk, X)) return false;
   out.S = Eigen::MatrixXd::Zero(3, n);
-  for (int i = 0; i < n; ++i) {
-    if (!keep[static_cast<std::size_t>(i)]) continue;
+  for (int i = 0, r = 0; i < n; ++i) {
+    if (r < static_cast<int>(removed.size()) && removed[static_cast<std::size_t>(r)] == i) {
+      ++r;
+      continue;
+    }
     for (int q = 0; q < 3; ++q) {
       double s = 0.0;
-      for (int a = 0; a < mk; ++a) s += X(a, q) * aiv.A(cols[static_cast<std::size_t>(a)], i);
+      for (int a = 0; a < mk; ++a) s += X[a][q] * aiv.A(cols[static_cast<std::size_t>(a)], i);
       out.S(q, i) = s;
     }
   }
-  for (int q = 0; q < 3; ++q) out.sigma[q] = std::sqrt(X(q, q));
+  for (int q = 0; q < 3; ++q) out.sigma[q] = std::sqrt(X[q][q]);
   return std::isfinite(out.sigma[0]) && std::isfinite(out.sigma[2]);
 }
 
@@ -99,7 +134,13 @@ AllInView allInView(const Geometry& g) {
   AllInView aiv;
   const Eigen::VectorXd w = g.sigma_int.array().square().inverse();
   aiv.A = g.G.transpose() * w.asDiagonal();
-  aiv.N = aiv.A * g.G;
+  const int m = g.numStates();
+  aiv.N = StateMatrix::Zero(m, m);
+  for (int i = 0; i < g.numSats(); ++i) {  // N = Σ w_i g_i g_iᵀ, without Eigen's general product kernel
+    for (int a = 0; a < m; ++a) {
+      for (int b = 0; b < m; ++b) aiv.N(a, b) += aiv.A(a, i) * g.G(i, b);
+    }
+  }
   return aiv;
 }
 
@@ -123,29 +164,42 @@ FaultModeSet faultModes(const Geometry& g, const ErrorModel& model, const AraimC
   }
   std::vector<double> p_const(kNumConstellations);
   for (Constellation c : kAllConstellations) p_const[static_cast<std::size_t>(c)] = model.of(c).pconst;
-  return determineFaultModes(cons, p_sat, p_const, cfg.requirements.p_thres, cfg.rule);
+  FaultModeOptions o;
+  o.rule = cfg.rule;
+  o.p_thres = cfg.requirements.p_thres;
+  o.phmi = cfg.requirements.phmi_vert + cfg.requirements.phmi_hor;
+  o.fc_thres = cfg.fc_thres;
+  return determineFaultModes(cons, p_sat, p_const, o);
 }
 
 /// One subset solution per monitorable fault mode; an unmonitorable mode's prior goes to the
 /// unmonitored probability.
-void monitorFaultModes(AraimResult& out, const Geometry& g, const AllInView& aiv, const FaultModeSet& fm,
+void monitorFaultModes(AraimResult& out, const Geometry& g, const AllInView& aiv, FaultModeSet&& fm,
                        const Eigen::VectorXd& c_acc) {
   out.n_fault_max = fm.n_fault_max;
   out.p_not_monitored = fm.p_not_monitored;
-  for (const FaultMode& mode : fm.modes) {
+  out.subsets.reserve(fm.modes.size());
+  for (FaultMode& mode : fm.modes) {
     SubsetSolution s;
-    s.removed = mode.removed;
+    s.removed = std::move(mode.removed);
     s.prior = mode.prior;
     s.event_prior = mode.event_prior;
-    if (!subsetSolution(g, aiv, mode.removed, s)) {
+    if (!subsetSolution(g, aiv, s.removed, s)) {
       out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
+      ++out.unmonitorable_modes;
       continue;
     }
-    const Eigen::MatrixXd dS = s.S - out.S0;
     for (int q = 0; q < 3; ++q) {
-      s.sigma_ss[q] = std::sqrt(dS.row(q).cwiseAbs2().dot(c_acc));  // ADD Eq. 21 (C_acc)
-      s.bias[q] = s.S.row(q).cwiseAbs().dot(g.bnom);
-      s.sigma_acc[q] = std::sqrt(s.S.row(q).cwiseAbs2().dot(c_acc));
+      double ss = 0.0, b = 0.0, acc = 0.0;
+      for (int i = 0; i < g.numSats(); ++i) {
+        const double sk = s.S(q, i), d = sk - out.S0(q, i);
+        ss += d * d * c_acc[i];  // ADD Eq. 21 (C_acc)
+        b += std::abs(sk) * g.bnom[i];
+        acc += sk * sk * c_acc[i];
+      }
+      s.sigma_ss[q] = std::sqrt(ss);
+      s.bias[q] = b;
+      s.sigma_acc[q] = std::sqrt(acc);
     }
     out.subsets.push_back(std::move(s));
   }
@@ -175,25 +229,31 @@ bool solveProtectionLevels(AraimResult& out, const Requirements& req) {
   const double budget_v = req.phmi_vert * scale;
   const double budget_h = 0.5 * req.phmi_hor * scale;  // per horizontal axis
   std::array<double, 3> pl{}, pl_eq{};
+  std::vector<RiskTerm> terms;
+  terms.reserve(out.subsets.size() + 1);
   for (int q = 0; q < 3; ++q) {
-    std::vector<RiskTerm> terms;
-    terms.reserve(out.subsets.size() + 1);
+    terms.clear();
     terms.push_back({2.0, 0.0, out.bias0[q], out.sigma0[q]});
     for (const SubsetSolution& s : out.subsets) terms.push_back({s.prior, s.threshold[q], s.bias[q], s.sigma[q]});
-    pl[q] = solveProtectionLevel(terms, q == 2 ? budget_v : budget_h, req.tol_pl_m, &pl_eq[q]);
+    pl[q] = solveProtectionLevel(terms, q == 2 ? budget_v : budget_h, req.tol_pl_m, &pl_eq[q],
+                                 &out.initial_bracket[static_cast<std::size_t>(q)]);
   }
   out.hpl_axis_m = {pl[0], pl[1]};
   out.hpl_m = std::hypot(pl[0], pl[1]);
   out.vpl_m = pl[2];
   out.hpl_equal_allocation_m = std::hypot(pl_eq[0], pl_eq[1]);
   out.vpl_equal_allocation_m = pl_eq[2];
-  // EMT (ADD Eq. 35): the largest vertical threshold among modes whose probability is at least
-  // P_EMT. The ISM rate ∏p_e is compared (a single-satellite mode at P_sat = P_EMT = 1e-5 counts;
-  // its exclusive prior, 1e-5·∏(1 − p), is a hair below and would not).
-  for (const SubsetSolution& s : out.subsets) {
-    if (s.event_prior >= req.p_emt) out.emt_m = std::max(out.emt_m, s.threshold[2]);
-  }
   return true;
+}
+
+/// EMT (ADD Eq. 35): the largest vertical threshold among monitored modes whose probability is
+/// at least P_EMT — by default the mode's own prior, as MAAST for ARAIM compares it.
+void setEffectiveMonitorThreshold(AraimResult& out, const AraimConfig& cfg) {
+  out.emt_m = 0.0;
+  for (const SubsetSolution& s : out.subsets) {
+    const double p = cfg.emt_probability == EmtProbability::kModePrior ? s.prior : s.event_prior;
+    if (p >= cfg.requirements.p_emt) out.emt_m = std::max(out.emt_m, s.threshold[2]);
+  }
 }
 
 /// Available when the levels are within the alert limits (and, unless horizontal only, the EMT
@@ -217,28 +277,66 @@ void judgeAvailability(AraimResult& out, const AraimConfig& cfg) {
 
 }  // namespace
 
+RiskAndSlope integrityRiskAndSlope(const std::vector<RiskTerm>& terms, double pl) {
+  constexpr double kInvSqrt2Pi = 0.39894228040143267794;
+  RiskAndSlope out;
+  for (const RiskTerm& t : terms) {
+    const double z = (pl - t.threshold - t.bias) / t.sigma;
+    if (z < 0.0) {
+      out.risk += t.prior;  // Q̃ = 1, flat
+      continue;
+    }
+    out.risk += t.prior * normalTail(z);
+    out.slope -= t.prior * kInvSqrt2Pi * std::exp(-0.5 * z * z) / t.sigma;
+  }
+  return out;
+}
+
 double integrityRisk(const std::vector<RiskTerm>& terms, double pl) {
   double r = 0.0;
   for (const RiskTerm& t : terms) r += t.prior * modifiedTail((pl - t.threshold - t.bias) / t.sigma);
   return r;
 }
 
-double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, double tol, double* equal_allocation) {
+double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, double tol, double* equal_allocation,
+                            PlBracket* initial) {
   const double n1 = static_cast<double>(terms.size());
   double low = -1e300, high = -1e300;
+  // Modes of one kind share a prior (every single satellite of a constellation …): the
+  // multipliers are reused while the prior repeats (the same values, not an approximation).
+  double last_prior = -1.0, k_low = 0.0, k_high = 0.0;
   for (const RiskTerm& t : terms) {
-    if (t.prior > budget) low = std::max(low, t.threshold + t.bias + normalTailInverse(budget / t.prior) * t.sigma);
-    const double share = budget / (n1 * t.prior);
-    const double k = share < 0.5 ? normalTailInverse(share) : 0.0;
-    high = std::max(high, t.threshold + t.bias + k * t.sigma);
+    if (t.prior != last_prior) {
+      last_prior = t.prior;
+      k_low = t.prior > budget ? normalTailInverse(budget / t.prior) : 0.0;
+      const double share = budget / (n1 * t.prior);
+      k_high = share < 0.5 ? normalTailInverse(share) : 0.0;
+    }
+    if (t.prior > budget) low = std::max(low, t.threshold + t.bias + k_low * t.sigma);
+    high = std::max(high, t.threshold + t.bias + k_high * t.sigma);
   }
   if (equal_allocation) *equal_allocation = high;
   low = std::min(low, high);
+  if (initial) *initial = {low, high};
   // ADD Appendix B: at `low` the largest single term already uses the whole budget; at `high`
-  // every term uses at most budget/(N+1). The risk decreases with PL in between.
+  // every term uses at most budget/(N+1). The risk decreases with PL in between. The bracket is
+  // shrunk to ≤ tol by a safeguarded Newton iteration (each evaluated point replaces `low` or
+  // `high`; a Newton step that leaves the bracket is replaced by the midpoint), and the upper
+  // end returned — the same guarantee as plain bisection in fewer risk evaluations.
+  double x = high;
   while (high - low > tol) {
-    const double mid = 0.5 * (low + high);
-    (integrityRisk(terms, mid) > budget ? low : high) = mid;
+    const RiskAndSlope rs = integrityRiskAndSlope(terms, x);
+    (rs.risk > budget ? low : high) = x;
+    if (high - low <= tol) break;
+    double next = 0.5 * (low + high);
+    if (rs.slope < 0.0) {
+      const double step = (rs.risk - budget) / -rs.slope;
+      // Once the step is below tol/2 the estimate is that close to the root: the next point
+      // goes tol/2 past it, on the side whose end of the bracket has not moved yet.
+      const double newton = x + step + (std::abs(step) < 0.5 * tol ? std::copysign(0.5 * tol, step) : 0.0);
+      if (newton > low && newton < high) next = newton;
+    }
+    x = next;
   }
   return high;
 }
@@ -259,6 +357,8 @@ AraimResult araimProtectionLevels(const Geometry& g, const ErrorModel& model, co
   setAllInViewErrors(out, g, all, c_acc);
   monitorFaultModes(out, g, aiv, faultModes(g, model, cfg), c_acc);
   setThresholds(out, cfg.requirements);
+  setEffectiveMonitorThreshold(out, cfg);
+  out.accuracy_computed = true;
   if (!solveProtectionLevels(out, cfg.requirements)) return out;
   out.pl_computed = std::isfinite(out.hpl_m) && std::isfinite(out.vpl_m);
   if (!out.pl_computed) {

@@ -24,10 +24,21 @@
 
 namespace skylane::integrity {
 
+/// \brief Which probability of a fault mode is compared with P_EMT for the EMT.
+enum class EmtProbability {
+  /// The mode's own (exclusive, merged) prior p_k — MAAST for ARAIM's convention, the default.
+  /// A single-satellite mode at P_sat = P_EMT = 1e-5 has p_k = 1e-5·∏(1 − p) < P_EMT: not counted.
+  kModePrior,
+  /// The product ∏ p_e of the mode's events (the ISM's nominal rate): that mode counts.
+  kEventProduct,
+};
+
 /// \brief ARAIM settings.
 struct AraimConfig {
   Requirements requirements;
-  FaultModeRule rule = FaultModeRule::kJointEvents;
+  FaultModeRule rule = FaultModeRule::kAddsUntilThreshold;
+  double fc_thres = 0.0;  ///< fault consolidation threshold (fault_modes.hpp); 0 = off
+  EmtProbability emt_probability = EmtProbability::kModePrior;
   bool horizontal_only = false;  ///< availability from HPL ≤ HAL alone (H-ARAIM)
 };
 
@@ -35,7 +46,7 @@ struct AraimConfig {
 struct SubsetSolution {
   std::vector<int> removed;  ///< indices into the geometry's satellites
   double prior = 0.0;
-  double event_prior = 0.0;  ///< ∏ p_e of the mode's events (compared with P_EMT)
+  double event_prior = 0.0;  ///< ∏ p_e of the mode's events (compared with P_EMT under kEventProduct)
   std::array<double, 3> sigma{};      ///< σ_q^(k) [m], integrity covariance
   std::array<double, 3> sigma_ss{};   ///< σ_ss,q^(k) [m], accuracy covariance (C_acc)
   std::array<double, 3> bias{};       ///< b_q^(k) [m]
@@ -44,9 +55,17 @@ struct SubsetSolution {
   Eigen::MatrixXd S;                  ///< rows 0..2 of S^(k) (3 × n), zero columns for removed satellites
 };
 
+/// \brief The bisection's initial bracket of one axis (ADD Appendix B bounds).
+struct PlBracket {
+  double low_m = 0.0;   ///< the largest single term alone uses the whole budget here
+  double high_m = 0.0;  ///< every term uses at most budget/(N+1) here (the equal-allocation bound)
+};
+
 /// \brief ARAIM protection levels and everything behind them.
 struct AraimResult {
   bool pl_computed = false;  ///< false: too few satellites, degenerate geometry, risk budget exhausted
+  /// The all-in-view solution exists: σ_acc and the EMT are computed (also when the PL is not).
+  bool accuracy_computed = false;
   bool available = false;    ///< against VAL/HAL/EMT/σ_acc (or HAL alone in horizontal-only mode)
   std::string reason;
   double hpl_m = 0, vpl_m = 0;
@@ -55,10 +74,12 @@ struct AraimResult {
   double emt_m = 0;
   double sigma_acc_v_m = 0;  ///< √(S⁰ C_acc S⁰ᵀ)_UU
   int fault_modes = 0;       ///< monitored (and monitorable) fault modes, fault-free excluded
+  int unmonitorable_modes = 0;  ///< selected modes whose subset is singular (prior added to P_not_monitored)
   int n_fault_max = 0;
   double p_not_monitored = 0;
   double k_fa_h = 0, k_fa_v = 0;
   std::array<double, 3> sigma0{}, bias0{};
+  std::array<PlBracket, 3> initial_bracket{};  ///< per axis east, north, up
   Eigen::MatrixXd S0;  ///< rows 0..2 of the all-in-view S
   std::vector<SubsetSolution> subsets;
 };
@@ -72,11 +93,19 @@ struct RiskTerm {
 /// \brief Total integrity risk Σ p·Q̃((PL − T − b)/σ) at PL, with Q̃(x) = 1 for x < 0 (ADD Eq. 7–8).
 [[nodiscard]] double integrityRisk(const std::vector<RiskTerm>& terms, double pl);
 
-/// \brief Solves integrityRisk(PL) = budget by bisection between the ADD's bounds (Appendix B),
-/// stopping when the bracket is ≤ tol; returns the upper end (conservative by ≤ tol).
+/// \brief The risk of integrityRisk and its derivative in PL (−Σ p φ(z)/σ over the terms with
+/// z ≥ 0; the Q̃ = 1 part is flat).
+struct RiskAndSlope {
+  double risk = 0.0, slope = 0.0;
+};
+[[nodiscard]] RiskAndSlope integrityRiskAndSlope(const std::vector<RiskTerm>& terms, double pl);
+
+/// \brief Solves integrityRisk(PL) = budget inside the ADD's bracket (Appendix B) by a
+/// safeguarded Newton iteration, stopping when the bracket is ≤ tol; returns the upper end
+/// (conservative by ≤ tol).
 /// `equal_allocation` receives the initial upper bound max_j(T_j + b_j + Q⁻¹(budget/((N+1)p_j))σ_j).
 [[nodiscard]] double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, double tol,
-                                          double* equal_allocation = nullptr);
+                                          double* equal_allocation = nullptr, PlBracket* initial = nullptr);
 
 /// \brief ARAIM MHSS protection levels for a geometry (σ_int, σ_acc, b_nom set) under an ISM.
 [[nodiscard]] AraimResult araimProtectionLevels(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg);

@@ -125,7 +125,12 @@ void TrackStore::requireSchema() const {
   }
   std::vector<std::string> present;
   while (sqlite3_step(tables.s) == SQLITE_ROW) present.push_back(columnText(tables.s, 0));
-  if (present.empty()) return;  // a new database: open() creates the tables
+  // None of the tracker's tables: a new database, or one that another part of skylane keeps in
+  // the same file (the service's tables): open() adds the tracker's. Some of them: all must be there.
+  const bool any = std::any_of(kSchema.begin(), kSchema.end(), [&present](const auto& t) {
+    return t.first != kOptionalTable && std::find(present.begin(), present.end(), t.first) != present.end();
+  });
+  if (!any) return;
   for (const auto& [table, columns] : kSchema) {
     std::vector<std::string> got;
     if (std::find(present.begin(), present.end(), table) != present.end()) {
@@ -226,6 +231,23 @@ std::vector<nlohmann::json> TrackStore::events(const std::string& type) const {
   return out;
 }
 
+std::vector<TrackStore::LoggedEvent> TrackStore::eventsAfter(std::int64_t after, std::size_t limit) const {
+  std::vector<LoggedEvent> out;
+  Statement st;
+  if (sqlite3_prepare_v2(db_, "SELECT seq, flight, type, json FROM events WHERE seq > ? ORDER BY seq LIMIT ?", -1, &st.s,
+                         nullptr) != SQLITE_OK) {
+    fail("cannot read events");
+  }
+  sqlite3_bind_int64(st.s, 1, after);
+  sqlite3_bind_int64(st.s, 2, static_cast<sqlite3_int64>(limit));
+  while (sqlite3_step(st.s) == SQLITE_ROW) {
+    out.push_back({sqlite3_column_int64(st.s, 0), columnText(st.s, 1), columnText(st.s, 2), columnText(st.s, 3)});
+  }
+  return out;
+}
+
+std::int64_t TrackStore::lastEventSeq() const { return sqlite3_last_insert_rowid(db_); }
+
 void TrackStore::begin() {
   if (in_batch_) return;
   exec("BEGIN");
@@ -316,7 +338,5 @@ std::vector<std::string> TrackStore::eventLines(std::int64_t first_seq, std::int
   while (sqlite3_step(st.s) == SQLITE_ROW) out.push_back(columnText(st.s, 0));
   return out;
 }
-
-std::int64_t TrackStore::lastEventSeq() const { return sqlite3_last_insert_rowid(db_); }
 
 }  // namespace skylane::planner

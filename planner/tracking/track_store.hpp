@@ -57,6 +57,16 @@ class TrackStore final : public EventSink {
   [[nodiscard]] std::size_t inputLine(const std::string& name) const;
   /// \brief Events in order (all, or of one type).
   [[nodiscard]] std::vector<nlohmann::json> events(const std::string& type = {}) const;
+  /// \brief An event as stored: its sequence number (the order of the log, never reused), flight,
+  /// type and JSON line.
+  struct LoggedEvent {
+    std::int64_t seq = 0;
+    std::string flight, type, line;
+  };
+  /// \brief Up to `limit` events after sequence number `after`, in order (a resumed event stream).
+  [[nodiscard]] std::vector<LoggedEvent> eventsAfter(std::int64_t after, std::size_t limit) const;
+  /// \brief The sequence number of the event appended last on this connection (0: none yet).
+  [[nodiscard]] std::int64_t lastEventSeq() const;
 
   /// \brief Starts a batch (a transaction); the writes below join it.
   void begin();
@@ -73,8 +83,7 @@ class TrackStore final : public EventSink {
   [[nodiscard]] std::optional<OutputMark> outputMark(const std::string& name) const;
   /// \brief The JSON lines of events first_seq…last_seq, in order, as they were streamed.
   [[nodiscard]] std::vector<std::string> eventLines(std::int64_t first_seq, std::int64_t last_seq) const;
-  /// \brief The seq of the event stored last by this connection.
-  [[nodiscard]] std::int64_t lastEventSeq() const;
+
   /// \brief appendEvent() of the event (EventSink).
   void write(const TrackEvent& event, const std::string& json_line) override;
   /// \brief Commits the batch.

@@ -129,6 +129,14 @@ json Tracker::routeJson(const std::string& id) const {
   return {{"departure", maps::formatRfc3339(f.plan.departure, 3)}, {"route", route}};
 }
 
+json Tracker::routeGeoJson(const std::string& id) const {
+  const TrackedFlight& f = *flights_.at(id);
+  json j = planner::routeGeoJson(f.plan, f.approver->mission(), f.approver->frame());
+  j["features"][0]["properties"]["flight"] = id;
+  j["features"][0]["properties"]["route_version"] = f.st.route_version;
+  return j;
+}
+
 void Tracker::restore(const std::string& id, const FlightState& state, const json& route) {
   TrackedFlight& f = *flights_.at(id);
   f.st = state;

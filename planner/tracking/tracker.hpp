@@ -118,6 +118,8 @@ class Tracker {
   /// \brief A flight's state and current route (for persistence); restore() puts them back.
   [[nodiscard]] const FlightState& state(const std::string& id) const;
   [[nodiscard]] nlohmann::json routeJson(const std::string& id) const;
+  /// \brief The flight's current route as route.geojson (line, points, both box levels).
+  [[nodiscard]] nlohmann::json routeGeoJson(const std::string& id) const;
   void restore(const std::string& id, const FlightState& state, const nlohmann::json& route);
   /// \brief The approver (mission, map frame, zones and obstacles) of a flight.
   [[nodiscard]] const Approver& approver(const std::string& id) const;

@@ -54,8 +54,6 @@ class TrackingSession {
   std::string addApprovalFile(const std::string& report_path, const std::string& id = {});
   /// \brief Events go to `sink` too (not owned; it outlives the session's runs).
   void addSink(EventSink& sink) { sinks_.push_back(&sink); }
-  /// \brief The database (null without one).
-  [[nodiscard]] TrackStore* store() { return store_.get(); }
   /// \brief Work that runs beside the stream (a link's mission upload): called after every
   /// record and whenever the input is quiet; the events it returns are the session's.
   using Ticker = std::function<std::vector<TrackEvent>()>;
@@ -75,6 +73,11 @@ class TrackingSession {
   void reject(const std::string& where, std::size_t line, const std::string& why, const std::string& flight = {});
   /// \brief The stale sweep at the stream time and a checkpoint (the end of a run).
   void finish();
+  /// \brief A checkpoint now: what was submitted is committed and handed to the sinks (a
+  /// service answers a request only after this, so an acknowledged fix is never lost).
+  void commit() { checkpoint(true); }
+  /// \brief The database, when there is one.
+  [[nodiscard]] TrackStore* store() { return store_.get(); }
 
   [[nodiscard]] Tracker& tracker() { return tracker_; }
   [[nodiscard]] const Tracker& tracker() const { return tracker_; }

@@ -53,9 +53,31 @@ TEST(Cli, PlDefaultsToAraimWithItsFields) {
                           "vpl_equal_allocation_m", "available", "subsets"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
-  EXPECT_EQ(j["fault_modes"].get<int>(), 14);  // 12 satellites + GPS out + Galileo out (P_sat 1e-5)
-  EXPECT_EQ(j["subsets"].size(), 14u);
+  // 12 satellites + Galileo out (P_sat 1e-5). GPS out (P_const 1e-8, below PHMI) is left to
+  // P_not_monitored by the default rule: with the singles monitored P_nm is already ≤ P_THRES.
+  EXPECT_EQ(j["fault_modes"].get<int>(), 13);
+  EXPECT_EQ(j["subsets"].size(), 13u);
+  EXPECT_LE(j["p_not_monitored"].get<double>(), 8e-8);
   EXPECT_LE(j["vpl_m"].get<double>(), j["vpl_equal_allocation_m"].get<double>());
+}
+
+TEST(Cli, PlPrintsEmtAndSigmaAccWhenThePlIsNotComputable) {
+  // GIVEN priors whose unmonitored probability exceeds the integrity budget
+  const std::string geo = writeTemp("geo_nopl.json", R"({"satellites":[
+    {"id":"G01","az_deg":0,"el_deg":88},{"id":"G05","az_deg":30,"el_deg":35},{"id":"G08","az_deg":95,"el_deg":20},
+    {"id":"G11","az_deg":150,"el_deg":55},{"id":"G17","az_deg":200,"el_deg":15},{"id":"E03","az_deg":60,"el_deg":65},
+    {"id":"E11","az_deg":120,"el_deg":12},{"id":"E19","az_deg":230,"el_deg":70},{"id":"E24","az_deg":290,"el_deg":10}],
+    "ism":{"GPS":{"psat":1e-2,"pconst":1e-2},"Galileo":{"psat":1e-2,"pconst":1e-2}},
+    "requirements":{"p_thres":1e-3}})");
+  const RunResult r = run("integrity pl --verbose --geometry " + geo);
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  // THEN no PL, but EMT, sigma_acc and the unmonitored probability are printed
+  EXPECT_FALSE(j["pl_computed"].get<bool>());
+  EXPECT_TRUE(j["vpl_m"].is_null());
+  EXPECT_GT(j["emt_m"].get<double>(), 0.0);
+  EXPECT_GT(j["sigma_acc_m"].get<double>(), 0.0);
+  EXPECT_GT(j["p_not_monitored"].get<double>(), 1e-7);
 }
 
 TEST(Cli, PlWithTooFewSatellitesSaysNotAvailable) {

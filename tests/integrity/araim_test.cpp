@@ -66,7 +66,8 @@ TEST(AraimFaultModes, TenSatellitesTwoConstellationsGive57UnderThe2012Rule) {
 
 TEST(AraimFaultModes, PriorsAreProductsOfEventProbabilities) {
   const std::vector<Constellation> cons(4, Constellation::kGps);
-  const FaultModeSet s = determineFaultModes(cons, std::vector<double>(4, 1e-3), std::vector<double>(kNumConstellations, 0.0), 1e-7);
+  const FaultModeSet s = determineFaultModes(cons, std::vector<double>(4, 1e-3), std::vector<double>(kNumConstellations, 0.0), 1e-7,
+                                             FaultModeRule::kJointEvents);
   ASSERT_EQ(s.n_fault_max, 2);
   const double p_nf = std::pow(1 - 1e-3, 4);
   EXPECT_NEAR(s.modes.front().prior, p_nf * 1e-3 / (1 - 1e-3), 1e-18);
@@ -91,7 +92,9 @@ TEST(AraimPl, ReproducesBlanch2012AppendixJ) {
 }
 
 TEST(AraimPl, ReproducesAddV3AppendixD) {
-  AraimConfig cfg;  // joint rule, P_THRES 8e-8
+  AraimConfig cfg;  // P_THRES 8e-8
+  cfg.rule = FaultModeRule::kJointEvents;
+  cfg.emt_probability = EmtProbability::kEventProduct;
   const AraimResult r = araimProtectionLevels(addExampleGeometry(), ismWith(1e-5, 1e-4), cfg);
   ASSERT_TRUE(r.pl_computed) << r.reason;
   EXPECT_EQ(r.n_fault_max, 1);
@@ -118,6 +121,146 @@ TEST(AraimPl, ReproducesAddV3AppendixD) {
   EXPECT_NEAR(gps_out->sigma_ss[2], 1.5307, 1e-3);
   EXPECT_NEAR(gps_out->bias[2], 2.8935, 1e-3);
   EXPECT_TRUE(r.available);
+}
+
+// GIVEN the Blanch 2012 example (P_sat = P_const = 1e-4, P_THRES = 4e-8)
+// WHEN the modes are selected by the default (reference) rule
+// THEN MAAST for ARAIM's numbers come out with the PL root solved exactly: 65 modes, P_nm
+// 3.019e-8, K_fa,v 5.4188, K_fa,h 6.1678, VPL 20.355 m, EMT 8.295 m, σ_acc 1.4698 m (issue 18),
+// and HPL 61.100 m (17.073 / 58.666 per axis). The horizontal root is MAAST's own
+// determine_subsets_v5 → compute_subset_solutions → compute_test_thresholds run under Octave 7
+// and bisected 80 times on its risk sum; issue 18 printed 61.109 (17.070 / 58.677), which that
+// computation does not give. MAAST itself returns 20.522 / 61.113: the upper ends after 10
+// halvings. The 45 pairs and 10 "constellation + own satellite" (merged into the constellation
+// modes) are added, then 8 of the 10 mixed modes in MAAST's order (GPS satellites 1–5 with
+// Galileo out, then Galileo satellites 1–3 with GPS out).
+TEST(AraimPl, ReproducesMaastOnTheBlanch2012ExampleUnderTheDefaultRule) {
+  AraimConfig cfg;
+  ASSERT_EQ(cfg.rule, FaultModeRule::kAddsUntilThreshold);
+  cfg.requirements.p_thres = 4e-8;
+  cfg.requirements.tol_pl_m = 1e-5;  // the root, to the printed precision
+  const AraimResult r = araimProtectionLevels(addExampleGeometry(), ismWith(1e-4, 1e-4), cfg);
+  ASSERT_TRUE(r.pl_computed) << r.reason;
+  EXPECT_EQ(r.fault_modes, 65);
+  EXPECT_EQ(r.n_fault_max, 2);
+  EXPECT_NEAR(r.p_not_monitored, 3.019e-8, 0.0005e-8);
+  EXPECT_NEAR(r.k_fa_v, 5.4188, 0.5e-4);
+  EXPECT_NEAR(r.k_fa_h, 6.1678, 0.5e-4);
+  EXPECT_NEAR(r.vpl_m, 20.355, 0.5e-3);
+  EXPECT_NEAR(r.hpl_m, 61.100, 0.5e-3);
+  EXPECT_NEAR(r.hpl_axis_m[0], 17.073, 0.5e-3);
+  EXPECT_NEAR(r.hpl_axis_m[1], 58.666, 0.5e-3);
+  EXPECT_LE(r.vpl_m, 20.522);  // never above MAAST's upper end
+  EXPECT_LE(r.hpl_m, 61.113);
+  EXPECT_NEAR(r.emt_m, 8.295, 0.5e-3);
+  EXPECT_NEAR(r.sigma_acc_v_m, 1.4698, 0.5e-4);
+  int mixed = 0;
+  for (const SubsetSolution& m : r.subsets) mixed += m.removed.size() == 6;
+  EXPECT_EQ(mixed, 8);
+  const auto has = [&](std::vector<int> removed) {
+    return std::any_of(r.subsets.begin(), r.subsets.end(), [&](const SubsetSolution& m) { return m.removed == removed; });
+  };
+  EXPECT_TRUE(has({4, 5, 6, 7, 8, 9}));   // GPS 5 + Galileo out: added
+  EXPECT_TRUE(has({0, 1, 2, 3, 4, 7}));   // GPS out + Galileo 8: added
+  EXPECT_FALSE(has({0, 1, 2, 3, 4, 8}));  // GPS out + Galileo 9: P_nm already ≤ P_THRES
+}
+
+TEST(AraimFaultModes, TheDefaultRuleLeavesAtMostPThresUnmonitoredAndAccountsForEveryFault) {
+  // GIVEN satellite counts 6 … 24 in two or three constellations and ISMs from the ADD's ranges
+  std::mt19937 rng(18);
+  std::uniform_int_distribution<int> count(3, 9), n_const(2, 3);
+  std::uniform_real_distribution<double> log_p(-6.0, -3.5), log_thres(-8.5, -7.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<Constellation> cons;
+    std::vector<double> psat;
+    const int nc = n_const(rng);
+    for (int c = 0; c < nc; ++c) {
+      for (int k = count(rng); k > 0; --k) {
+        cons.push_back(kAllConstellations[static_cast<std::size_t>(c)]);
+        psat.push_back(std::pow(10.0, log_p(rng)));
+      }
+    }
+    std::vector<double> pconst(kNumConstellations);
+    for (double& p : pconst) p = std::pow(10.0, log_p(rng) - 1.0);
+    FaultModeOptions o;
+    o.p_thres = std::pow(10.0, log_thres(rng));
+    o.fc_thres = trial % 2 ? 0.01 : 0.0;
+    // WHEN the default rule selects the modes
+    const FaultModeSet s = determineFaultModes(cons, psat, pconst, o);
+    // THEN at most P_THRES is left unmonitored
+    EXPECT_LE(s.p_not_monitored, o.p_thres) << "trial " << trial;
+    // AND the monitored priors plus the unmonitored probability are P(any fault)
+    double log_nf = 0, monitored = 0;
+    for (double p : psat) log_nf += std::log1p(-p);
+    for (int c = 0; c < nc; ++c) log_nf += std::log1p(-pconst[static_cast<std::size_t>(c)]);
+    for (const FaultMode& m : s.modes) monitored += m.prior;
+    EXPECT_NEAR(monitored + s.p_not_monitored, -std::expm1(log_nf), 1e-15) << "trial " << trial;
+  }
+}
+
+TEST(AraimFaultModes, ConsolidationFoldsWeakModesOfAConstellationIntoIt) {
+  // GIVEN the Blanch 2012 example's events and MAAST's LPV-200 consolidation threshold 0.01
+  std::vector<Constellation> cons(10, Constellation::kGps);
+  for (int i = 5; i < 10; ++i) cons[static_cast<std::size_t>(i)] = Constellation::kGalileo;
+  FaultModeOptions o;
+  o.p_thres = 4e-8;
+  const FaultModeSet plain = determineFaultModes(cons, std::vector<double>(10, 1e-4), std::vector<double>(kNumConstellations, 1e-4), o);
+  o.fc_thres = 0.01;
+  const FaultModeSet fc = determineFaultModes(cons, std::vector<double>(10, 1e-4), std::vector<double>(kNumConstellations, 1e-4), o);
+  // THEN the 2 × 10 pairs inside one constellation (prior 1e-8 < 0.01 × 1e-4) go into the two
+  // constellation modes, whose priors grow by 10 pairs + 5 "constellation + own satellite" each,
+  // and P_nm is unchanged (only monitored priors moved); the 25 cross pairs and 8 mixed modes stay.
+  EXPECT_EQ(plain.modes.size(), 65u);
+  EXPECT_EQ(fc.modes.size(), 45u);
+  EXPECT_NEAR(fc.p_not_monitored, plain.p_not_monitored, 1e-18);
+  const auto gps_out = [](const FaultModeSet& s) {
+    return std::find_if(s.modes.begin(), s.modes.end(), [](const FaultMode& m) { return m.removed == std::vector<int>{0, 1, 2, 3, 4}; })->prior;
+  };
+  const double pair = std::pow(1e-4 / (1 - 1e-4), 2) * std::pow(1 - 1e-4, 12);
+  EXPECT_NEAR(gps_out(fc) - gps_out(plain), 10 * pair, 1e-19);
+}
+
+TEST(AraimPl, EmtComparesTheModesOwnPriorWithPEmtByDefault) {
+  // GIVEN P_sat = P_EMT = 1e-5, P_const 1e-8 (GPS) and 1e-4 (Galileo)
+  ErrorModel m = ismWith(1e-5, 1e-8);
+  m.of(Constellation::kGalileo).pconst = 1e-4;
+  AraimConfig by_prior_cfg, by_rate_cfg;
+  by_rate_cfg.emt_probability = EmtProbability::kEventProduct;
+  const auto max_threshold = [](const AraimResult& r) {
+    double t = 0;
+    for (const SubsetSolution& s : r.subsets) t = std::max(t, s.threshold[2]);
+    return t;
+  };
+  // WHEN GPS + Galileo: THEN by default only the Galileo-out mode (prior ≈ 1e-4) counts; a
+  // single-satellite mode's prior 1e-5·∏(1 − p) is below P_EMT
+  const AraimResult two = araimProtectionLevels(addExampleGeometry(), m, by_prior_cfg);
+  ASSERT_TRUE(two.pl_computed) << two.reason;
+  const auto gal_out = std::find_if(two.subsets.begin(), two.subsets.end(),
+                                    [](const SubsetSolution& s) { return s.removed == std::vector<int>{5, 6, 7, 8, 9}; });
+  ASSERT_NE(gal_out, two.subsets.end());
+  EXPECT_DOUBLE_EQ(two.emt_m, gal_out->threshold[2]);
+  // WHEN GPS alone: THEN no mode reaches P_EMT by its prior (EMT 0, as MAAST's eps), while the
+  // event-product convention takes the largest single-satellite threshold
+  Geometry gps = addExampleGeometry();
+  for (int k = 0; k < 5; ++k) gps = gps.without(gps.numSats() - 1);
+  const AraimResult p = araimProtectionLevels(gps, m, by_prior_cfg), r = araimProtectionLevels(gps, m, by_rate_cfg);
+  ASSERT_TRUE(p.pl_computed && r.pl_computed);
+  EXPECT_EQ(p.emt_m, 0.0);
+  EXPECT_GT(r.emt_m, 0.0);
+  EXPECT_DOUBLE_EQ(r.emt_m, max_threshold(r));
+}
+
+TEST(AraimPl, EmtAndSigmaAccAreGivenWhenThePlIsNot) {
+  // GIVEN priors so large that the unmonitored probability exceeds the whole budget
+  AraimConfig cfg;
+  cfg.requirements.p_thres = 1e-3;
+  const AraimResult r = araimProtectionLevels(addExampleGeometry(), ismWith(1e-2, 1e-2), cfg);
+  // THEN no PL, but the all-in-view σ_acc and the EMT are there (MAAST reports them too)
+  EXPECT_FALSE(r.pl_computed);
+  EXPECT_NE(r.reason.find("exceeds the integrity budget"), std::string::npos) << r.reason;
+  ASSERT_TRUE(r.accuracy_computed);
+  EXPECT_NEAR(r.sigma_acc_v_m, 1.4698, 0.5e-4);
+  EXPECT_GT(r.emt_m, 0.0);
 }
 
 /// GPS + Galileo geometries from the shared almanacs at random places and times.

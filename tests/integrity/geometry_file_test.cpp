@@ -21,6 +21,18 @@ TEST(GeometryFile, DefaultsApplyWhenOnlySatellitesAreGiven) {
   EXPECT_DOUBLE_EQ(in.requirements.phmi_vert, 9.8e-8);
   EXPECT_DOUBLE_EQ(in.requirements.val_m, 35.0);
   EXPECT_EQ(in.model.user_model[0], UserErrorModel::kDualFrequency);
+  // ARAIM: the reference rule (MAAST for ARAIM), no consolidation, the mode's own prior for the EMT.
+  EXPECT_EQ(in.araim.rule, FaultModeRule::kAddsUntilThreshold);
+  EXPECT_EQ(in.araim.fc_thres, 0.0);
+  EXPECT_EQ(in.araim.emt_probability, EmtProbability::kModePrior);
+}
+
+TEST(GeometryFile, AraimRuleConsolidationAndEmtConventionAreRead) {
+  const GeometryInput in = parseGeometry(json::parse(R"({"satellites":[],
+      "araim":{"fault_mode_rule":"joint_events","fc_thres":0.01,"emt_probability":"event_product"}})"), "g.json");
+  EXPECT_EQ(in.araim.rule, FaultModeRule::kJointEvents);
+  EXPECT_DOUBLE_EQ(in.araim.fc_thres, 0.01);
+  EXPECT_EQ(in.araim.emt_probability, EmtProbability::kEventProduct);
 }
 
 TEST(GeometryFile, OverridesArePerConstellation) {
@@ -53,6 +65,10 @@ TEST(GeometryFile, ErrorsNameTheFieldTheValueAndWhatWasExpected) {
       {R"({"satellites":[],"requirements":{"phmi_vert":2}})", "field 'requirements.phmi_vert': got '2', expected a probability"},
       {R"({"satellites":[],"user_error_model":"triple"})", "field 'user_error_model'"},
       {R"({"satellites":[],"sattelites":[]})", "field 'sattelites': got '(unknown field)'"},
+      {R"({"satellites":[],"araim":{"fault_mode_rule":"all"}})",
+       "field 'araim.fault_mode_rule': got '\"all\"', expected \"adds_until_threshold\", \"joint_events\" or \"blanch2012\""},
+      {R"({"satellites":[],"araim":{"fc_thres":1}})", "field 'araim.fc_thres': got '1', expected a fraction in [0, 1)"},
+      {R"({"satellites":[],"araim":{"emt_probability":"rate"}})", "field 'araim.emt_probability': got '\"rate\"'"},
   };
   for (const auto& c : cases) {
     const std::string msg = test::messageOf<ParseError>([&] { (void)parseGeometry(json::parse(c.doc), "g.json"); });

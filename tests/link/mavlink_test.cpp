@@ -153,6 +153,7 @@ TEST(MavlinkWire, GarbageTruncationBadChecksumsAndUnknownIdsAreCountedAndSkipped
   std::vector<std::uint8_t> stream;
   auto add = [&stream](const std::vector<std::uint8_t>& b) { stream.insert(stream.end(), b.begin(), b.end()); };
   const std::vector<json>& node = encodedByNode();
+  ASSERT_GT(node.size(), 8u) << "node-mavlink's frames are missing (run `npm ci --prefix tests/link/js`)";
   add({0x00, 0x13, 0xFD, 0x01});                     // garbage, with a start byte inside
   add(fromHex(node[1].at("hex")));                   // GLOBAL_POSITION_INT
   std::vector<std::uint8_t> corrupt = fromHex(node[2].at("hex"));

@@ -121,16 +121,23 @@ TEST(TrackStore, ADamagedPageInTheMiddleIsFoundBeforeTheDatabaseIsUsed) {
   EXPECT_NE(msg.find("expected an undamaged skylane tracker database"), std::string::npos) << msg;
 }
 
-TEST(TrackStore, AMissingTableOrAnotherProgramsDatabaseIsRefusedNotRecreated) {
+TEST(TrackStore, AMissingTableIsRefusedNotRecreated) {
   const std::string path = filledDatabase("dropped.sqlite", 3);
   runSql(path, "DROP TABLE events");
   EXPECT_EQ(test::messageOf<maps::ParseError>([&] { TrackStore s(path); }),
             path + ": field '(tracker database) table events': got 'missing', expected a skylane tracker database, whose "
                    "table events has the columns seq, flight, time, type, json");
-  const std::string other = test::scratchPath("other_program.sqlite");
-  std::filesystem::remove(other);
-  runSql(other, "CREATE TABLE photos (id INTEGER, jpeg BLOB)");
-  EXPECT_NE(test::messageOf<maps::ParseError>([&] { TrackStore s(other); }).find("table flights': got 'missing'"),
+  // A file with other tables and none of the tracker's (the service keeps its own tables in the
+  // same file) gets the tracker's beside them.
+  const std::string shared = test::scratchPath("shared.sqlite");
+  std::filesystem::remove(shared);
+  runSql(shared, "CREATE TABLE approvals (id TEXT)");
+  EXPECT_TRUE(TrackStore(shared).flights().empty());
+  // One of the tracker's tables without the others is a damaged tracker database.
+  const std::string partial = test::scratchPath("partial.sqlite");
+  std::filesystem::remove(partial);
+  runSql(partial, "CREATE TABLE inputs (name TEXT PRIMARY KEY, line INTEGER NOT NULL)");
+  EXPECT_NE(test::messageOf<maps::ParseError>([&] { TrackStore s(partial); }).find("table flights': got 'missing'"),
             std::string::npos);
 }
 
