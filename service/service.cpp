@@ -1,5 +1,6 @@
 #include "service/service.hpp"
 
+#include "maps/atomic_file.hpp"
 #include "maps/text_file.hpp"
 #include "service/service_impl.hpp"
 
@@ -69,16 +70,9 @@ HttpResponse jsonBody(int status, const nlohmann::json& j) {
 }
 
 void writeFileAtomically(const fs::path& p, const std::string& text) {
-  const fs::path tmp = p.string() + ".tmp";
-  FILE* f = std::fopen(tmp.c_str(), "wb");
-  bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size() && std::fflush(f) == 0 && fsync(fileno(f)) == 0;
-  if (f) ok = std::fclose(f) == 0 && ok;
-  std::error_code ec;
-  if (ok) fs::rename(tmp, p, ec);
-  if (!ok || ec) {
-    fs::remove(tmp, ec);
-    throw std::runtime_error("cannot write " + p.filename().string() + " (" + (ec ? ec.message() : std::strerror(errno)) + ")");
-  }
+  maps::AtomicFile f(p.string(), "the service folder");
+  f.stream() << text;
+  f.commit();
 }
 
 HttpResponse fileResponse(const fs::path& p, const std::string& content_type) {

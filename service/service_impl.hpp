@@ -131,7 +131,7 @@ class ServiceImpl {
 /// \brief A JSON value as a 200/201 body.
 [[nodiscard]] HttpResponse jsonBody(int status, const nlohmann::json& j);
 /// \brief Writes a file whole or not at all: a temporary name in the same folder, flushed to
-/// disk, then renamed. \throws std::runtime_error naming the file.
+/// disk, then renamed (maps/atomic_file.hpp). \throws maps::OutputError naming the file.
 void writeFileAtomically(const std::filesystem::path& p, const std::string& text);
 /// \brief The OpenAPI 3 document of the API (service/openapi.json, built in).
 [[nodiscard]] const std::string& openApiDocument();
