@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <fstream>
 #include <thread>
@@ -543,6 +544,47 @@ TEST(ServiceStart, ADamagedDatabaseOrTokensFileIsAClearErrorExit2) {
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("$.tokens[0].sha256"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("64 lower-case hex"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace skylane
+
+namespace skylane {
+namespace {
+
+TEST_F(ServiceUdpInput, AMavlinkLinkFromAnIndependentVehicleFeedsItsFlight) {
+  // GIVEN a tracked flight, and the service restarted with a MAVLink input for it on a UDP port
+  const std::string zs = publishZones();
+  const std::string ap = approve(TestTokens::kAcme, zs);
+  const std::string fl = startFlight(TestTokens::kAcme, ap);
+  ASSERT_EQ(server_->kill(SIGTERM), 0);
+  const int port = freeUdpPort();
+  server_->start({"--input", "mavlink:udp://127.0.0.1:" + std::to_string(port) + "#" + fl});
+  client_ = std::make_unique<HttpClient>(server_->port());
+  // WHEN a vehicle written on node-mavlink flies the approved route for 30 s at 5 Hz (150
+  // GPS_RAW_INT frames, h_acc 150 mm, v_acc 200 mm) with junk bytes and a corrupted frame
+  const std::string report = dir_ + "/service.sqlite.files/approvals/" + ap + "/report.json";
+  const test::CommandResult v = test::runCommand("node " + std::string(SKYLANE_TEST_DATA) + "/../link/js/vehicle.mjs --report " + report +
+                                                 " --port " + std::to_string(port) + " --seconds 30 --garbage 2>&1 || echo vehicle-failed");
+  ASSERT_EQ(v.out.find("vehicle-failed"), std::string::npos) << v.out;
+  json st;
+  for (int i = 0; i < 100; ++i) {
+    st = json::parse(call("GET", "/v1/flights/" + fl, TestTokens::kAcme).body);
+    if (st["state"]["fixes"] >= 150) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  // THEN every good frame is a fix of that flight, inside its corridor, with the PLs of the
+  // documented accuracy rule, and the bad bytes are rejected inputs naming the flight
+  EXPECT_EQ(st["state"]["fixes"], 150) << st.dump();
+  ASSERT_TRUE(st.contains("last_fix")) << st.dump();
+  EXPECT_EQ(st["last_fix"]["pl_source"], "mavlink_accuracy");
+  EXPECT_EQ(st["last_fix"]["verdict"], "inside") << st["last_fix"].dump();
+  EXPECT_NEAR(st["last_fix"]["hpl_m"].get<double>(), std::sqrt(-2.0 * std::log(2e-9)) * 0.15, 2e-3);
+  HttpClient log(server_->port());
+  log.openStream("/v1/flights/" + fl + "/events", {auth(TestTokens::kAcme), "Last-Event-ID: 0"});
+  log.readFor(500);
+  EXPECT_NE(log.streamed().find("event: rejected_input"), std::string::npos);
+  EXPECT_NE(log.streamed().find("bad checksum"), std::string::npos);
 }
 
 }  // namespace
