@@ -119,8 +119,11 @@ HttpResponse ServiceImpl::submitApproval(const HttpRequest& r, const Principal& 
   if (auto bad = requireContentType(r, {"application/json"})) return *bad;
   const std::string id = newId("ap-");
   const fs::path dir = files / "approvals" / id;
+  std::string name;
   try {
-    const json mission = resolveMission(maps::parseJsonText(r.body, "the request body"), who);
+    const json body = maps::parseJsonText(r.body, "the request body");
+    const json mission = resolveMission(body, who);
+    name = mission.value("name", json()).is_string() ? mission["name"].get<std::string>() : std::string();
     fs::create_directories(dir);
     writeFileAtomically(dir / "mission.json", mission.dump(1) + "\n");
     (void)planner::loadMission((dir / "mission.json").string());  // what approve will read, checked now
@@ -132,8 +135,7 @@ HttpResponse ServiceImpl::submitApproval(const HttpRequest& r, const Principal& 
     return errorResponse(400, withoutFolder(e.what(), dir / "mission.json", "the mission"));
   }
   ApprovalState a;
-  a.row = {id, who.owner(), r.body.size() < (1 << 20) ? json::parse(r.body).value("name", std::string()) : std::string(),
-           "queued", nowUtc(), "approvals/" + id, "", ""};
+  a.row = {id, who.owner(), name, "queued", nowUtc(), "approvals/" + id, "", ""};
   a.submitted = std::chrono::steady_clock::now();
   if (!pool->submit({id, (dir / "mission.json").string(), dir.string()})) {
     ++metrics.approvals_refused_queue_full;

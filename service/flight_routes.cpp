@@ -25,7 +25,7 @@ HttpResponse ServiceImpl::flightsRoute(const HttpRequest& r, const Principal& wh
     if (r.method != "GET") return methodNotAllowed("GET, POST");
     json list = json::array();
     for (const auto& [id, f] : flights) {
-      if (f.owner == who.owner()) list.push_back(json::parse(flightJson(f).body));
+      if (f.owner == who.owner()) list.push_back(flightObject(f));
     }
     return jsonBody(200, {{"flights", list}});
   }
@@ -77,12 +77,14 @@ HttpResponse ServiceImpl::startFlight(const HttpRequest& r, const Principal& who
   return res;
 }
 
-HttpResponse ServiceImpl::flightJson(const FlightRow& f) const {
+nlohmann::json ServiceImpl::flightObject(const FlightRow& f) const {
   const planner::FlightState& st = session->tracker().state(f.id);
   nlohmann::json j = {{"id", f.id}, {"approval", f.approval}, {"created", f.created}, {"state", planner::flightStateJson(st)}};
   if (const auto it = last_fix.find(f.id); it != last_fix.end()) j["last_fix"] = nlohmann::json::parse(it->second);
-  return jsonBody(200, j);
+  return j;
 }
+
+HttpResponse ServiceImpl::flightJson(const FlightRow& f) const { return jsonBody(200, flightObject(f)); }
 
 HttpResponse ServiceImpl::postFixes(const HttpRequest& r, const FlightRow& f) {
   if (auto bad = requireContentType(r, {"application/x-ndjson", "application/jsonl", "application/json"})) return *bad;
@@ -122,11 +124,15 @@ HttpResponse ServiceImpl::postFixes(const HttpRequest& r, const FlightRow& f) {
   }
   session->commit();
   metrics.fix_request_seconds.observe(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  json events = json::array();
+  // The events as the engine wrote them (each a JSON object on one line), not parsed again.
+  std::string body = "{\"accepted\":" + std::to_string(accepted) + ",\"rejected\":" + std::to_string(rejected) + ",\"events\":[";
+  bool first = true;
   for (const HubEvent& e : mine) {
-    if (e.flight == f.id) events.push_back(json::parse(e.line));
+    if (e.flight != f.id) continue;
+    body += (first ? "" : ",") + e.line;
+    first = false;
   }
-  return jsonBody(200, {{"accepted", accepted}, {"rejected", rejected}, {"events", events}});
+  return jsonResponse(200, body + "]}\n");
 }
 
 HttpResponse ServiceImpl::eventStream(const HttpRequest& r, const Principal& who, const std::string& flight) {

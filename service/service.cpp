@@ -185,7 +185,7 @@ void ServiceImpl::restore() {
     if (st.row.status == "queued" || st.row.status == "running") queueApproval(st);
   }
   for (FlightRow& f : store->flights()) flights[f.id] = std::move(f);
-  last_fix = store->lastFixes();
+  last_fix = session->store()->lastEventOfEachFlight("fix");
   session->resumeFlights();
   log("serving " + std::to_string(zonesets.size()) + " zone sets, " + std::to_string(approvals.size()) + " approvals, " +
       std::to_string(flights.size()) + " flights from " + options.db);

@@ -115,6 +115,7 @@ class ServiceImpl {
   HttpResponse startFlight(const HttpRequest& r, const Principal& who);
   HttpResponse postFixes(const HttpRequest& r, const FlightRow& f);
   HttpResponse flightJson(const FlightRow& f) const;
+  [[nodiscard]] nlohmann::json flightObject(const FlightRow& f) const;
   HttpResponse eventStream(const HttpRequest& r, const Principal& who, const std::string& flight);
   [[nodiscard]] bool owns(const Principal& who, const std::string& flight) const;
 };

@@ -148,17 +148,3 @@ std::vector<FlightRow> ServiceStore::flights() const {
 }
 
 }  // namespace skylane::service
-
-namespace skylane::service {
-
-std::map<std::string, std::string> ServiceStore::lastFixes() const {
-  const auto failure = [this](const std::string& w) { fail(w); };
-  std::map<std::string, std::string> out;
-  // The tracker's table (track_store.hpp), created by it before the service reads it.
-  Statement st(db_, "SELECT flight, json FROM events WHERE seq IN (SELECT MAX(seq) FROM events WHERE type = 'fix' GROUP BY flight)",
-               failure);
-  while (st.row()) out[st.col(0)] = st.col(1);
-  return out;
-}
-
-}  // namespace skylane::service

@@ -60,8 +60,6 @@ class ServiceStore {
 
   void addFlight(const FlightRow& f);
   [[nodiscard]] std::vector<FlightRow> flights() const;
-  /// \brief Each flight's last `fix` event in the tracker's event log (flight → JSON line).
-  [[nodiscard]] std::map<std::string, std::string> lastFixes() const;
 
  private:
   void exec(const std::string& sql) const;

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <stdexcept>
 #include <system_error>
 
@@ -243,6 +244,18 @@ std::vector<TrackStore::LoggedEvent> TrackStore::eventsAfter(std::int64_t after,
   while (sqlite3_step(st.s) == SQLITE_ROW) {
     out.push_back({sqlite3_column_int64(st.s, 0), columnText(st.s, 1), columnText(st.s, 2), columnText(st.s, 3)});
   }
+  return out;
+}
+
+std::map<std::string, std::string> TrackStore::lastEventOfEachFlight(const std::string& type) const {
+  std::map<std::string, std::string> out;
+  Statement st;
+  if (sqlite3_prepare_v2(db_, "SELECT flight, json FROM events WHERE seq IN (SELECT MAX(seq) FROM events WHERE type = ? GROUP BY flight)",
+                         -1, &st.s, nullptr) != SQLITE_OK) {
+    fail("cannot read events");
+  }
+  bindText(st.s, 1, type);
+  while (sqlite3_step(st.s) == SQLITE_ROW) out[columnText(st.s, 0)] = columnText(st.s, 1);
   return out;
 }
 

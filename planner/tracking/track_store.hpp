@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -65,6 +66,8 @@ class TrackStore final : public EventSink {
   };
   /// \brief Up to `limit` events after sequence number `after`, in order (a resumed event stream).
   [[nodiscard]] std::vector<LoggedEvent> eventsAfter(std::int64_t after, std::size_t limit) const;
+  /// \brief Each flight's last event of `type` (flight → its JSON line).
+  [[nodiscard]] std::map<std::string, std::string> lastEventOfEachFlight(const std::string& type) const;
   /// \brief The sequence number of the event appended last on this connection (0: none yet).
   [[nodiscard]] std::int64_t lastEventSeq() const;
 
