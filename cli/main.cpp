@@ -9,6 +9,7 @@
 #include "cli/simulate_commands.hpp"
 #include "cli/skymask_commands.hpp"
 #include "cli/track_commands.hpp"
+#include "cli/worker_commands.hpp"
 #include "cli/zones_commands.hpp"
 #include "integrity/gnss/parse_error.hpp"
 #include "maps/atomic_file.hpp"
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
   skylane::cli::addTrackCommands(app);
   skylane::cli::addPlanCommands(app);
   skylane::cli::addServeCommands(app);
+  skylane::cli::addWorkerCommands(app);
   skylane::maps::watchStandardOutput();
   try {
     app.parse(argc, argv);

@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(g++ cmake make ccache pkg-config universal-ctags python3
   libeigen3-dev libgeographiclib-dev libcli11-dev nlohmann-json3-dev libboost-dev
   libcgal-dev libgmp-dev libmpfr-dev libfcl-dev libgdal-dev proj-data
-  libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev libode-dev libssl-dev libsqlite3-dev
+  nats-server libnats-dev libompl-dev libboost-filesystem-dev libboost-serialization-dev libboost-system-dev libode-dev libssl-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3-gps
   chromium)  # headless, for the web map's browser test (tests/web/map_test.mjs)
 

@@ -1,0 +1,365 @@
+#include "service/track_worker.hpp"
+
+#include "maps/json_node.hpp"
+#include "maps/parse_error.hpp"
+#include "planner/tracking/flight_state.hpp"
+#include "planner/tracking/track_event.hpp"
+#include "service/approval_bundle.hpp"
+#include "service/nats_layout.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <thread>
+
+namespace skylane::service {
+
+namespace {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
+
+/// A flight of a held partition: who it belongs to and how far its checkpoint goes.
+struct FlightSlot {
+  std::string op, flight, approval;  ///< approval empty: not started
+  std::uint64_t covered_seq = 0;     ///< the last fix sequence its checkpoint covers
+  int checkpointed_route = 0;        ///< the route version last put with it
+  bool dirty = false;
+};
+
+/// A partition the worker may hold.
+struct Partition {
+  int index = 0;
+  bool held = false;
+  std::uint64_t lease_rev = 0, checkpoint_rev = 0, covered_seq = 0;
+  std::unique_ptr<NatsPull> pull;
+  std::unique_ptr<planner::Tracker> tracker;
+  std::map<std::string, FlightSlot> flights;  ///< by tracker id "<operator>.<flight>"
+};
+
+/// An event to publish.
+struct Outgoing {
+  std::string subject, data, msg_id;
+};
+
+/// A message that cannot be judged: why, for its rejected_input event.
+struct Rejected {
+  std::string why;
+};
+
+class Worker {
+ public:
+  Worker(const TrackWorkerOptions& o, TrackWorkerCounters& c) : o_(o), c_(c), nats_(o.url, o.name) {}
+  void run(const std::atomic<bool>& stop);
+
+ private:
+  void log(const std::string& s) const {
+    if (o_.log) o_.log(s);
+  }
+  void choosePartitions();
+  void refreshLeases();
+  bool acquire(Partition& p);
+  void drop(Partition& p, const std::string& why);
+  bool runBatch(Partition& p, std::chrono::milliseconds wait);
+  void judge(Partition& p, const NatsMessage& m, std::vector<Outgoing>& out);
+  void judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, const json& body, std::vector<Outgoing>& out);
+  void startFlight(Partition& p, FlightSlot& slot, const json& body);
+  FlightSlot& slotOf(Partition& p, const std::string& op, const std::string& flight);
+  void loadApproval(Partition& p, const FlightSlot& slot, const std::string& id);
+  void sweepStale(Partition& p, std::uint64_t last_seq, std::vector<Outgoing>& out);
+  void commit(Partition& p, std::vector<Outgoing>& out, std::uint64_t last_seq);
+  void reject(const NatsMessage& m, const std::string& subject, const std::string& why, std::vector<Outgoing>& out);
+  void report(Clock::time_point& last) const;
+
+  const TrackWorkerOptions& o_;
+  TrackWorkerCounters& c_;
+  NatsClient nats_;
+  std::vector<Partition> parts_;
+};
+
+std::string leaseKey(int k) { return "p" + std::to_string(k); }
+
+void Worker::choosePartitions() {
+  const int count = nats::partitionCount(nats_);
+  std::vector<int> want = o_.partitions;
+  if (want.empty()) {
+    for (int k = 0; k < count; ++k) want.push_back(k);
+  }
+  for (int k : want) {
+    if (k < 0 || k >= count) {
+      throw std::invalid_argument("--partitions: partition " + std::to_string(k) + " is outside 0.." + std::to_string(count - 1) +
+                                  " (the count recorded in NATS)");
+    }
+    Partition p;
+    p.index = k;
+    parts_.push_back(std::move(p));
+  }
+}
+
+bool Worker::acquire(Partition& p) {
+  std::optional<std::uint64_t> rev;
+  if (p.lease_rev != 0) rev = nats_.update(nats::kLeaseBucket, leaseKey(p.index), o_.name, p.lease_rev);
+  if (!rev) rev = nats_.create(nats::kLeaseBucket, leaseKey(p.index), o_.name);
+  if (!rev) return false;
+  p.lease_rev = *rev;
+  const auto cp = nats_.get(nats::kPartitionBucket, leaseKey(p.index));
+  p.checkpoint_rev = cp ? cp->revision : 0;
+  p.covered_seq = cp ? json::parse(cp->value).at("seq").get<std::uint64_t>() : 0;
+  p.tracker = std::make_unique<planner::Tracker>(o_.tracker);
+  p.flights.clear();
+  p.pull = nats_.pullFrom(nats::kFixStream, "track-" + leaseKey(p.index), nats::partitionFilter(p.index), p.covered_seq + 1);
+  p.held = true;
+  ++c_.partitions_held;
+  log("holds partition " + std::to_string(p.index) + " from fix sequence " + std::to_string(p.covered_seq + 1));
+  return true;
+}
+
+void Worker::drop(Partition& p, const std::string& why) {
+  if (!p.held) return;
+  log("lets go of partition " + std::to_string(p.index) + ": " + why);
+  p.pull.reset();
+  p.tracker.reset();
+  p.flights.clear();
+  p.held = false;
+  --c_.partitions_held;
+}
+
+void Worker::refreshLeases() {
+  for (Partition& p : parts_) {
+    try {
+      if (!p.held) {
+        (void)acquire(p);
+      } else if (const auto rev = nats_.update(nats::kLeaseBucket, leaseKey(p.index), o_.name, p.lease_rev)) {
+        p.lease_rev = *rev;
+      } else {
+        p.lease_rev = 0;
+        drop(p, "its lease was taken");
+      }
+    } catch (const NatsError& e) {
+      drop(p, e.what());
+    }
+  }
+}
+
+FlightSlot& Worker::slotOf(Partition& p, const std::string& op, const std::string& flight) {
+  const std::string id = op + "." + flight;
+  if (const auto it = p.flights.find(id); it != p.flights.end()) return it->second;
+  FlightSlot slot{op, flight, {}, 0, 0, false};
+  if (const auto cp = nats_.get(nats::kFlightBucket, id)) {
+    const json j = json::parse(cp->value);
+    slot.approval = j.at("approval").get<std::string>();
+    slot.covered_seq = j.at("seq").get<std::uint64_t>();
+    loadApproval(p, slot, id);
+    const planner::FlightState st = planner::parseFlightState(j.at("state"), "NATS checkpoint of flight " + id);
+    json route;
+    if (st.route_version > 0) {
+      const auto r = nats_.get(nats::kFlightBucket, id + ".route");
+      if (r) route = json::parse(r->value);
+    }
+    p.tracker->restore(id, st, route);
+    slot.checkpointed_route = st.route_version;
+  }
+  return p.flights.emplace(id, std::move(slot)).first->second;
+}
+
+/// The approval's bundle, unpacked once per worker into the cache, registered under `id`.
+void Worker::loadApproval(Partition& p, const FlightSlot& slot, const std::string& id) {
+  const fs::path dir = fs::path(o_.cache_dir) / slot.op / slot.approval;
+  if (!fs::exists(dir / "report.json")) {
+    const std::string key = slot.op + "." + slot.approval + ".bundle";
+    const auto b = nats_.get(nats::kApprovalBucket, key);
+    if (!b) throw Rejected{"operator " + slot.op + " has no approval \"" + slot.approval + "\" with a report"};
+    unpackBundle(parseBundle(b->value, "approval bundle " + key), dir);
+  }
+  try {
+    (void)p.tracker->addApprovalFile((dir / "report.json").string(), id);
+  } catch (const std::exception& e) {
+    throw Rejected{std::string("approval \"") + slot.approval + "\": " + e.what()};
+  }
+}
+
+void Worker::startFlight(Partition& p, FlightSlot& slot, const json& body) {
+  if (!slot.approval.empty()) throw Rejected{"flight " + slot.flight + " was started already (approval " + slot.approval + ")"};
+  const json& s = body.at("start");
+  if (!s.is_object() || !s.contains("approval") || !s["approval"].is_string() || !nats::validId(s["approval"].get<std::string>())) {
+    throw Rejected{"$.start: expected {\"approval\": ID} with the id of an approval of this operator"};
+  }
+  slot.approval = s["approval"].get<std::string>();
+  try {
+    loadApproval(p, slot, slot.op + "." + slot.flight);
+  } catch (...) {
+    slot.approval.clear();
+    throw;
+  }
+}
+
+void Worker::reject(const NatsMessage& m, const std::string& subject, const std::string& why, std::vector<Outgoing>& out) {
+  json e = planner::rejectedInputEvent(m.subject, 0, why).toJson();
+  // The subject it was published to (skylane.fix.<operator>.<flight>), `source` the partition's.
+  const std::vector<std::string> t = nats::subjectTokens(m.subject);
+  e["subject"] = t.size() == 5 ? nats::fixSubject(t[3], t[4]) : m.subject;
+  e["input_seq"] = m.stream_seq;
+  out.push_back({subject, e.dump(), "fix." + std::to_string(m.stream_seq) + ".r"});
+  ++c_.rejected;
+}
+
+void Worker::judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, const json& body, std::vector<Outgoing>& out) {
+  if (slot.approval.empty()) {
+    throw Rejected{"flight " + slot.flight + " of operator " + slot.op + " is not started: its first message is {\"start\": {\"approval\": ID}}"};
+  }
+  planner::TrackFix fix = planner::parseTrackFixJson(body, m.subject);
+  if (!fix.flight.empty() && fix.flight != slot.flight) throw Rejected{"the fix names flight \"" + fix.flight.substr(0, 64) + "\", not " + slot.flight};
+  fix.flight = slot.op + "." + slot.flight;
+  fix.line = 0;
+  const std::vector<json> events = p.tracker->processJson(fix);
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    json e = events[i];
+    e["flight"] = slot.flight;
+    e["operator"] = slot.op;
+    e["input_seq"] = m.stream_seq;
+    out.push_back({nats::eventSubject(slot.op, slot.flight), e.dump(), "fix." + std::to_string(m.stream_seq) + "." + std::to_string(i)});
+  }
+  ++c_.fixes;
+}
+
+void Worker::judge(Partition& p, const NatsMessage& m, std::vector<Outgoing>& out) {
+  const std::vector<std::string> t = nats::subjectTokens(m.subject);
+  if (t.size() != 5 || !nats::validId(t[3]) || !nats::validId(t[4])) {
+    reject(m, nats::kRejectedSubject, "the subject names no operator and flight (skylane.fix.<operator>.<flight>, ids of A-Z a-z 0-9 - _)", out);
+    return;
+  }
+  const std::string subject = nats::eventSubject(t[3], t[4]);
+  try {
+    FlightSlot& slot = slotOf(p, t[3], t[4]);
+    if (m.stream_seq <= slot.covered_seq) {
+      ++c_.skipped;
+      return;
+    }
+    slot.covered_seq = m.stream_seq;
+    slot.dirty = true;
+    const json body = maps::parseJsonLine(m.data, m.subject);
+    if (body.is_object() && body.contains("start")) {
+      startFlight(p, slot, body);
+      out.push_back({subject, json{{"event", "flight_started"}, {"flight", slot.flight}, {"operator", slot.op}, {"approval", slot.approval},
+                                   {"input_seq", m.stream_seq}}.dump(), "fix." + std::to_string(m.stream_seq) + ".0"});
+    } else {
+      judgeFix(p, slot, m, body, out);
+    }
+  } catch (const Rejected& r) {
+    reject(m, subject, r.why, out);
+  } catch (const maps::ParseError& e) {
+    reject(m, subject, e.what(), out);
+  }
+}
+
+void Worker::sweepStale(Partition& p, std::uint64_t last_seq, std::vector<Outgoing>& out) {
+  const auto now = p.tracker->streamTime();
+  if (!now) return;
+  for (const planner::TrackEvent& e : p.tracker->sweepStale(*now)) {
+    const auto it = p.flights.find(e.flight);
+    if (it == p.flights.end()) continue;
+    json j = e.toJson();
+    j["flight"] = it->second.flight;
+    j["operator"] = it->second.op;
+    out.push_back({nats::eventSubject(it->second.op, it->second.flight), j.dump(), "stale." + e.flight + "." + std::to_string(last_seq)});
+    it->second.dirty = true;
+  }
+}
+
+/// Events, then the flights' checkpoints, then the partition's (compare-and-set), each step
+/// acknowledged before the next.
+void Worker::commit(Partition& p, std::vector<Outgoing>& out, std::uint64_t last_seq) {
+  // The events first and acknowledged: a checkpoint never covers a fix whose events are not kept.
+  for (const Outgoing& o : out) nats_.publishAsync(o.subject, o.data, o.msg_id);
+  nats_.publishesComplete();
+  c_.events += out.size();
+  for (auto& [id, slot] : p.flights) {
+    if (!slot.dirty) continue;
+    json cp = {{"approval", slot.approval}, {"seq", slot.covered_seq}};
+    if (!slot.approval.empty()) {
+      const planner::FlightState& st = p.tracker->state(id);
+      cp["state"] = planner::flightStateJson(st);
+      if (st.route_version != slot.checkpointed_route) {
+        nats_.putAsync(nats::kFlightBucket, id + ".route", p.tracker->routeJson(id).dump());
+        slot.checkpointed_route = st.route_version;
+      }
+    } else {
+      cp["state"] = planner::flightStateJson(planner::FlightState{});
+    }
+    nats_.putAsync(nats::kFlightBucket, id, cp.dump());
+    slot.dirty = false;
+  }
+  nats_.publishesComplete();
+  const std::string value = json{{"seq", last_seq}, {"worker", o_.name}}.dump();
+  const auto rev = p.checkpoint_rev == 0 ? nats_.create(nats::kPartitionBucket, leaseKey(p.index), value)
+                                         : nats_.update(nats::kPartitionBucket, leaseKey(p.index), value, p.checkpoint_rev);
+  if (!rev) {
+    drop(p, "another worker checkpointed it");
+    return;
+  }
+  p.checkpoint_rev = *rev;
+  p.covered_seq = last_seq;
+}
+
+bool Worker::runBatch(Partition& p, std::chrono::milliseconds wait) {
+  const std::vector<NatsMessage> msgs = p.pull->fetch(o_.batch, wait);
+  if (msgs.empty()) return false;
+  std::vector<Outgoing> out;
+  for (const NatsMessage& m : msgs) judge(p, m, out);
+  sweepStale(p, msgs.back().stream_seq, out);
+  commit(p, out, msgs.back().stream_seq);
+  return true;
+}
+
+void Worker::report(Clock::time_point& last) const {
+  if (Clock::now() - last < std::chrono::seconds(10)) return;
+  last = Clock::now();
+  log(std::to_string(c_.partitions_held.load()) + " partitions held, " + std::to_string(c_.fixes.load()) + " fixes judged, " +
+      std::to_string(c_.events.load()) + " events, " + std::to_string(c_.rejected.load()) + " rejected, " +
+      std::to_string(c_.skipped.load()) + " skipped as judged before");
+}
+
+void Worker::run(const std::atomic<bool>& stop) {
+  choosePartitions();
+  Clock::time_point last_refresh{}, last_report = Clock::now();
+  while (!stop.load()) {
+    if (Clock::now() - last_refresh >= std::chrono::seconds(1)) {
+      refreshLeases();
+      last_refresh = Clock::now();
+    }
+    const int held = c_.partitions_held.load();
+    const auto wait = std::chrono::milliseconds(held > 0 ? std::max(5, 200 / held) : 0);
+    bool busy = false;
+    for (Partition& p : parts_) {
+      if (!p.held) continue;
+      try {
+        busy = runBatch(p, wait) || busy;
+      } catch (const std::exception& e) {  // NATS gone or refused: start the partition again from its checkpoint
+        drop(p, e.what());
+        ++c_.restarts;
+      }
+    }
+    if (held == 0 || (!busy && c_.partitions_held.load() == 0)) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    report(last_report);
+  }
+  for (Partition& p : parts_) {
+    if (!p.held) continue;
+    drop(p, "stopping");
+    try {
+      nats_.erase(nats::kLeaseBucket, leaseKey(p.index));
+    } catch (const NatsError&) {
+    }
+  }
+}
+
+}  // namespace
+
+void runTrackWorker(const TrackWorkerOptions& options, const std::atomic<bool>& stop, TrackWorkerCounters& counters) {
+  Worker w(options, counters);
+  w.run(stop);
+}
+
+}  // namespace skylane::service
