@@ -105,11 +105,27 @@ void handleRequest(const ApproveWorkerOptions& o, NatsClient& nats, const NatsMe
   NatsPull::ack(m);
 }
 
+/// The connection, waiting for a server that is not (yet) there.
+std::unique_ptr<NatsClient> connectWaiting(const ApproveWorkerOptions& o, const std::atomic<bool>& stop) {
+  for (int attempt = 0; !stop.load(); ++attempt) {
+    try {
+      auto nats = std::make_unique<NatsClient>(o.url, o.name);
+      (void)nats::partitionCount(*nats);  // the streams are set up
+      return nats;
+    } catch (const NatsError& e) {
+      if (o.log && attempt % 10 == 0) o.log(std::string("waiting for NATS: ") + e.what());
+      std::this_thread::sleep_for(std::chrono::seconds(1));
+    }
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 void runApproveWorker(const ApproveWorkerOptions& o, const std::atomic<bool>& stop, ApproveWorkerCounters& c) {
-  NatsClient nats(o.url, o.name);
-  (void)nats::partitionCount(nats);  // the streams are set up
+  const std::unique_ptr<NatsClient> client = connectWaiting(o, stop);
+  if (!client) return;
+  NatsClient& nats = *client;
   std::unique_ptr<NatsPull> pull;
   while (!stop.load()) {
     try {

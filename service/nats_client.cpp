@@ -43,6 +43,7 @@ NatsMessage takeMessage(natsMsg* msg) {
   jsMsgMetaData* meta = nullptr;
   if (natsMsg_GetMetaData(&meta, msg) == NATS_OK) {
     m.stream_seq = meta->Sequence.Stream;
+    m.consumer_seq = meta->Sequence.Consumer;
     m.delivered = meta->NumDelivered;
     jsMsgMetaData_Destroy(meta);
   }

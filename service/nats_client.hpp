@@ -48,7 +48,8 @@ struct NatsMessage {
   std::string subject;
   std::string data;
   std::uint64_t stream_seq = 0;
-  std::uint64_t delivered = 0;   ///< 1 at the first delivery
+  std::uint64_t consumer_seq = 0;  ///< the consumer's delivery count (1, 2, … without acknowledgements)
+  std::uint64_t delivered = 0;     ///< 1 at the first delivery
   std::shared_ptr<void> handle;  ///< the client's message (for ack)
 };
 

@@ -35,6 +35,7 @@ struct Partition {
   int index = 0;
   bool held = false;
   std::uint64_t lease_rev = 0, checkpoint_rev = 0, covered_seq = 0;
+  std::uint64_t deliveries = 0;  ///< messages taken from the consumer since it was made
   std::unique_ptr<NatsPull> pull;
   std::unique_ptr<planner::Tracker> tracker;
   std::map<std::string, FlightSlot> flights;  ///< by tracker id "<operator>.<flight>"
@@ -110,6 +111,7 @@ bool Worker::acquire(Partition& p) {
   p.covered_seq = cp ? json::parse(cp->value).at("seq").get<std::uint64_t>() : 0;
   p.tracker = std::make_unique<planner::Tracker>(o_.tracker);
   p.flights.clear();
+  p.deliveries = 0;
   p.pull = nats_.pullFrom(nats::kFixStream, "track-" + leaseKey(p.index), nats::partitionFilter(p.index), p.covered_seq + 1);
   p.held = true;
   ++c_.partitions_held;
@@ -220,6 +222,7 @@ void Worker::judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, cons
     e["flight"] = slot.flight;
     e["operator"] = slot.op;
     e["input_seq"] = m.stream_seq;
+    if (e.value("event", "") == "rejected_input") e["subject"] = nats::fixSubject(slot.op, slot.flight);
     out.push_back({nats::eventSubject(slot.op, slot.flight), e.dump(), "fix." + std::to_string(m.stream_seq) + "." + std::to_string(i)});
   }
   ++c_.fixes;
@@ -307,6 +310,11 @@ void Worker::commit(Partition& p, std::vector<Outgoing>& out, std::uint64_t last
 bool Worker::runBatch(Partition& p, std::chrono::milliseconds wait) {
   const std::vector<NatsMessage> msgs = p.pull->fetch(o_.batch, wait);
   if (msgs.empty()) return false;
+  // Without acknowledgements a delivery lost with a connection is not sent again: a gap in the
+  // consumer's count starts the partition again from its checkpoint.
+  for (const NatsMessage& m : msgs) {
+    if (m.consumer_seq != ++p.deliveries) throw NatsError("delivery " + std::to_string(m.consumer_seq) + " came where " + std::to_string(p.deliveries) + " was due");
+  }
   std::vector<Outgoing> out;
   for (const NatsMessage& m : msgs) judge(p, m, out);
   sweepStale(p, msgs.back().stream_seq, out);
@@ -358,8 +366,17 @@ void Worker::run(const std::atomic<bool>& stop) {
 }  // namespace
 
 void runTrackWorker(const TrackWorkerOptions& options, const std::atomic<bool>& stop, TrackWorkerCounters& counters) {
-  Worker w(options, counters);
-  w.run(stop);
+  // A worker started before its server (or during a restart) waits for it.
+  for (int attempt = 0; !stop.load(); ++attempt) {
+    try {
+      Worker w(options, counters);
+      w.run(stop);
+      return;
+    } catch (const NatsError& e) {
+      if (options.log && attempt % 10 == 0) options.log(std::string("waiting for NATS: ") + e.what());
+      std::this_thread::sleep_for(std::chrono::seconds(1));
+    }
+  }
 }
 
 }  // namespace skylane::service

@@ -1,0 +1,118 @@
+#pragma once
+/// \file
+/// \brief A real `nats-server -js` on a free loopback port with a file store in the test's folder
+/// (killed and restarted by the test on the same store), and skylane workers as child processes.
+
+#include "tests/test_util.hpp"
+
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace skylane::test {
+
+/// A free TCP port on 127.0.0.1 (bound and released: the kernel does not hand it out again at once).
+inline int freeTcpPort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  socklen_t len = sizeof a;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  ::close(fd);
+  return ntohs(a.sin_port);
+}
+
+inline bool tcpAccepts(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  const bool ok = ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  ::close(fd);
+  return ok;
+}
+
+/// A child process with its standard error (and output) in a log file.
+class ChildProcess {
+ public:
+  ChildProcess(std::vector<std::string> args, const std::string& log) : args_(std::move(args)), log_(log) { start(); }
+  ~ChildProcess() { kill(SIGKILL); }
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+  void start() {
+    pid_ = fork();
+    if (pid_ == 0) {
+      FILE* f = std::fopen(log_.c_str(), "a");
+      if (f) {
+        dup2(fileno(f), STDOUT_FILENO);
+        dup2(fileno(f), STDERR_FILENO);
+      }
+      std::vector<char*> argv;
+      for (std::string& a : args_) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execvp(argv[0], argv.data());
+      _exit(127);
+    }
+  }
+  /// Sends `sig` and waits; the exit status (128 + signal when killed).
+  int kill(int sig) {
+    if (pid_ <= 0) return -1;
+    ::kill(pid_, sig);
+    int st = 0;
+    waitpid(pid_, &st, 0);
+    pid_ = -1;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+  }
+  [[nodiscard]] bool running() const { return pid_ > 0 && ::waitpid(pid_, nullptr, WNOHANG) == 0; }
+  [[nodiscard]] std::string log() const {
+    std::ifstream in(log_);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+
+ private:
+  std::vector<std::string> args_;
+  std::string log_;
+  pid_t pid_ = -1;
+};
+
+/// nats-server with JetStream, the skylane fix mapping for `partitions`, a file store in `dir`.
+class NatsServer {
+ public:
+  NatsServer(const std::filesystem::path& dir, int partitions) : dir_(dir), port_(freeTcpPort()) {
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "nats.conf") << "listen: 127.0.0.1:" << port_ << "\nmax_payload: 8MB\njetstream { store_dir: \""
+                                     << (dir / "store").string() << "\" }\nmappings = {\n  \"skylane.fix.*.*\": \"skylane.fixp.{{partition("
+                                     << partitions << ",1,2)}}.{{wildcard(1)}}.{{wildcard(2)}}\"\n}\n";
+    start();
+  }
+  void start() {
+    process_ = std::make_unique<ChildProcess>(std::vector<std::string>{"nats-server", "-c", (dir_ / "nats.conf").string()},
+                                              (dir_ / "nats.log").string());
+    for (int i = 0; i < 200 && !tcpAccepts(port_); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    if (!tcpAccepts(port_)) throw std::runtime_error("nats-server did not start: " + process_->log());
+  }
+  void kill() { process_->kill(SIGKILL); }
+  [[nodiscard]] std::string url() const { return "nats://127.0.0.1:" + std::to_string(port_); }
+  /// Whether nats-server is installed (the tests skip without it only outside CI).
+  static bool installed() { return runCommand("command -v nats-server").status == 0; }
+
+ private:
+  std::filesystem::path dir_;
+  int port_;
+  std::unique_ptr<ChildProcess> process_;
+};
+
+}  // namespace skylane::test

@@ -1,0 +1,308 @@
+// skylane on NATS JetStream against a real nats-server (started by the test on a loopback port
+// with a file store): approvals through the work queue, tracking through partitioned fix
+// streams with the events of `skylane track` on the same approval and fixes, a track worker
+// killed with kill -9 and replaced, the server killed and restarted on its store, duplicates,
+// out-of-order fixes and bad messages.
+
+#include "maps/time.hpp"
+#include "service/approval_bundle.hpp"
+#include "service/nats_client.hpp"
+#include "service/nats_layout.hpp"
+#include "tests/service/nats_process.hpp"
+#include "tests/test_util.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <map>
+#include <set>
+#include <thread>
+
+namespace skylane {
+namespace {
+
+using nlohmann::json;
+using service::NatsClient;
+using test::ChildProcess;
+using test::NatsServer;
+namespace nats = service::nats;
+
+constexpr int kPartitions = 4;
+
+class NatsWorkers : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!NatsServer::installed()) GTEST_SKIP() << "nats-server is not installed (scripts/setup.sh installs it)";
+    dir_ = test::scratchPath("nats-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    server_ = std::make_unique<NatsServer>(std::filesystem::path(dir_) / "server", kPartitions);
+    const test::CommandResult setup = test::runCommand(std::string(SKYLANE_BINARY) + " nats setup --nats " + server_->url() +
+                                                       " --partitions " + std::to_string(kPartitions));
+    ASSERT_EQ(setup.status, 0) << setup.out;
+    client_ = std::make_unique<NatsClient>(server_->url(), "test");
+  }
+  std::unique_ptr<ChildProcess> worker(const std::string& role, const std::string& name, const std::string& partitions = "all") {
+    return std::make_unique<ChildProcess>(
+        std::vector<std::string>{SKYLANE_BINARY, "worker", "--nats", server_->url(), "--role", role, "--name", name, "--partitions",
+                                 partitions, "--cache", dir_ + "/cache-" + name, "--work", dir_ + "/work-" + name},
+        dir_ + "/" + name + ".log");
+  }
+  /// Requests the example mission's approval as acme/`id` and waits for its status.
+  json approve(const std::string& id, const std::string& mission = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/mission.json") {
+    const test::CommandResult r = test::runCommand(std::string(SKYLANE_BINARY) + " nats approve " + mission + " --nats " + server_->url() +
+                                                   " --operator acme --id " + id + " --wait 300 2>&1");
+    return r.out.empty() || r.out[0] != '{' ? json{{"status", "no outcome: " + r.out}} : json::parse(r.out);
+  }
+  /// The approved report (from the approval's bundle in the bucket).
+  json report(const std::string& id) {
+    const auto b = client_->get(nats::kApprovalBucket, "acme." + id + ".bundle");
+    return b ? json::parse(service::parseBundle(b->value, "bundle").report) : json();
+  }
+  /// A fix k seconds after departure on the route, `off_m` north of it, with PLs `pl_m`.
+  static json fixAt(const json& rep, int k, double off_m = 0.0, double pl_m = 0.5) {
+    const json& pts = rep.at("route");
+    std::size_t i = 1;
+    while (i + 1 < pts.size() && k > pts[i].at("eta_s").get<double>()) ++i;
+    const json &a = pts[i - 1], &b = pts[i];
+    const double f = std::clamp((k - a.at("eta_s").get<double>()) / (b.at("eta_s").get<double>() - a.at("eta_s").get<double>()), 0.0, 1.0);
+    auto mix = [&](const char* key) { return a.at(key).get<double>() + f * (b.at(key).get<double>() - a.at(key).get<double>()); };
+    const std::string time = maps::formatRfc3339(maps::parseRfc3339(rep.at("departure").get<std::string>())->plus(k));
+    return {{"time", time}, {"lat", mix("lat") + off_m / 111'195.0}, {"lon", mix("lon")}, {"h_ell_m", mix("h_ell_m")}, {"hpl_m", pl_m}, {"vpl_m", pl_m}};
+  }
+  /// Every event in the stream, each with its subject.
+  std::vector<json> events() {
+    std::vector<json> out;
+    const std::uint64_t last = client_->lastSequence(nats::kEventStream);
+    for (std::uint64_t s = 1; s <= last; ++s) {
+      if (auto m = client_->message(nats::kEventStream, s)) {
+        json e = json::parse(m->data);
+        e["_subject"] = m->subject;
+        out.push_back(e);
+      }
+    }
+    return out;
+  }
+  /// Waits until `done(events)` holds (at most `seconds`); the events.
+  std::vector<json> waitFor(const std::function<bool(const std::vector<json>&)>& done, int seconds = 60) {
+    std::vector<json> ev;
+    for (int i = 0; i < seconds * 10; ++i) {
+      ev = events();
+      if (done(ev)) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return ev;
+  }
+  static std::size_t count(const std::vector<json>& ev, const std::string& type, const std::string& flight = {}) {
+    return static_cast<std::size_t>(std::count_if(ev.begin(), ev.end(), [&](const json& e) {
+      return e.at("event") == type && (flight.empty() || e.value("flight", "") == flight);
+    }));
+  }
+  /// The events of `skylane track` on the approval and the fixes (lines as published).
+  std::vector<json> trackEvents(const std::string& id, const std::string& flight, const std::vector<std::string>& lines) {
+    const std::string rep = dir_ + "/" + id + "-report.json", fixes = dir_ + "/" + flight + "-fixes.jsonl";
+    std::ofstream(rep) << report(id).dump();
+    {
+      std::ofstream f(fixes);
+      for (const std::string& l : lines) f << l << "\n";
+    }
+    // The report's mission, from the approve worker's folder (its sha256 is checked).
+    const test::CommandResult cli = test::runCommand(std::string(SKYLANE_BINARY) + " track --approval " + flight + "=" + rep + " --input " +
+                                                     fixes + " 2>&1");
+    std::vector<json> out;
+    std::istringstream in(cli.out);
+    for (std::string line; std::getline(in, line);) {
+      if (!line.empty() && line[0] == '{') out.push_back(json::parse(line));
+    }
+    EXPECT_FALSE(out.empty()) << cli.out;
+    return out;
+  }
+  /// An event without what names the input (subject, sequence, line, file) and wall-clock times.
+  static json comparable(json e) {
+    for (const char* k : {"line", "source", "report", "error", "planning_time_s", "operator", "input_seq", "subject", "_subject"}) e.erase(k);
+    if (e.at("event") == "rejected_input") e.erase("flight");
+    return e;
+  }
+  std::string dir_;
+  std::unique_ptr<NatsServer> server_;
+  std::unique_ptr<NatsClient> client_;
+};
+
+TEST_F(NatsWorkers, AFlightsEventsEqualSkylaneTracksAndBadMessagesAreRejectedByName) {
+  auto approver = worker("approve", "ap1");
+  ASSERT_EQ(approve("a1").at("status"), "approved") << approver->log();
+  auto tracker = worker("track", "tr1");
+  const json rep = report("a1");
+  // On the route, then 40 m off it (a level-1 violation by position: a replan), then a bad line.
+  std::vector<std::string> lines;
+  for (int k = 0; k < 30; ++k) lines.push_back(fixAt(rep, k, k >= 12 && k < 20 ? 40.0 : 0.0).dump());
+  lines.push_back("{\"time\": 3}");
+  const std::string subject = nats::fixSubject("acme", "f1");
+  client_->publish(subject, json{{"start", {{"approval", "a1"}}}}.dump());
+  for (const std::string& l : lines) client_->publish(subject, l);
+  // Bad messages elsewhere: not JSON, a flight never started, a subject with no valid flight id.
+  client_->publish(nats::fixSubject("acme", "f2"), "not json at all");
+  client_->publish(nats::fixSubject("acme", "f3"), lines[0]);
+  client_->publish("skylane.fix.acme._bad", lines[0]);
+  const std::vector<json> ev = waitFor([](const std::vector<json>& e) { return count(e, "rejected_input") >= 4 && count(e, "fix") >= 30; });
+  ASSERT_EQ(count(ev, "fix", "f1"), 30u) << tracker->log();
+  std::vector<json> mine;
+  for (const json& e : ev) {
+    if (e.at("_subject") == nats::eventSubject("acme", "f1") && e.at("event") != "flight_started") mine.push_back(comparable(e));
+  }
+  std::vector<json> expected;
+  for (const json& e : trackEvents("a1", "f1", lines)) expected.push_back(comparable(e));
+  ASSERT_EQ(mine.size(), expected.size());
+  for (std::size_t i = 0; i < mine.size(); ++i) EXPECT_EQ(mine[i], expected[i]) << i;
+  EXPECT_GE(count(ev, "replan", "f1"), 1u);
+  // Each bad message: a rejected_input event naming the subject it was published to and why.
+  std::map<std::string, std::string> why;
+  for (const json& e : ev) {
+    if (e.at("event") == "rejected_input") why[e.at("subject")] = e.at("error");
+  }
+  EXPECT_NE(why[nats::fixSubject("acme", "f2")].find("syntax"), std::string::npos) << why[nats::fixSubject("acme", "f2")];
+  EXPECT_NE(why[nats::fixSubject("acme", "f3")].find("not started"), std::string::npos);
+  EXPECT_NE(why["skylane.fix.acme._bad"].find("names no operator and flight"), std::string::npos);
+  EXPECT_NE(why[subject].find("$.time"), std::string::npos);
+  EXPECT_TRUE(tracker->running());
+}
+
+/// Four flights, fixes published while the worker that holds the partitions is killed -9; a
+/// second worker (running all along, its leases refused) takes them over from the checkpoints.
+TEST_F(NatsWorkers, AKilledTrackWorkerIsReplacedAndEveryFixIsJudgedOnceWithNoEventLostOrDoubled) {
+  auto approver = worker("approve", "ap1");
+  ASSERT_EQ(approve("a1").at("status"), "approved");
+  const json rep = report("a1");
+  auto first = worker("track", "tr1");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // tr1 holds every partition
+  auto second = worker("track", "tr2");
+  const std::vector<std::string> flights = {"f1", "f2", "f3", "f4", "f5", "f6"};
+  constexpr int kFixes = 120;
+  std::map<std::string, std::vector<std::string>> lines;
+  for (const std::string& f : flights) {
+    client_->publish(nats::fixSubject("acme", f), json{{"start", {{"approval", "a1"}}}}.dump());
+    // PLs over the corridor now and then: violations and recoveries, judged the same every time.
+    for (int k = 0; k < kFixes; ++k) lines[f].push_back(fixAt(rep, k, 0.0, (k / 10) % 3 == 1 ? 3.0 : 0.5).dump());
+  }
+  for (int k = 0; k < kFixes; ++k) {
+    for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), lines[f][static_cast<std::size_t>(k)]);
+    if (k == kFixes / 3) {
+      EXPECT_EQ(first->kill(SIGKILL), 128 + SIGKILL);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  const std::vector<json> ev = waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= flights.size() * kFixes; }, 90);
+  ASSERT_EQ(count(ev, "fix"), flights.size() * kFixes) << second->log();
+  EXPECT_NE(second->log().find("holds partition"), std::string::npos);
+  for (const std::string& f : flights) {
+    std::vector<json> mine;
+    std::set<std::uint64_t> judged;
+    for (const json& e : ev) {
+      if (e.at("_subject") != nats::eventSubject("acme", f) || e.at("event") == "flight_started") continue;
+      if (e.at("event") == "fix") {
+        EXPECT_TRUE(judged.insert(e.at("input_seq").get<std::uint64_t>()).second) << f << " judged twice";
+      }
+      mine.push_back(comparable(e));
+    }
+    const std::vector<json> expected = [&] {
+      std::vector<json> x;
+      for (const json& e : trackEvents("a1", f, lines[f])) x.push_back(comparable(e));
+      return x;
+    }();
+    ASSERT_EQ(mine.size(), expected.size()) << f;
+    for (std::size_t i = 0; i < mine.size(); ++i) EXPECT_EQ(mine[i], expected[i]) << f << " event " << i;
+    EXPECT_GE(count(ev, "violation", f), 2u);
+  }
+}
+
+/// The server killed -9 in the middle of a stream and restarted on its file store: every fix it
+/// acknowledged is judged, once; the worker goes on by itself.
+TEST_F(NatsWorkers, ARestartedServerLosesNothingAcknowledged) {
+  auto approver = worker("approve", "ap1");
+  ASSERT_EQ(approve("a1").at("status"), "approved");
+  const json rep = report("a1");
+  auto tracker = worker("track", "tr1");
+  for (int i = 0; i < 100 && tracker->log().find("holds partition") == std::string::npos; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const std::string subject = nats::fixSubject("acme", "f1");
+  client_->publish(subject, json{{"start", {{"approval", "a1"}}}}.dump());
+  constexpr int kFixes = 80;
+  int acknowledged = 0;
+  for (int k = 0; k < kFixes; ++k) {
+    if (k == kFixes / 2) {
+      server_->kill();
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      server_->start();
+    }
+    // A publisher retries with the same message id until acknowledged: a repeat is dropped.
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      try {
+        client_->publish(subject, fixAt(rep, k).dump(), "fix-f1-" + std::to_string(k));
+        ++acknowledged;
+        break;
+      } catch (const service::NatsError&) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+    }
+  }
+  ASSERT_EQ(acknowledged, kFixes);
+  const std::vector<json> ev = waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= kFixes; }, 60);
+  EXPECT_EQ(count(ev, "fix"), static_cast<std::size_t>(kFixes)) << tracker->log();
+  EXPECT_EQ(count(ev, "rejected_input"), 0u);
+  EXPECT_TRUE(tracker->running());
+}
+
+TEST_F(NatsWorkers, DuplicateAndOutOfOrderFixesAreRejectedAndARepeatedMessageIdIsDropped) {
+  auto approver = worker("approve", "ap1");
+  ASSERT_EQ(approve("a1").at("status"), "approved");
+  const json rep = report("a1");
+  auto tracker = worker("track", "tr1");
+  const std::string subject = nats::fixSubject("acme", "f1");
+  client_->publish(subject, json{{"start", {{"approval", "a1"}}}}.dump());
+  for (int k = 0; k < 10; ++k) client_->publish(subject, fixAt(rep, k).dump(), "fix-" + std::to_string(k));
+  const std::uint64_t before = client_->lastSequence(nats::kFixStream);
+  EXPECT_EQ(client_->publish(subject, fixAt(rep, 9).dump(), "fix-9"), before);  // the same id again: not stored
+  client_->publish(subject, fixAt(rep, 9).dump());                               // the same fix, a new message
+  client_->publish(subject, fixAt(rep, 4).dump());                               // an older one
+  client_->publish(subject, fixAt(rep, 10).dump());
+  const std::vector<json> ev = waitFor([](const std::vector<json>& e) { return count(e, "fix") >= 11 && count(e, "rejected_input") >= 2; });
+  EXPECT_EQ(count(ev, "fix"), 11u);
+  ASSERT_EQ(count(ev, "rejected_input"), 2u);
+  for (const json& e : ev) {
+    if (e.at("event") == "rejected_input") {
+      EXPECT_EQ(e.at("subject"), subject);
+    }
+  }
+}
+
+TEST_F(NatsWorkers, TwoApproveWorkersDoEachRequestOnceAndABadRequestIsInvalidByName) {
+  auto a = worker("approve", "ap1");
+  auto b = worker("approve", "ap2");
+  const std::string mission = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/mission.json";
+  std::vector<std::thread> requests;
+  std::vector<json> outcomes(4);
+  for (int i = 0; i < 4; ++i) requests.emplace_back([&, i] { outcomes[static_cast<std::size_t>(i)] = approve("r" + std::to_string(i)); });
+  for (auto& t : requests) t.join();
+  for (const json& o : outcomes) EXPECT_EQ(o.at("status"), "approved") << o.dump();
+  // The same request again: its outcome stands, no second approval.
+  EXPECT_EQ(approve("r0").at("status"), "approved");
+  // A mission without its vehicle: invalid, the message names the field.
+  json bad = json::parse(std::ifstream(mission));
+  bad.erase("vehicle");
+  for (auto& z : bad["zones"]) z = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/" + z.get<std::string>();
+  for (auto& o : bad["orbits"]) o = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/" + o.get<std::string>();
+  bad["buildings"] = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/" + bad["buildings"].get<std::string>();
+  std::ofstream(dir_ + "/bad.json") << bad.dump();
+  const json invalid = approve("bad", dir_ + "/bad.json");
+  EXPECT_EQ(invalid.at("status"), "invalid");
+  EXPECT_NE(invalid.value("message", "").find("vehicle"), std::string::npos) << invalid.dump();
+  const std::vector<json> ev = events();
+  for (const char* id : {"r0", "r1", "r2", "r3", "bad"}) {
+    EXPECT_EQ(std::count_if(ev.begin(), ev.end(), [&](const json& e) { return e.at("event") == "approval" && e.at("id") == id; }), 1) << id;
+  }
+  EXPECT_EQ(client_->pending(nats::kApprovalStream, "approvers"), 0u);
+}
+
+}  // namespace
+}  // namespace skylane
