@@ -61,6 +61,7 @@ class Worker {
     if (o_.log) o_.log(s);
   }
   void choosePartitions();
+  std::size_t fairShare();
   void refreshLeases();
   bool acquire(Partition& p);
   void drop(Partition& p, const std::string& why);
@@ -79,12 +80,14 @@ class Worker {
   TrackWorkerCounters& c_;
   NatsClient nats_;
   std::vector<Partition> parts_;
+  int partition_count_ = 0;
 };
 
 std::string leaseKey(int k) { return "p" + std::to_string(k); }
 
 void Worker::choosePartitions() {
   const int count = nats::partitionCount(nats_);
+  partition_count_ = count;
   std::vector<int> want = o_.partitions;
   if (want.empty()) {
     for (int k = 0; k < count; ++k) want.push_back(k);
@@ -129,13 +132,38 @@ void Worker::drop(Partition& p, const std::string& why) {
   --c_.partitions_held;
 }
 
+/// The partitions this worker should hold: an even share among the live workers (each keeps a
+/// presence key in the lease bucket), so that a second worker gets half and a stopped one's go
+/// to the others.
+std::size_t Worker::fairShare() {
+  nats_.put(nats::kLeaseBucket, "w." + o_.name, "alive");
+  std::size_t live = 0;
+  for (const std::string& k : nats_.keys(nats::kLeaseBucket)) live += k.rfind("w.", 0) == 0 ? 1 : 0;
+  const std::size_t n = std::max<std::size_t>(live, 1);
+  return (static_cast<std::size_t>(partition_count_) + n - 1) / n;
+}
+
 void Worker::refreshLeases() {
+  std::size_t share = parts_.size();
+  try {
+    share = fairShare();
+  } catch (const NatsError& e) {
+    log(std::string("NATS: ") + e.what());
+  }
+  std::size_t held = 0;
+  bool released = false;
   for (Partition& p : parts_) {
     try {
       if (!p.held) {
-        (void)acquire(p);
+        if (held < share && acquire(p)) ++held;
+      } else if (held >= share && !released) {  // more than its share: one goes back each second
+        drop(p, "another worker takes its share");
+        nats_.erase(nats::kLeaseBucket, leaseKey(p.index));
+        p.lease_rev = 0;
+        released = true;
       } else if (const auto rev = nats_.update(nats::kLeaseBucket, leaseKey(p.index), o_.name, p.lease_rev)) {
         p.lease_rev = *rev;
+        ++held;
       } else {
         p.lease_rev = 0;
         drop(p, "its lease was taken");
@@ -360,6 +388,10 @@ void Worker::run(const std::atomic<bool>& stop) {
       nats_.erase(nats::kLeaseBucket, leaseKey(p.index));
     } catch (const NatsError&) {
     }
+  }
+  try {
+    nats_.erase(nats::kLeaseBucket, "w." + o_.name);
+  } catch (const NatsError&) {
   }
 }
 

@@ -3,8 +3,6 @@
 /// \brief A real `nats-server -js` on a free loopback port with a file store in the test's folder
 /// (killed and restarted by the test on the same store), and skylane workers as child processes.
 
-#include "tests/test_util.hpp"
-
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
@@ -12,6 +10,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -20,6 +19,8 @@
 #include <vector>
 
 namespace skylane::test {
+
+// (Shared by tests/service/nats_test.cpp and the load generator bench/nats_load.cpp.)
 
 /// A free TCP port on 127.0.0.1 (bound and released: the kernel does not hand it out again at once).
 inline int freeTcpPort() {
@@ -76,6 +77,7 @@ class ChildProcess {
     pid_ = -1;
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
   }
+  [[nodiscard]] pid_t pid() const { return pid_; }
   [[nodiscard]] bool running() const { return pid_ > 0 && ::waitpid(pid_, nullptr, WNOHANG) == 0; }
   [[nodiscard]] std::string log() const {
     std::ifstream in(log_);
@@ -107,7 +109,7 @@ class NatsServer {
   void kill() { process_->kill(SIGKILL); }
   [[nodiscard]] std::string url() const { return "nats://127.0.0.1:" + std::to_string(port_); }
   /// Whether nats-server is installed (the tests skip without it only outside CI).
-  static bool installed() { return runCommand("command -v nats-server").status == 0; }
+  static bool installed() { return std::system("command -v nats-server > /dev/null 2>&1") == 0; }
 
  private:
   std::filesystem::path dir_;
