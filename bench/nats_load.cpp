@@ -168,6 +168,14 @@ int main(int argc, char** argv) try {
   }
   c.publishesComplete(std::chrono::seconds(60));
   std::thread events([&] { reader.run(server.url()); });
+  struct Join {  // the reader stops and is joined however main ends
+    EventReader& r;
+    std::thread& t;
+    ~Join() {
+      r.stop = true;
+      if (t.joinable()) t.join();
+    }
+  } join{reader, events};
   std::cerr << "nats_load: " << o.flights << " flights on " << o.partitions << " partitions, " << o.workers << " track workers, " << o.seconds
             << " s at 1 Hz\n";
   std::uint64_t max_lag = 0;

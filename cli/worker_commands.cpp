@@ -1,5 +1,7 @@
 #include "cli/worker_commands.hpp"
 
+#include "airspace/loaders.hpp"
+#include "airspace/validation.hpp"
 #include "cli/zones_commands.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
@@ -149,6 +151,20 @@ void runApprove(const NatsCli& n) {
   throw std::runtime_error("no outcome of approval " + n.op + "/" + n.id + " within --wait " + std::to_string(n.wait_s) + " s");
 }
 
+/// Validates a zone file and puts it as a new version of zone set OWNER.NAME; prints the version.
+void runZones(const NatsCli& n) {
+  if (n.op != "authority") requireId(n.op, "--owner");
+  requireId(n.id, "--set");
+  const std::string text = maps::readTextFile(n.file);
+  std::vector<airspace::Zone> zones = airspace::parseZones(maps::parseJsonText(text, n.file), n.file);
+  const airspace::ValidationReport report = airspace::validateZones(zones, false);
+  if (const airspace::ZoneIssue* e = report.firstError()) throw maps::ParseError(n.file, 0, zones[e->zone].feature, "", e->what + "; expected a valid zone");
+  if (zones.empty()) throw maps::ParseError(n.file, 0, "$", "", "at least one zone");
+  auto c = connect(n.url, "skylane-zones");
+  const std::uint64_t version = c->put(nats::kZoneSetBucket, n.op + "." + n.id, text);
+  std::cout << json{{"zoneset", n.op + "." + n.id}, {"version", version}, {"zones", zones.size()}}.dump() << std::endl;
+}
+
 /// Publishes a start record (with --approval) and then every line of the file as a fix.
 void runPublish(const NatsCli& n) {
   requireId(n.op, "--operator");
@@ -203,6 +219,12 @@ void addNats(CLI::App& app) {
   approve->add_option("--id", n->id, "approval id (unique per operator)")->required();
   approve->add_option("--wait", n->wait_s, "seconds to wait for the outcome, printed (exit 0 approved, 1 rejected, 2 invalid)");
   approve->callback([n] { runApprove(*n); });
+  CLI::App* zones = top->add_subcommand("zones", "put a zone file (ED-269, ED-318, GeoJSON, QGC) as the next version of a zone set");
+  url(zones);
+  zones->add_option("ZONES", n->file, "zone file")->required()->check(CLI::ExistingFile);
+  zones->add_option("--owner", n->op, "authority, or the operator whose private set it is")->required();
+  zones->add_option("--set", n->id, "the zone set's name")->required();
+  zones->callback([n] { runZones(*n); });
   CLI::App* publish = top->add_subcommand("publish", "publish a flight's fixes (JSON lines) to skylane.fix.OPERATOR.FLIGHT");
   url(publish);
   publish->add_option("FIXES", n->file, "file of JSON lines, - for standard input")->required();

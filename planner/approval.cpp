@@ -119,20 +119,7 @@ Approver::Impl::Impl(Mission mission)
   }
   placeStops();
   requireReadableInputs(m);
-  const auto format = airspace::parseZoneFormat(m.zone_format);
-  if (!format) throw maps::ParseError(m.source, 0, "$.zone_format", m.zone_format, "auto, ed269, ed318, geojson or qgc");
-  geofence::ZonePolicy policy;
-  policy.authorisations = m.authorisations;
-  geofence::FenceOptions options;
-  options.horizon_m = 500.0;  // zones within 500 m are reported with their clearance
-  std::set<std::string> qgc_plans;  // the .plan's geoFence: QGroundControl whatever zone_format says
-  if (!m.qgc_plan_file.empty()) qgc_plans.insert(m.qgc_plan_file);
-  obstructions = std::make_unique<geofence::Obstructions>(geofence::loadObstructions(
-      {m.zone_files, *format, m.buildings_file}, frame, terrain, policy, options, qgc_plans));
-  if (!obstructions->buildings().empty()) {
-    const maps::Geodetic origin{m.points.front().lat_rad, m.points.front().lon_rad, 0.0};
-    index = std::make_unique<maps::BuildingIndex>(obstructions->buildings(), origin);
-  }
+  loadObstructions();
   orbits = integrity::loadOrbitFiles(m.orbit_files, m.source, "$.orbits");
   record = missionRecord(m);  // the files as they were read
   // Search box: every mission point ± margin; heights from the terrain's range over it.
@@ -366,7 +353,32 @@ Eigen::Vector3d positionAlong(const std::vector<RoutePoint>& route, double t_s) 
   return route.back().xyz;
 }
 
+void Approver::Impl::loadObstructions() {
+  const auto format = airspace::parseZoneFormat(m.zone_format);
+  if (!format) throw maps::ParseError(m.source, 0, "$.zone_format", m.zone_format, "auto, ed269, ed318, geojson or qgc");
+  geofence::ZonePolicy policy;
+  policy.authorisations = m.authorisations;
+  geofence::FenceOptions options;
+  options.horizon_m = 500.0;  // zones within 500 m are reported with their clearance
+  std::set<std::string> qgc_plans;  // the .plan's geoFence: QGroundControl whatever zone_format says
+  if (!m.qgc_plan_file.empty()) qgc_plans.insert(m.qgc_plan_file);
+  auto loaded = std::make_unique<geofence::Obstructions>(geofence::loadObstructions(
+      {m.zone_files, *format, m.buildings_file}, frame, terrain, policy, options, qgc_plans));
+  std::unique_ptr<maps::BuildingIndex> built;
+  if (!loaded->buildings().empty()) {
+    const maps::Geodetic origin{m.points.front().lat_rad, m.points.front().lon_rad, 0.0};
+    built = std::make_unique<maps::BuildingIndex>(loaded->buildings(), origin);
+  }
+  obstructions = std::move(loaded);  // only once both are read: a bad file leaves the old ones
+  index = std::move(built);
+}
+
 Approver::Approver(Mission mission) : impl_(std::make_unique<Impl>(std::move(mission))) {}
+
+void Approver::reloadZones() {
+  impl_->loadObstructions();
+  impl_->record = missionRecord(impl_->m);
+}
 Approver::~Approver() = default;
 const Mission& Approver::mission() const { return impl_->m; }
 const maps::PlaneFrame& Approver::frame() const { return impl_->frame; }

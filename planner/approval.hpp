@@ -219,6 +219,10 @@ class Approver {
   [[nodiscard]] const integrity::OrbitSource& orbits() const;
   /// \brief The zones and obstacles loaded from the mission's files.
   [[nodiscard]] const geofence::Obstructions& obstructions() const;
+  /// \brief Reads the mission's zone and buildings files again (a zone set's new version written
+  /// over its file): checks and replans from now on use them.
+  /// \throws maps::ParseError naming a bad file; the zones read before stay.
+  void reloadZones();
 
  private:
   struct Impl;

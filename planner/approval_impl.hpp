@@ -148,6 +148,8 @@ struct Approver::Impl {
 
   /// \throws maps::ParseError naming the mission's field of a bad input.
   explicit Impl(Mission mission);
+  /// Reads the mission's zone and buildings files into `obstructions` (and the buildings' index).
+  void loadObstructions();
 
   // --- the mission's map and integrity (approval.cpp) ---
 

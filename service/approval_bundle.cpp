@@ -63,10 +63,40 @@ ApprovalBundle packMission(const std::string& mission_path) {
   return b;
 }
 
+json zoneSetsJson(const std::map<std::string, ApprovalBundle::ZoneSetFile>& sets) {
+  json z = json::object();
+  for (const auto& [name, f] : sets) z[name] = {{"file", f.file}, {"version", f.version}};
+  return z;
+}
+
+std::string zoneSetsText(const std::map<std::string, ApprovalBundle::ZoneSetFile>& sets) { return zoneSetsJson(sets).dump(); }
+
 std::string bundleText(const ApprovalBundle& b) {
   json j = {{"mission", b.mission}, {"files", b.files}};
+  if (!b.zonesets.empty()) j["zonesets"] = zoneSetsJson(b.zonesets);
   if (!b.report.empty()) j["report"] = b.report;
   return j.dump();
+}
+
+namespace {
+
+std::map<std::string, ApprovalBundle::ZoneSetFile> parseZoneSets(const json& z, const std::string& source) {
+  std::map<std::string, ApprovalBundle::ZoneSetFile> out;
+  if (!z.is_object()) throw maps::ParseError(source, 0, "$.zonesets", "", "an object of zone set name → {file, version}");
+  for (const auto& [name, f] : z.items()) {
+    const bool ok = f.is_object() && f.contains("file") && f["file"].is_string() && safeRelativeName(f["file"].get<std::string>()) &&
+                    f.contains("version") && f["version"].is_number_unsigned();
+    if (!ok) throw maps::ParseError(source, 0, "$.zonesets." + name.substr(0, 64), "", "{\"file\": a relative name, \"version\": a revision}");
+    out[name] = {f["file"].get<std::string>(), f["version"].get<std::uint64_t>()};
+  }
+  return out;
+}
+
+}  // namespace
+
+std::map<std::string, ApprovalBundle::ZoneSetFile> readZoneSets(const fs::path& dir) {
+  if (!fs::exists(dir / "zonesets.json")) return {};
+  return parseZoneSets(maps::readJsonFile((dir / "zonesets.json").string()), (dir / "zonesets.json").string());
 }
 
 ApprovalBundle parseBundle(const std::string& text, const std::string& source) {
@@ -84,6 +114,7 @@ ApprovalBundle parseBundle(const std::string& text, const std::string& source) {
       b.files[name] = content.get<std::string>();
     }
   }
+  if (j.contains("zonesets")) b.zonesets = parseZoneSets(j["zonesets"], source);
   if (j.contains("report")) {
     if (!j["report"].is_string()) throw maps::ParseError(source, 0, "$.report", "", "the report's text");
     b.report = j["report"].get<std::string>();
@@ -99,6 +130,7 @@ void unpackBundle(const ApprovalBundle& b, const fs::path& dir) {
     maps::writeFileAtomically(p.string(), content, "bundle file");
   }
   maps::writeFileAtomically((dir / "mission.json").string(), b.mission, "bundle mission");
+  if (!b.zonesets.empty()) maps::writeFileAtomically((dir / "zonesets.json").string(), zoneSetsText(b.zonesets) + "\n", "bundle zone sets");
   if (!b.report.empty()) maps::writeFileAtomically((dir / "report.json").string(), b.report, "bundle report");
 }
 

@@ -63,6 +63,32 @@ void finishInvalid(NatsClient& nats, const std::string& op, const std::string& i
   (void)nats.publish(nats::eventSubject(op, id), st.dump(), "approval." + key);
 }
 
+/// The mission's `zonesets` ("authority.NAME" or "<operator>.NAME") → their current versions as
+/// files of the bundle, added to the mission's zones. \throws maps::ParseError naming the field.
+void resolveZoneSets(NatsClient& nats, const std::string& op, ApprovalBundle& b, const std::string& source) {
+  json m = maps::parseJsonText(b.mission, source + " mission");
+  if (!m.is_object() || !m.contains("zonesets")) return;
+  const json sets = m["zonesets"];
+  if (!sets.is_array()) throw maps::ParseError(source, 0, "$.zonesets", "", "an array of zone set names");
+  if (!m.contains("zones")) m["zones"] = json::array();
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    const std::string field = "$.zonesets[" + std::to_string(i) + "]";
+    const std::string name = sets[i].is_string() ? sets[i].get<std::string>() : std::string();
+    const std::vector<std::string> t = nats::subjectTokens(name);
+    if (t.size() != 2 || (t[0] != "authority" && t[0] != op) || !nats::validId(t[1])) {
+      throw maps::ParseError(source, 0, field, name.substr(0, 64), "authority.NAME or " + op + ".NAME (a zone set of the authority or of this operator)");
+    }
+    const auto e = nats.get(nats::kZoneSetBucket, name);
+    if (!e) throw maps::ParseError(source, 0, field, name, "a zone set put in " + nats::kZoneSetBucket + " (skylane nats zones)");
+    const std::string file = "files/zs-" + name + ".json";
+    b.files[file] = e->value;
+    b.zonesets[name] = {file, e->revision};
+    m["zones"].push_back(file);
+  }
+  m.erase("zonesets");
+  b.mission = m.dump(1) + "\n";
+}
+
 bool finalStatus(NatsClient& nats, const std::string& key) {
   const auto e = nats.get(nats::kApprovalBucket, key);
   if (!e) return false;
@@ -89,6 +115,8 @@ void handleRequest(const ApproveWorkerOptions& o, NatsClient& nats, const NatsMe
   try {
     bundle = parseBundle(m.data, m.subject);
     bundle.report.clear();
+    bundle.zonesets.clear();
+    resolveZoneSets(nats, op, bundle, m.subject);
     fs::remove_all(dir);
     unpackBundle(bundle, dir);
   } catch (const maps::ParseError& e) {

@@ -38,8 +38,10 @@ bool lostCompareAndSet(natsStatus s, jsErrCode jerr) {
 
 NatsMessage takeMessage(natsMsg* msg) {
   NatsMessage m;
-  m.subject = natsMsg_GetSubject(msg);
-  m.data.assign(natsMsg_GetData(msg), static_cast<std::size_t>(natsMsg_GetDataLength(msg)));
+  const char* subject = natsMsg_GetSubject(msg);
+  const char* data = natsMsg_GetData(msg);  // null for an empty message
+  if (subject != nullptr) m.subject = subject;
+  if (data != nullptr) m.data.assign(data, static_cast<std::size_t>(natsMsg_GetDataLength(msg)));
   jsMsgMetaData* meta = nullptr;
   if (natsMsg_GetMetaData(&meta, msg) == NATS_OK) {
     m.stream_seq = meta->Sequence.Stream;
@@ -189,7 +191,9 @@ std::optional<NatsEntry> NatsClient::get(const std::string& bucket, const std::s
   const natsStatus s = kvStore_Get(&e, impl_->bucket(bucket), key.c_str());
   if (s == NATS_NOT_FOUND) return std::nullopt;
   check("get " + bucket + "/" + key, s);
-  NatsEntry out{std::string(static_cast<const char*>(kvEntry_Value(e)), static_cast<std::size_t>(kvEntry_ValueLen(e))), kvEntry_Revision(e)};
+  const void* value = kvEntry_Value(e);  // null for an empty value
+  NatsEntry out{value == nullptr ? std::string() : std::string(static_cast<const char*>(value), static_cast<std::size_t>(kvEntry_ValueLen(e))),
+                kvEntry_Revision(e)};
   kvEntry_Destroy(e);
   return out;
 }

@@ -32,6 +32,7 @@ void setUp(NatsClient& nats, int partitions) {
   nats.ensureBucket({kPartitionBucket, 1, std::chrono::seconds(0)});
   nats.ensureBucket({kLeaseBucket, 1, std::chrono::seconds(kLeaseTtl_s)});
   nats.ensureBucket({kApprovalBucket, 1, std::chrono::seconds(0)});
+  nats.ensureBucket({kZoneSetBucket, 64, std::chrono::seconds(0)});
   const std::string count = std::to_string(partitions);
   if (!nats.create(kPartitionBucket, "count", count)) {
     const int recorded = partitionCount(nats);

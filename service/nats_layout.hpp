@@ -13,7 +13,8 @@
 /// - Buckets: skylane_flights (a flight's checkpoint: state, route, the fix sequence it covers),
 ///   skylane_partitions (each partition's checkpoint and the partition count), skylane_leases
 ///   (which worker holds a partition; keys expire unless refreshed), skylane_approvals (status,
-///   report bundle and route of each approval, by operator and id).
+///   report bundle and route of each approval, by operator and id), skylane_zonesets (zone sets
+///   by `<owner>.<name>`, owner `authority` or an operator; each put a new version, the last 64 kept).
 
 #include "service/nats_client.hpp"
 
@@ -30,6 +31,7 @@ inline const std::string kFlightBucket = "skylane_flights";
 inline const std::string kPartitionBucket = "skylane_partitions";
 inline const std::string kLeaseBucket = "skylane_leases";
 inline const std::string kApprovalBucket = "skylane_approvals";
+inline const std::string kZoneSetBucket = "skylane_zonesets";
 inline const std::string kRejectedSubject = "skylane.event._.rejected";
 inline constexpr int kLeaseTtl_s = 5;  ///< a partition whose worker stopped refreshing is free after this
 

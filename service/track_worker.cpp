@@ -1,7 +1,11 @@
 #include "service/track_worker.hpp"
 
+#include "maps/atomic_file.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
+#include "maps/text_file.hpp"
+#include "planner/mission.hpp"
+#include "planner/report_formats.hpp"
 #include "planner/tracking/flight_state.hpp"
 #include "planner/tracking/track_event.hpp"
 #include "service/approval_bundle.hpp"
@@ -25,9 +29,16 @@ namespace fs = std::filesystem;
 /// A flight of a held partition: who it belongs to and how far its checkpoint goes.
 struct FlightSlot {
   std::string op, flight, approval;  ///< approval empty: not started
+  std::string approval_dir;          ///< where its approval is unpacked
   std::uint64_t covered_seq = 0;     ///< the last fix sequence its checkpoint covers
   int checkpointed_route = 0;        ///< the route version last put with it
   bool dirty = false;
+};
+
+/// The zone sets an approval's zones come from, and one of its flights (the approver is shared).
+struct ApprovalZones {
+  std::string flight;
+  std::map<std::string, ApprovalBundle::ZoneSetFile> zonesets;
 };
 
 /// A partition the worker may hold.
@@ -39,6 +50,9 @@ struct Partition {
   std::unique_ptr<NatsPull> pull;
   std::unique_ptr<planner::Tracker> tracker;
   std::map<std::string, FlightSlot> flights;  ///< by tracker id "<operator>.<flight>"
+  std::map<std::string, ApprovalZones> approvals;  ///< by unpacked folder, those with zone sets
+  /// Each approval's report and approver, read once for all its flights (by unpacked folder).
+  std::map<std::string, std::pair<planner::ApprovedFlight, std::shared_ptr<planner::Approver>>> loaded;
 };
 
 /// An event to publish.
@@ -70,7 +84,9 @@ class Worker {
   void judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, const json& body, std::vector<Outgoing>& out);
   void startFlight(Partition& p, FlightSlot& slot, const json& body);
   FlightSlot& slotOf(Partition& p, const std::string& op, const std::string& flight);
-  void loadApproval(Partition& p, const FlightSlot& slot, const std::string& id);
+  void loadApproval(Partition& p, FlightSlot& slot, const std::string& id);
+  void checkZoneSets();
+  void followZoneSets(Partition& p, const std::string& dir, ApprovalZones& a);
   void sweepStale(Partition& p, std::uint64_t last_seq, std::vector<Outgoing>& out);
   void commit(Partition& p, std::vector<Outgoing>& out, std::uint64_t last_seq);
   void reject(const NatsMessage& m, const std::string& subject, const std::string& why, std::vector<Outgoing>& out);
@@ -81,6 +97,7 @@ class Worker {
   NatsClient nats_;
   std::vector<Partition> parts_;
   int partition_count_ = 0;
+  std::uint64_t zone_seq_ = 0;  ///< the zone set bucket's last sequence when last looked at
 };
 
 std::string leaseKey(int k) { return "p" + std::to_string(k); }
@@ -128,6 +145,8 @@ void Worker::drop(Partition& p, const std::string& why) {
   p.pull.reset();
   p.tracker.reset();
   p.flights.clear();
+  p.approvals.clear();
+  p.loaded.clear();
   p.held = false;
   --c_.partitions_held;
 }
@@ -177,7 +196,9 @@ void Worker::refreshLeases() {
 FlightSlot& Worker::slotOf(Partition& p, const std::string& op, const std::string& flight) {
   const std::string id = op + "." + flight;
   if (const auto it = p.flights.find(id); it != p.flights.end()) return it->second;
-  FlightSlot slot{op, flight, {}, 0, 0, false};
+  FlightSlot slot;
+  slot.op = op;
+  slot.flight = flight;
   if (const auto cp = nats_.get(nats::kFlightBucket, id)) {
     const json j = json::parse(cp->value);
     slot.approval = j.at("approval").get<std::string>();
@@ -196,7 +217,7 @@ FlightSlot& Worker::slotOf(Partition& p, const std::string& op, const std::strin
 }
 
 /// The approval's bundle, unpacked once per worker into the cache, registered under `id`.
-void Worker::loadApproval(Partition& p, const FlightSlot& slot, const std::string& id) {
+void Worker::loadApproval(Partition& p, FlightSlot& slot, const std::string& id) {
   const fs::path dir = fs::path(o_.cache_dir) / slot.op / slot.approval;
   if (!fs::exists(dir / "report.json")) {
     const std::string key = slot.op + "." + slot.approval + ".bundle";
@@ -205,10 +226,56 @@ void Worker::loadApproval(Partition& p, const FlightSlot& slot, const std::strin
     unpackBundle(parseBundle(b->value, "approval bundle " + key), dir);
   }
   try {
-    (void)p.tracker->addApprovalFile((dir / "report.json").string(), id);
+    auto it = p.loaded.find(dir.string());
+    if (it == p.loaded.end()) {
+      const std::string report = (dir / "report.json").string();
+      planner::ApprovedFlight plan = planner::parseApprovalReport(maps::readJsonFile(report), report);
+      if (!plan.approved) throw Rejected{"approval \"" + slot.approval + "\" was rejected, not approved"};
+      auto approver = std::make_shared<planner::Approver>(planner::loadMission(planner::approvedMissionPath(plan, report)));
+      it = p.loaded.emplace(dir.string(), std::make_pair(std::move(plan), std::move(approver))).first;
+    }
+    p.tracker->addFlight(id, it->second.first, it->second.second);
+  } catch (const Rejected&) {
+    throw;
   } catch (const std::exception& e) {
     throw Rejected{std::string("approval \"") + slot.approval + "\": " + e.what()};
   }
+  slot.approval_dir = dir.string();
+  if (p.approvals.count(slot.approval_dir) == 0) {
+    auto sets = readZoneSets(dir);
+    if (!sets.empty()) p.approvals[slot.approval_dir] = {id, std::move(sets)};
+  }
+}
+
+/// A zone set put since the last look: its new version replaces the file of every approval of a
+/// held partition made from it, and their flights' next fixes are judged against it.
+void Worker::checkZoneSets() {
+  const std::uint64_t last = nats_.lastSequence("KV_" + nats::kZoneSetBucket);
+  if (last == zone_seq_) return;
+  zone_seq_ = last;
+  for (Partition& p : parts_) {
+    if (!p.held) continue;
+    for (auto& [dir, a] : p.approvals) followZoneSets(p, dir, a);
+  }
+}
+
+void Worker::followZoneSets(Partition& p, const std::string& dir, ApprovalZones& a) {
+  for (auto& [name, f] : a.zonesets) {
+    const auto e = nats_.get(nats::kZoneSetBucket, name);
+    if (!e || e->revision == f.version) continue;
+    const std::string path = (fs::path(dir) / f.file).string();
+    const std::string before = maps::readTextFile(path);
+    maps::writeFileAtomically(path, e->value, "zone set file");
+    try {
+      p.tracker->reloadZones(a.flight);
+      log("partition " + std::to_string(p.index) + ": zone set " + name + " version " + std::to_string(e->revision) + " in force");
+      f.version = e->revision;
+    } catch (const std::exception& ex) {  // a version the fence cannot use: the one before stays
+      maps::writeFileAtomically(path, before, "zone set file");
+      log("zone set " + name + " version " + std::to_string(e->revision) + " not taken: " + ex.what());
+    }
+  }
+  maps::writeFileAtomically((fs::path(dir) / "zonesets.json").string(), zoneSetsText(a.zonesets) + "\n", "zone sets");
 }
 
 void Worker::startFlight(Partition& p, FlightSlot& slot, const json& body) {
@@ -250,6 +317,9 @@ void Worker::judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, cons
     e["flight"] = slot.flight;
     e["operator"] = slot.op;
     e["input_seq"] = m.stream_seq;
+    if (const auto z = p.approvals.find(slot.approval_dir); z != p.approvals.end()) {
+      for (const auto& [name, f] : z->second.zonesets) e["zonesets"][name] = f.version;
+    }
     if (e.value("event", "") == "rejected_input") e["subject"] = nats::fixSubject(slot.op, slot.flight);
     out.push_back({nats::eventSubject(slot.op, slot.flight), e.dump(), "fix." + std::to_string(m.stream_seq) + "." + std::to_string(i)});
   }
@@ -338,6 +408,7 @@ void Worker::commit(Partition& p, std::vector<Outgoing>& out, std::uint64_t last
 bool Worker::runBatch(Partition& p, std::chrono::milliseconds wait) {
   const std::vector<NatsMessage> msgs = p.pull->fetch(o_.batch, wait);
   if (msgs.empty()) return false;
+  checkZoneSets();  // a zone set put before these fixes were fetched is in force for them
   // Without acknowledgements a delivery lost with a connection is not sent again: a gap in the
   // consumer's count starts the partition again from its checkpoint.
   for (const NatsMessage& m : msgs) {

@@ -83,15 +83,37 @@ void TrackedFlight::align(const TrackFix& fix, const integrity::LiveFix& snap, s
   if (note.empty()) note = "GNSS/INS aligned at the snapshot position with the fix's velocity and attitude";
 }
 
-void TrackedFlight::buildBoxes() {
+void TrackedFlight::buildBoxes(const TrackedFlight* same_route) {
   std::vector<Eigen::Vector3d> path;
   for (RoutePoint& p : plan.route) {
     const Eigen::Vector2d xy = approver->frame().toPlane(p.lat_rad, p.lon_rad);
     p.xyz = Eigen::Vector3d(xy.x(), xy.y(), p.h_ell_m);
     path.push_back(p.xyz);
   }
-  level1 = std::make_unique<geofence::Corridor>(path, plan.level1);
-  level2 = std::make_unique<geofence::Corridor>(path, plan.level2);
+  if (same_route != nullptr) {
+    level1 = same_route->level1;
+    level2 = same_route->level2;
+    return;
+  }
+  level1 = std::make_shared<const geofence::Corridor>(path, plan.level1);
+  level2 = std::make_shared<const geofence::Corridor>(path, plan.level2);
+}
+
+std::string TrackedFlight::routeKey() const {
+  std::string key;
+  const auto add = [&key](double v) { key.append(reinterpret_cast<const char*>(&v), sizeof v); };
+  const Approver* a = approver.get();
+  key.append(reinterpret_cast<const char*>(&a), sizeof a);
+  for (const RoutePoint& p : plan.route) {
+    add(p.lat_rad);
+    add(p.lon_rad);
+    add(p.h_ell_m);
+  }
+  for (const geofence::AlertLimits& l : {plan.level1, plan.level2}) {
+    add(l.hal_m);
+    add(l.val_m);
+  }
+  return key;
 }
 
 }  // namespace skylane::planner

@@ -23,7 +23,9 @@ struct TrackedFlight {
   std::string id;
   ApprovedFlight plan;
   std::shared_ptr<Approver> approver;
-  std::unique_ptr<geofence::Corridor> level1, level2;
+  /// Shared by the flights of one approval until one of them is replanned (many vehicles may fly
+  /// the same approved route: the boxes are built once).
+  std::shared_ptr<const geofence::Corridor> level1, level2;
   std::vector<Eigen::Vector3d> stops;  ///< the mission's points (map frame)
   integrity::LiveFixConfig live;
   FlightState st;
@@ -43,8 +45,11 @@ struct TrackedFlight {
   std::optional<integrity::ins::NavigatorEpoch> deeperEpoch(const integrity::ins::Navigator& before, const TrackFix& fix);
   /// \brief Aligns the filter at a snapshot solution with the fix's velocity and attitude.
   void align(const TrackFix& fix, const integrity::LiveFix& snap, std::string& note);
-  /// \brief Both box levels around the current route (and each route point's map position).
-  void buildBoxes();
+  /// \brief Both box levels around the current route (and each route point's map position);
+  /// `same_route`'s boxes when it is given (a flight of the same approver and route).
+  void buildBoxes(const TrackedFlight* same_route = nullptr);
+  /// \brief What makes two flights' boxes the same: the approver and the route, exactly.
+  [[nodiscard]] std::string routeKey() const;
 
  private:
   /// One epoch of `n`: the fix's IMU increments, then its pseudoranges and aiding.

@@ -45,7 +45,15 @@ void Tracker::addFlight(const std::string& id, const ApprovedFlight& approval, s
   f->id = id;
   f->plan = approval;
   f->approver = std::move(approver);
-  f->buildBoxes();
+  // A flight of the same approver on the same route, not replanned since: its boxes serve both.
+  std::string key = f->routeKey();
+  const TrackedFlight* twin = nullptr;
+  if (const auto t = same_route_.find(key); t != same_route_.end()) {
+    const auto it = flights_.find(t->second);
+    if (it != flights_.end() && it->second->st.route_version == 0) twin = it->second.get();
+  }
+  f->buildBoxes(twin);
+  same_route_[std::move(key)] = id;
   f->stops = f->approver->missionStops();
   const Mission& m = f->approver->mission();
   f->live.method = m.method;
@@ -91,6 +99,8 @@ std::string Tracker::addApproval(const json& report, const std::string& report_p
   addFlight(name, plan, it->second);
   return name;
 }
+
+void Tracker::reloadZones(const std::string& id) { flights_.at(id)->approver->reloadZones(); }
 
 std::vector<std::string> Tracker::flights() const {
   std::vector<std::string> out;

@@ -123,6 +123,9 @@ class Tracker {
   void restore(const std::string& id, const FlightState& state, const nlohmann::json& route);
   /// \brief The approver (mission, map frame, zones and obstacles) of a flight.
   [[nodiscard]] const Approver& approver(const std::string& id) const;
+  /// \brief Reads the zone files of a flight's mission again (Approver::reloadZones): the next
+  /// fixes of every flight of that mission are judged against them.
+  void reloadZones(const std::string& id);
   /// \brief The latest fix time over all flights (stream time).
   [[nodiscard]] std::optional<maps::GpsTime> streamTime() const { return stream_time_; }
   [[nodiscard]] const TrackerOptions& options() const { return options_; }
@@ -133,6 +136,7 @@ class Tracker {
   TrackerOptions options_;
   std::map<std::string, std::unique_ptr<TrackedFlight>> flights_;
   std::map<std::string, std::shared_ptr<Approver>> approvers_;  ///< by mission file
+  std::map<std::string, std::string> same_route_;  ///< TrackedFlight::routeKey → a flight with those boxes
   std::optional<maps::GpsTime> stream_time_;
   std::optional<maps::GpsTime> last_sweep_;
 };
