@@ -103,6 +103,7 @@ NatsClient::NatsClient(const std::string& url, const std::string& name, std::chr
   jsOptions_Init(&jo);
   jo.Wait = 5000;
   jo.PublishAsync.MaxPending = 8192;
+  jo.PublishAsync.StallWait = 10000;  // a busy server slows a publisher down rather than failing it
   jo.PublishAsync.ErrHandler = &Impl::onPublishError;
   jo.PublishAsync.ErrHandlerClosure = impl_.get();
   check("JetStream context", natsConnection_JetStream(&impl_->js, impl_->nc, &jo));

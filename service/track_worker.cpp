@@ -1,6 +1,7 @@
 #include "service/track_worker.hpp"
 
 #include "maps/atomic_file.hpp"
+#include "maps/file_digest.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
@@ -231,7 +232,13 @@ void Worker::loadApproval(Partition& p, FlightSlot& slot, const std::string& id)
       const std::string report = (dir / "report.json").string();
       planner::ApprovedFlight plan = planner::parseApprovalReport(maps::readJsonFile(report), report);
       if (!plan.approved) throw Rejected{"approval \"" + slot.approval + "\" was rejected, not approved"};
-      auto approver = std::make_shared<planner::Approver>(planner::loadMission(planner::approvedMissionPath(plan, report)));
+      // The mission of the bundle, beside the report (not where the approve worker had it): its
+      // zone files are the ones a zone set's new version is written over.
+      const std::string mission = (dir / "mission.json").string();
+      if (!plan.mission_sha256.empty() && maps::fileSha256Hex(mission) != plan.mission_sha256) {
+        throw Rejected{"approval \"" + slot.approval + "\": its bundle's mission is not the one approved (SHA-256 differs)"};
+      }
+      auto approver = std::make_shared<planner::Approver>(planner::loadMission(mission));
       it = p.loaded.emplace(dir.string(), std::make_pair(std::move(plan), std::move(approver))).first;
     }
     p.tracker->addFlight(id, it->second.first, it->second.second);

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <map>
 #include <set>
@@ -274,6 +275,78 @@ TEST_F(NatsWorkers, DuplicateAndOutOfOrderFixesAreRejectedAndARepeatedMessageIdI
       EXPECT_EQ(e.at("subject"), subject);
     }
   }
+}
+
+/// A zone set's new version, put while two workers track four flights made from it: every fix
+/// published after the put is judged against it (its events name the version), a closure it adds
+/// on the route ahead gives a zone violation naming it, and the fixes before name the old version.
+TEST_F(NatsWorkers, AZoneSetUpdateIsInForceForEveryFixPublishedAfterIt) {
+  const std::string examples = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/";
+  const auto put = [&](const std::string& file) {
+    const test::CommandResult r = test::runCommand(std::string(SKYLANE_BINARY) + " nats zones " + file + " --nats " + server_->url() +
+                                                   " --owner authority --set zurich");
+    EXPECT_EQ(r.status, 0) << r.out;
+    return json::parse(r.out).at("version").get<std::uint64_t>();
+  };
+  const std::uint64_t v1 = put(examples + "zones_ed269.json");
+  json mission = json::parse(std::ifstream(examples + "mission.json"));
+  mission.erase("zones");
+  mission["zonesets"] = {"authority.zurich"};
+  for (auto& o : mission["orbits"]) o = examples + o.get<std::string>();
+  mission["buildings"] = examples + mission["buildings"].get<std::string>();
+  std::ofstream(dir_ + "/mission.json") << mission.dump();
+  auto approver = worker("approve", "ap1");
+  ASSERT_EQ(approve("a1", dir_ + "/mission.json").at("status"), "approved") << approver->log();
+  const json rep = report("a1");
+  auto w1 = worker("track", "tr1");
+  auto w2 = worker("track", "tr2");
+  const std::vector<std::string> flights = {"f1", "f2", "f3", "f4"};
+  for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), json{{"start", {{"approval", "a1"}}}}.dump());
+  for (int k = 0; k < 10; ++k) {
+    for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), fixAt(rep, k).dump());
+  }
+  (void)waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= 40; });
+  // Version 2: the same zones and a closure 120 m wide around the route 25 s after departure.
+  json zones = json::parse(std::ifstream(examples + "zones_ed269.json"));
+  json closure = zones["UASZoneList"][0];
+  const json at = fixAt(rep, 25);
+  const double lat = at["lat"], lon = at["lon"], dlat = 60.0 / 111'195.0, dlon = dlat / std::cos(lat * M_PI / 180.0);
+  closure["identifier"] = "EX-NEW-CLOSURE";
+  closure["name"] = "Closure put while flying (test)";
+  closure["geometry"][0]["horizontalProjection"]["coordinates"] =
+      json::array({json::array({{lon - dlon, lat - dlat}, {lon + dlon, lat - dlat}, {lon + dlon, lat + dlat}, {lon - dlon, lat + dlat}, {lon - dlon, lat - dlat}})});
+  zones["UASZoneList"].push_back(closure);
+  std::ofstream(dir_ + "/zones_v2.json") << zones.dump();
+  const std::uint64_t v2 = put(dir_ + "/zones_v2.json");
+  const auto t_put = std::chrono::steady_clock::now();
+  for (int k = 10; k < 30; ++k) {
+    for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), fixAt(rep, k).dump());
+  }
+  const std::vector<json> ev = waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= 120; });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_put).count();
+  ASSERT_EQ(count(ev, "fix"), 120u) << w1->log() << w2->log();
+  for (const json& e : ev) {
+    if (e.at("event") != "fix") continue;
+    const int k = static_cast<int>(std::lround(*maps::parseRfc3339(e.at("time").get<std::string>()) - *maps::parseRfc3339(rep.at("departure").get<std::string>())));
+    EXPECT_EQ(e.at("zonesets").at("authority.zurich").get<std::uint64_t>(), k < 10 ? v1 : v2) << e.dump();
+  }
+  for (const std::string& f : flights) {
+    const bool named = std::any_of(ev.begin(), ev.end(), [&](const json& e) {
+      return e.at("event") == "violation" && e.value("flight", "") == f && e.dump().find("EX-NEW-CLOSURE") != std::string::npos;
+    });
+    EXPECT_TRUE(named) << f << [&] {
+      std::string all;
+      for (const json& e : ev) {
+        if (e.value("flight", "") == f && e.at("event") != "fix") all += e.dump() + "\n";
+      }
+      for (const json& e : ev) {
+        if (e.value("flight", "") == f && e.at("event") == "fix" && e.at("time") > "2020-01-01T14:00:23") all += e.dump().substr(0, 900) + "\n";
+      }
+      return all;
+    }();
+  }
+  EXPECT_LT(seconds, 30.0);
+  EXPECT_NE((w1->log() + w2->log()).find("zone set authority.zurich version " + std::to_string(v2) + " in force"), std::string::npos);
 }
 
 TEST_F(NatsWorkers, TwoApproveWorkersDoEachRequestOnceAndABadRequestIsInvalidByName) {
