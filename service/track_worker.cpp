@@ -17,6 +17,7 @@
 #include <chrono>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <thread>
 
 namespace skylane::service {
@@ -52,6 +53,8 @@ struct Partition {
   std::unique_ptr<planner::Tracker> tracker;
   std::map<std::string, FlightSlot> flights;  ///< by tracker id "<operator>.<flight>"
   std::map<std::string, ApprovalZones> approvals;  ///< by unpacked folder, those with zone sets
+  /// The flights with a checkpoint when the partition was taken: any other is new (no lookup).
+  std::set<std::string> known;
   /// Each approval's report and approver, read once for all its flights (by unpacked folder).
   std::map<std::string, std::pair<planner::ApprovedFlight, std::shared_ptr<planner::Approver>>> loaded;
 };
@@ -132,6 +135,10 @@ bool Worker::acquire(Partition& p) {
   p.covered_seq = cp ? json::parse(cp->value).at("seq").get<std::uint64_t>() : 0;
   p.tracker = std::make_unique<planner::Tracker>(o_.tracker);
   p.flights.clear();
+  // Only this partition's holder writes its flights' checkpoints, so a flight without one now is
+  // new until this worker writes it: its first message needs no lookup.
+  const std::vector<std::string> keys = nats_.keys(nats::kFlightBucket);
+  p.known = std::set<std::string>(keys.begin(), keys.end());
   p.deliveries = 0;
   p.pull = nats_.pullFrom(nats::kFixStream, "track-" + leaseKey(p.index), nats::partitionFilter(p.index), p.covered_seq + 1);
   p.held = true;
@@ -148,6 +155,7 @@ void Worker::drop(Partition& p, const std::string& why) {
   p.flights.clear();
   p.approvals.clear();
   p.loaded.clear();
+  p.known.clear();
   p.held = false;
   --c_.partitions_held;
 }
@@ -200,7 +208,8 @@ FlightSlot& Worker::slotOf(Partition& p, const std::string& op, const std::strin
   FlightSlot slot;
   slot.op = op;
   slot.flight = flight;
-  if (const auto cp = nats_.get(nats::kFlightBucket, id)) {
+  const auto cp = p.known.count(id) > 0 ? nats_.get(nats::kFlightBucket, id) : std::nullopt;
+  if (cp) {
     const json j = json::parse(cp->value);
     slot.approval = j.at("approval").get<std::string>();
     slot.covered_seq = j.at("seq").get<std::uint64_t>();
@@ -445,7 +454,9 @@ void Worker::run(const std::atomic<bool>& stop) {
       last_refresh = Clock::now();
     }
     const int held = c_.partitions_held.load();
-    const auto wait = std::chrono::milliseconds(held > 0 ? std::max(5, 200 / held) : 0);
+    // A fetch waits for a full batch or this long: short, so that a quiet partition does not
+    // hold up the others (a batch is also judged as soon as it is full).
+    const auto wait = std::chrono::milliseconds(held > 0 ? std::max(2, 20 / held) : 0);
     bool busy = false;
     for (Partition& p : parts_) {
       if (!p.held) continue;
