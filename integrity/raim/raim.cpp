@@ -2,6 +2,7 @@
 
 #include "integrity/stats.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -108,8 +109,32 @@ RaimPl raimProtectionLevels(const Geometry& g, const RaimConfig& cfg) {
   return out;
 }
 
-RaimFdeResult raimFde(const Geometry& g, const Eigen::VectorXd& prefit, const RaimConfig& cfg) {
+int raimExclusionCandidates(int n, int m, int max_exclusions) {
+  double total = 0.0, choose = 1.0;  // C(n, r) built up in r
+  for (int r = 1; r <= max_exclusions && n - r > m; ++r) {
+    choose = choose * (n - r + 1) / r;
+    total += choose;
+  }
+  return static_cast<int>(std::min(total, 1e9));
+}
+
+RaimConfig outcomeConfig(const RaimConfig& cfg, double budget_share) {
+  RaimConfig c = cfg;
+  c.pmd *= budget_share;
+  c.phmi_hor *= budget_share;
+  c.phmi_vert *= budget_share;
+  return c;
+}
+
+RaimFdeResult raimFde(const Geometry& g, const Eigen::VectorXd& prefit, const RaimConfig& fde_cfg) {
   RaimFdeResult out;
+  // Every outcome's PL with its share of P_md and P_HMI (docs/method.md §3.2a): P(HMI | fault)
+  // ≤ Σ_outcomes P(HMI ∧ outcome | fault) ≤ (N_exc + 1)·ρ·P_md = P_md.
+  if (fde_cfg.exclusion_pl == ExclusionPl::kAllocated) {
+    out.exclusion_candidates = raimExclusionCandidates(g.numSats(), g.numStates(), fde_cfg.max_exclusions);
+    out.budget_share = 1.0 / (out.exclusion_candidates + 1.0);
+  }
+  const RaimConfig cfg = outcomeConfig(fde_cfg, out.budget_share);
   std::vector<int> kept(static_cast<std::size_t>(g.numSats()));
   for (int i = 0; i < g.numSats(); ++i) kept[static_cast<std::size_t>(i)] = i;
   Geometry cur = g;
