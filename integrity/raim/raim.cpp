@@ -126,15 +126,23 @@ RaimConfig outcomeConfig(const RaimConfig& cfg, double budget_share) {
   return c;
 }
 
+namespace {
+
+/// The configuration of every outcome of raimFde, with its share of P_md and P_HMI
+/// (docs/method.md §3.2a): P(HMI | fault) ≤ Σ_outcomes P(HMI ∧ outcome | fault) ≤
+/// (N_exc + 1)·ρ·P_md = P_md. Records N_exc and ρ in `out`.
+RaimConfig fdeOutcomeConfig(const Geometry& g, const RaimConfig& cfg, RaimFdeResult& out) {
+  if (cfg.exclusion_pl != ExclusionPl::kAllocated) return cfg;
+  out.exclusion_candidates = raimExclusionCandidates(g.numSats(), g.numStates(), cfg.max_exclusions);
+  out.budget_share = 1.0 / (out.exclusion_candidates + 1.0);
+  return outcomeConfig(cfg, out.budget_share);
+}
+
+}  // namespace
+
 RaimFdeResult raimFde(const Geometry& g, const Eigen::VectorXd& prefit, const RaimConfig& fde_cfg) {
   RaimFdeResult out;
-  // Every outcome's PL with its share of P_md and P_HMI (docs/method.md §3.2a): P(HMI | fault)
-  // ≤ Σ_outcomes P(HMI ∧ outcome | fault) ≤ (N_exc + 1)·ρ·P_md = P_md.
-  if (fde_cfg.exclusion_pl == ExclusionPl::kAllocated) {
-    out.exclusion_candidates = raimExclusionCandidates(g.numSats(), g.numStates(), fde_cfg.max_exclusions);
-    out.budget_share = 1.0 / (out.exclusion_candidates + 1.0);
-  }
-  const RaimConfig cfg = outcomeConfig(fde_cfg, out.budget_share);
+  const RaimConfig cfg = fdeOutcomeConfig(g, fde_cfg, out);
   std::vector<int> kept(static_cast<std::size_t>(g.numSats()));
   for (int i = 0; i < g.numSats(); ++i) kept[static_cast<std::size_t>(i)] = i;
   Geometry cur = g;
