@@ -56,6 +56,7 @@ BENCHMARK(BM_RaimFdeWithFault)->Repetitions(5)->ReportAggregatesOnly(true);
 
 // ARAIM MHSS for one epoch, GPS + Galileo from the shared ED-259 almanacs (~18–22 satellites).
 // Target (issue 3): ≤ 50 µs median on one core.
+#include "integrity/araim/exclusion.hpp"
 #include "integrity/araim/mhss.hpp"
 #include "integrity/gnss/almanac.hpp"
 #include "integrity/gnss/orbit_source.hpp"
@@ -97,5 +98,16 @@ void BM_AraimPlGpsGalileo(benchmark::State& state) {
   state.counters["modes"] = benchmark::Counter(static_cast<double>(modes), benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_AraimPlGpsGalileo)->Arg(0)->Arg(1)->Repetitions(5)->ReportAggregatesOnly(true);
+
+/// The predicted PL of a user who excludes (docs/method.md §4.3 step 5): the no-exclusion
+/// outcome and one outcome per satellite, each at ρ = 1/(N_exc + 1).
+void BM_AraimFdePredictionGpsGalileo(benchmark::State& state) {
+  const auto skies = almanacSkies();
+  const ErrorModel model;
+  const AraimConfig cfg;
+  std::size_t k = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(araimFdeProtectionLevels(skies[k++ % skies.size()], model, cfg));
+}
+BENCHMARK(BM_AraimFdePredictionGpsGalileo)->Repetitions(3)->ReportAggregatesOnly(true);
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include "cli/skymask_commands.hpp"
 #include "cli/svg_plot.hpp"
+#include "integrity/araim/exclusion.hpp"
 #include "integrity/availability.hpp"
 #include "integrity/geometry_file.hpp"
 #include "integrity/gnss/almanac.hpp"
@@ -137,6 +138,21 @@ double parseMask(double mask_deg) {
 
 json triple(const std::array<double, 3>& v) { return json::array({r4(v[0]), r4(v[1]), r4(v[2])}); }
 
+/// The predicted PLs of a user who excludes (docs/method.md §4.3, step 5): the maximum over the
+/// no-exclusion outcome and every candidate's, each with ρ = 1/(N_exc + 1) of the budget.
+json afterExclusionJson(const integrity::Geometry& g, const integrity::GeometryInput& in) {
+  const integrity::AraimResult r = integrity::araimFdeProtectionLevels(g, in.model, in.araim);
+  json j;
+  j["exclusion_candidates"] = integrity::exclusionCandidates(g, in.model, in.araim).size();
+  j["budget_share"] = r.budget_share;
+  j["pl_computed"] = r.pl_computed;
+  j["available"] = r.available;
+  if (!r.reason.empty()) j["reason"] = r.reason;
+  j["hpl_m"] = r.pl_computed ? r4(r.hpl_m) : json(nullptr);
+  j["vpl_m"] = r.pl_computed ? r4(r.vpl_m) : json(nullptr);
+  return j;
+}
+
 json araimJson(const integrity::AraimResult& r, bool verbose, const std::vector<integrity::SatId>& sats) {
   json j;
   j["method"] = "araim";
@@ -196,7 +212,9 @@ void runPl(const PlOptions& o) {
   const integrity::GeometryInput in = integrity::loadGeometryFile(o.geometry);
   const integrity::Geometry g = integrity::buildGeometry(in.satellites, in.model, in.tau_vert_m);
   if (method == integrity::IntegrityMethod::kAraim) {
-    std::cout << araimJson(integrity::araimProtectionLevels(g, in.model, in.araim), o.verbose, g.sats).dump(2) << "\n";
+    json j = araimJson(integrity::araimProtectionLevels(g, in.model, in.araim), o.verbose, g.sats);
+    if (in.araim.exclusion_pl == integrity::ExclusionPl::kAllocated) j["after_exclusion"] = afterExclusionJson(g, in);
+    std::cout << j.dump(2) << "\n";
   } else {
     std::cout << plJson(integrity::raimProtectionLevels(g, in.raim), in.requirements, o.verbose, g.sats).dump(2) << "\n";
   }

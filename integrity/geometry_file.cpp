@@ -156,9 +156,18 @@ void readRequirements(const json& r, Requirements& q, const std::string& src) {
   q.sigma_acc_m = number(r, "sigma_acc_m", q.sigma_acc_m, src, "requirements", 0.0, 1e6, "a limit in metres >= 0");
 }
 
+/// `block`.exclusion_pl: "allocated" or "remaining_geometry" (docs/method.md §3.2a, §4.3).
+ExclusionPl exclusionPl(const json& block, ExclusionPl fallback, const std::string& src, const std::string& name) {
+  const auto e = block.find("exclusion_pl");
+  if (e == block.end()) return fallback;
+  if (*e == "allocated") return ExclusionPl::kAllocated;
+  if (*e == "remaining_geometry") return ExclusionPl::kRemainingGeometry;
+  throw ParseError(src, 0, name + ".exclusion_pl", shown(*e), "\"allocated\" or \"remaining_geometry\"");
+}
+
 void readRaim(const json& r, RaimConfig& raim, const std::string& src) {
   if (!r.is_object()) throw ParseError(src, 0, "raim", shown(r), "an object");
-  requireKeys(r, {"pfa", "pmd", "formula", "max_exclusions"}, src, "raim");
+  requireKeys(r, {"pfa", "pmd", "formula", "max_exclusions", "exclusion_pl"}, src, "raim");
   raim.pfa = probability(r, "pfa", raim.pfa, src, "raim");
   raim.pmd = probability(r, "pmd", raim.pmd, src, "raim");
   raim.max_exclusions = static_cast<int>(number(r, "max_exclusions", raim.max_exclusions, src, "raim", 0, 10, "0 to 10"));
@@ -167,11 +176,18 @@ void readRaim(const json& r, RaimConfig& raim, const std::string& src) {
     else if (*f == "brown") raim.formula = RaimPlFormula::kSlopePbias;
     else throw ParseError(src, 0, "raim.formula", shown(*f), "\"pbias_plus_noise\" or \"brown\"");
   }
+  raim.exclusion_pl = exclusionPl(r, raim.exclusion_pl, src, "raim");
 }
 
 void readAraim(const json& a, AraimConfig& araim, const std::string& src) {
   if (!a.is_object()) throw ParseError(src, 0, "araim", shown(a), "an object");
-  requireKeys(a, {"fault_mode_rule", "fc_thres", "emt_probability", "horizontal_only"}, src, "araim");
+  requireKeys(a, {"fault_mode_rule", "fc_thres", "emt_probability", "horizontal_only", "exclusion_pl",
+                  "exclude_constellations"}, src, "araim");
+  araim.exclusion_pl = exclusionPl(a, araim.exclusion_pl, src, "araim");
+  if (const auto x = a.find("exclude_constellations"); x != a.end()) {
+    if (!x->is_boolean()) throw ParseError(src, 0, "araim.exclude_constellations", shown(*x), "true or false");
+    araim.exclude_constellations = x->get<bool>();
+  }
   if (const auto f = a.find("fault_mode_rule"); f != a.end()) {
     if (*f == "adds_until_threshold") araim.rule = FaultModeRule::kAddsUntilThreshold;
     else if (*f == "joint_events") araim.rule = FaultModeRule::kJointEvents;

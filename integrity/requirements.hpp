@@ -19,4 +19,18 @@ struct Requirements {
   double sigma_acc_m = 1.87;
 };
 
+/// \brief What a protection level after a fault exclusion accounts for (RAIM and ARAIM FDE;
+/// docs/method.md §3.2a and §4.3).
+enum class ExclusionPl {
+  /// The integrity budget is shared by the outcomes of FDE — no exclusion and each of the N_exc
+  /// exclusion candidates get ρ = 1/(N_exc + 1) of it — so that a wrong exclusion is bounded
+  /// (J. Blanch, T. Walter, P. Enge, "Protection Levels after Fault Exclusion for Advanced RAIM",
+  /// NAVIGATION 64(4), 2017; ARAIM: the modes of the remaining subset with their own thresholds
+  /// T_k,j). The default.
+  kAllocated,
+  /// The plain detection-only PL of the remaining geometry with the whole budget (skylane before
+  /// issue 18); it does not account for a wrong exclusion. Kept to compare.
+  kRemainingGeometry,
+};
+
 }  // namespace skylane::integrity

@@ -154,8 +154,10 @@ void setAllInViewErrors(AraimResult& out, const Geometry& g, const SubsetSolutio
   out.sigma_acc_v_m = std::sqrt(out.S0.row(2).cwiseAbs2().dot(c_acc));
 }
 
+}  // namespace
+
 /// Fault modes from the ISM.
-FaultModeSet faultModes(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg) {
+FaultModeSet araimFaultModes(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg) {
   std::vector<Constellation> cons;
   std::vector<double> p_sat;
   for (const SatId& s : g.sats) {
@@ -171,6 +173,8 @@ FaultModeSet faultModes(const Geometry& g, const ErrorModel& model, const AraimC
   o.fc_thres = cfg.fc_thres;
   return determineFaultModes(cons, p_sat, p_const, o);
 }
+
+namespace {
 
 /// One subset solution per monitorable fault mode; an unmonitorable mode's prior goes to the
 /// unmonitored probability.
@@ -219,8 +223,9 @@ void setThresholds(AraimResult& out, const Requirements& req) {
 /// Protection levels per axis and the EMT; false (with the reason) when the unmonitored
 /// probability leaves no budget.
 bool solveProtectionLevels(AraimResult& out, const Requirements& req) {
-  // Risk budgets (ADD Eq. 31–32): the unmonitored probability is taken off the top.
-  const double scale = 1.0 - out.p_not_monitored / (req.phmi_vert + req.phmi_hor);
+  // Risk budgets (ADD Eq. 31–32): the unmonitored probability is taken off the top; an outcome
+  // of FDE gets the share ρ of what is left (MAAST for ARAIM's rho_j).
+  const double scale = out.budget_share * (1.0 - out.p_not_monitored / (req.phmi_vert + req.phmi_hor));
   if (!(scale > 0.0)) {
     out.reason = "the unmonitored fault probability " + std::to_string(out.p_not_monitored) +
                  " exceeds the integrity budget";
@@ -342,7 +347,13 @@ double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, d
 }
 
 AraimResult araimProtectionLevels(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg) {
+  if (geometryShortfall(g)) return araimLevelsOverModes(g, FaultModeSet{}, cfg, 1.0);  // states why
+  return araimLevelsOverModes(g, araimFaultModes(g, model, cfg), cfg, 1.0);
+}
+
+AraimResult araimLevelsOverModes(const Geometry& g, FaultModeSet modes, const AraimConfig& cfg, double budget_share) {
   AraimResult out;
+  out.budget_share = budget_share;
   if (const std::optional<std::string> why = geometryShortfall(g)) {
     out.reason = *why;
     return out;
@@ -355,7 +366,7 @@ AraimResult araimProtectionLevels(const Geometry& g, const ErrorModel& model, co
   }
   const Eigen::VectorXd c_acc = g.sigma_acc.array().square();
   setAllInViewErrors(out, g, all, c_acc);
-  monitorFaultModes(out, g, aiv, faultModes(g, model, cfg), c_acc);
+  monitorFaultModes(out, g, aiv, std::move(modes), c_acc);
   setThresholds(out, cfg.requirements);
   setEffectiveMonitorThreshold(out, cfg);
   out.accuracy_computed = true;

@@ -40,6 +40,11 @@ struct AraimConfig {
   double fc_thres = 0.0;  ///< fault consolidation threshold (fault_modes.hpp); 0 = off
   EmtProbability emt_probability = EmtProbability::kModePrior;
   bool horizontal_only = false;  ///< availability from HPL ≤ HAL alone (H-ARAIM)
+  ExclusionPl exclusion_pl = ExclusionPl::kAllocated;  ///< the PL after FDE (araimFde)
+  /// Constellations with P_const > P_HMI are exclusion candidates too (MAAST's `fde_wf_flag`;
+  /// off by default: with two constellations, the other one's fault cannot be monitored after
+  /// one is excluded, so that outcome has no PL unless P_const is within P_THRES).
+  bool exclude_constellations = false;
 };
 
 /// \brief One monitored fault mode with its subset solution.
@@ -77,6 +82,9 @@ struct AraimResult {
   int unmonitorable_modes = 0;  ///< selected modes whose subset is singular (prior added to P_not_monitored)
   int n_fault_max = 0;
   double p_not_monitored = 0;
+  /// Share ρ of the integrity budget this outcome was solved with: 1 for detection only,
+  /// 1/(N_exc + 1) under exclusion (ExclusionPl::kAllocated).
+  double budget_share = 1.0;
   double k_fa_h = 0, k_fa_v = 0;
   std::array<double, 3> sigma0{}, bias0{};
   std::array<PlBracket, 3> initial_bracket{};  ///< per axis east, north, up
@@ -107,7 +115,17 @@ struct RiskAndSlope {
 [[nodiscard]] double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, double tol,
                                           double* equal_allocation = nullptr, PlBracket* initial = nullptr);
 
-/// \brief ARAIM MHSS protection levels for a geometry (σ_int, σ_acc, b_nom set) under an ISM.
+/// \brief ARAIM MHSS protection levels for a geometry (σ_int, σ_acc, b_nom set) under an ISM
+/// (fault detection only: the whole integrity budget, ρ = 1).
 [[nodiscard]] AraimResult araimProtectionLevels(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg);
+
+/// \brief The fault modes araimProtectionLevels monitors for `g` (before the subset solutions:
+/// a mode that turns out unmonitorable is still listed).
+[[nodiscard]] FaultModeSet araimFaultModes(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg);
+
+/// \brief The MHSS protection levels over the given fault modes (indices into `g`) with the
+/// share ρ ∈ (0, 1] of the integrity budget: Eq. (4.5) with budgets ρ·𝓑_q (docs/method.md §4.3).
+[[nodiscard]] AraimResult araimLevelsOverModes(const Geometry& g, FaultModeSet modes, const AraimConfig& cfg,
+                                               double budget_share);
 
 }  // namespace skylane::integrity

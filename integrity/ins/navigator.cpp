@@ -48,6 +48,11 @@ RaimConfig gnssAloneRaimConfig(int n, const NavigatorConfig& cfg) {
   RaimConfig rc;
   rc.pfa = cfg.fault_modes.pfa_gnss;
   rc.max_exclusions = cfg.max_exclusions;
+  // The plain PL after an exclusion: this step's risk is allocated by the fault-mode tree of
+  // docs/method.md §5.3 (Zhao & Song 2024), whose GNSS single-fault class carries P_md; the
+  // split over FDE outcomes of §3.2a is not part of that tree (its PL feeds the
+  // three-hypothesis INS PL of §5.5).
+  rc.exclusion_pl = ExclusionPl::kRemainingGeometry;
   const RiskAllocation a_h = allocateRisk(std::max(n, 1), DetectionClass::kGnssAlone, false, cfg.fault_modes.risk);
   const RiskAllocation a_v = allocateRisk(std::max(n, 1), DetectionClass::kGnssAlone, true, cfg.fault_modes.risk);
   rc.pmd = std::min(a_h.of(InsFaultMode::kGnssSingle).conditional, a_v.of(InsFaultMode::kGnssSingle).conditional);

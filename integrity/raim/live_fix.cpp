@@ -1,5 +1,6 @@
 #include "integrity/raim/live_fix.hpp"
 
+#include "integrity/araim/exclusion.hpp"
 #include "integrity/araim/fde.hpp"
 #include "integrity/gnss/atmosphere.hpp"
 #include "integrity/raim/wls.hpp"
@@ -166,6 +167,44 @@ std::vector<int> excludedRows(const Linearised& lin, const LiveFixConfig& cfg) {
   return r.fault_excluded ? r.excluded : std::vector<int>{};
 }
 
+/// The PL and test of the outcome "exclude `excluded`" under ExclusionPl::kAllocated
+/// (docs/method.md §3.2a, §4.3): the all-in-view ranges are linearised again at the reduced
+/// solution's last point; ARAIM solves the restricted modes of that geometry with ρ·P_HMI and
+/// tests the reduced solution against their thresholds T_k,j, RAIM takes the reduced geometry's
+/// PL with ρ·P_md and ρ·P_HMI. Without the allocation it is the reduced geometry's own check.
+GeometryCheck checkAfterExclusion(const RangesSeenFrom& ranges_from, const std::vector<int>& all, const Linearised& reduced,
+                                  const std::vector<SatId>& excluded, const LiveFixConfig& cfg) {
+  const bool araim = cfg.method == IntegrityMethod::kAraim;
+  if ((araim ? cfg.araim.exclusion_pl : cfg.raim.exclusion_pl) != ExclusionPl::kAllocated) return checkGeometry(reduced, cfg);
+  std::array<double, kNumConstellations> clock = reduced.clock;
+  bool clocks_set = true;
+  const Eigen::Vector3d x = maps::geodeticToEcef(reduced.user);
+  const Linearised full = linearise(ranges_from(x), all, x, cfg, clock, clocks_set);
+  if (!araim) {
+    LiveFixConfig c = cfg;
+    const int n_exc = raimExclusionCandidates(full.g.numSats(), full.g.numStates(), std::max(1, cfg.raim.max_exclusions));
+    c.raim = outcomeConfig(cfg.raim, 1.0 / (n_exc + 1.0));
+    return checkGeometry(reduced, c);
+  }
+  std::vector<int> rows;
+  for (int r = 0; r < full.g.numSats(); ++r) {
+    if (std::find(excluded.begin(), excluded.end(), full.g.sats[static_cast<std::size_t>(r)]) != excluded.end()) rows.push_back(r);
+  }
+  const FaultModeSet modes = araimFaultModes(full.g, cfg.model, cfg.araim);
+  const double rho = exclusionBudgetShare(exclusionCandidates(full.g, cfg.model, cfg.araim).size());
+  const AraimResult rk = araimLevelsAfterExclusion(full.g, modes, rows, cfg.araim, rho);
+  Eigen::VectorXd yk(full.g.numSats() - static_cast<int>(rows.size()));
+  for (int r = 0, j = 0; r < full.g.numSats(); ++r) {
+    if (!std::binary_search(rows.begin(), rows.end(), r)) yk[j++] = full.y[r];
+  }
+  GeometryCheck out;
+  out.pl = summarize(rk);
+  out.threshold = 1.0;
+  if (rk.pl_computed) out.statistic = solutionSeparationRatio(rk, yk);
+  out.fails = out.statistic > out.threshold;
+  return out;
+}
+
 /// The range indices of `lin` without its `rows`; their satellites go to `excluded`.
 std::vector<int> keptRanges(const Linearised& lin, const std::vector<int>& rows, std::vector<SatId>& excluded) {
   std::vector<int> kept;
@@ -276,7 +315,7 @@ LiveFix solveEpoch(const RangesSeenFrom& ranges_from, const Eigen::Vector3d& x0_
       return out;
     }
     lin = std::move(again);
-    check = checkGeometry(lin, cfg);
+    check = checkAfterExclusion(ranges_from, all, lin, out.excluded, cfg);
     out.fault_excluded = true;
   }
   fillSolution(lin, check, out);

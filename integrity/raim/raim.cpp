@@ -2,6 +2,7 @@
 
 #include "integrity/stats.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -108,8 +109,40 @@ RaimPl raimProtectionLevels(const Geometry& g, const RaimConfig& cfg) {
   return out;
 }
 
-RaimFdeResult raimFde(const Geometry& g, const Eigen::VectorXd& prefit, const RaimConfig& cfg) {
+int raimExclusionCandidates(int n, int m, int max_exclusions) {
+  double total = 0.0, choose = 1.0;  // C(n, r) built up in r
+  for (int r = 1; r <= max_exclusions && n - r > m; ++r) {
+    choose = choose * (n - r + 1) / r;
+    total += choose;
+  }
+  return static_cast<int>(std::min(total, 1e9));
+}
+
+RaimConfig outcomeConfig(const RaimConfig& cfg, double budget_share) {
+  RaimConfig c = cfg;
+  c.pmd *= budget_share;
+  c.phmi_hor *= budget_share;
+  c.phmi_vert *= budget_share;
+  return c;
+}
+
+namespace {
+
+/// The configuration of every outcome of raimFde, with its share of P_md and P_HMI
+/// (docs/method.md §3.2a): P(HMI | fault) ≤ Σ_outcomes P(HMI ∧ outcome | fault) ≤
+/// (N_exc + 1)·ρ·P_md = P_md. Records N_exc and ρ in `out`.
+RaimConfig fdeOutcomeConfig(const Geometry& g, const RaimConfig& cfg, RaimFdeResult& out) {
+  if (cfg.exclusion_pl != ExclusionPl::kAllocated) return cfg;
+  out.exclusion_candidates = raimExclusionCandidates(g.numSats(), g.numStates(), cfg.max_exclusions);
+  out.budget_share = 1.0 / (out.exclusion_candidates + 1.0);
+  return outcomeConfig(cfg, out.budget_share);
+}
+
+}  // namespace
+
+RaimFdeResult raimFde(const Geometry& g, const Eigen::VectorXd& prefit, const RaimConfig& fde_cfg) {
   RaimFdeResult out;
+  const RaimConfig cfg = fdeOutcomeConfig(g, fde_cfg, out);
   std::vector<int> kept(static_cast<std::size_t>(g.numSats()));
   for (int i = 0; i < g.numSats(); ++i) kept[static_cast<std::size_t>(i)] = i;
   Geometry cur = g;

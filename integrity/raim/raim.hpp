@@ -13,6 +13,7 @@
 /// K_md → k_md, σ_V → sigma_v_m.
 
 #include "integrity/raim/wls.hpp"
+#include "integrity/requirements.hpp"
 
 #include <Eigen/Core>
 
@@ -55,6 +56,10 @@ struct RaimConfig {
   double phmi_vert = 9.8e-8;///< fault-free vertical integrity budget (K_ff,V)
   RaimPlFormula formula = RaimPlFormula::kSlopePbiasPlusNoise;
   int max_exclusions = 1;   ///< w-test exclusions attempted per epoch
+  /// The PL of raimFde's outcomes (docs/method.md §3.2a): kAllocated gives every outcome —
+  /// no exclusion and each of the N_exc possible exclusions — ρ = 1/(N_exc + 1) of P_md and of
+  /// P_HMI, so that a wrong exclusion is bounded; kRemainingGeometry is the plain PL.
+  ExclusionPl exclusion_pl = ExclusionPl::kAllocated;
 };
 
 /// \brief Protection levels for one geometry (no measurements needed).
@@ -88,9 +93,19 @@ struct RaimFdeResult {
   Eigen::VectorXd residuals;    ///< post-fit residuals of all input satellites [m]
   double test_statistic = 0.0;  ///< √(rᵀWr) of the final solution (normalised; compare to threshold)
   double threshold = 0.0;       ///< T_d of the final solution (0 when dof = 0)
-  RaimPl pl;                    ///< protection levels of the final geometry
+  RaimPl pl;                    ///< protection levels of the final geometry (outcome share budget_share)
   Geometry final_geometry;
+  int exclusion_candidates = 0; ///< N_exc: the exclusions raimFde may make (Σ_r C(n, r), r ≤ max_exclusions)
+  double budget_share = 1.0;    ///< ρ the outcome's PL was solved with (1/(N_exc + 1) under kAllocated)
 };
+
+/// \brief N_exc for `n` satellites and `m` states: every set of up to `max_exclusions`
+/// satellites whose removal leaves redundancy (n − r > m), Σ_r C(n, r).
+[[nodiscard]] int raimExclusionCandidates(int n, int m, int max_exclusions);
+
+/// \brief `cfg` for one outcome of FDE with share ρ: P_md, P_HMI,H and P_HMI,V multiplied by ρ
+/// (the detection threshold, from P_fa, is unchanged).
+[[nodiscard]] RaimConfig outcomeConfig(const RaimConfig& cfg, double budget_share);
 
 /// \brief Least-squares residual test, then w-test exclusion of the worst satellite while the
 /// test fails and exclusions remain. `prefit` holds measured − predicted ranges [m].

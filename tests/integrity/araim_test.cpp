@@ -389,13 +389,16 @@ TEST(AraimAvailability, MoreSatellitesDoNotRaiseUnavailableEpochsBeyondTheModelA
 // GIVEN the ADD Appendix D geometry and noise-free measurements of a known position
 // WHEN one satellite carries a large bias
 // THEN the solution-separation test detects it, the exclusion removes exactly that satellite,
-// the remaining solution is the true one and its protection levels are those of the reduced
-// geometry. (Every candidate is visited after the first valid exclusion; the loop used to read
-// the candidate list after replacing it — a use after free found by ASan.)
+// the remaining solution is the true one and, under the plain rule this test names
+// (ExclusionPl::kRemainingGeometry), its protection levels are those of the reduced geometry.
+// (Every candidate is visited after the first valid exclusion; the loop used to read the
+// candidate list after replacing it — a use after free found by ASan.) The default allocated
+// PL after exclusion is tested in exclusion_test.cpp.
 TEST(AraimFde, ExcludesTheBiasedSatelliteAndRecoversThePosition) {
   const Geometry g = addExampleGeometry();
   const ErrorModel model = ismWith(1e-5, 1e-4);
-  const AraimConfig cfg;
+  AraimConfig cfg;
+  cfg.exclusion_pl = ExclusionPl::kRemainingGeometry;
   Eigen::VectorXd x_true(5);
   x_true << 3.0, -2.0, 5.0, 12.0, -7.0;
   const Eigen::VectorXd clean = g.G * x_true;

@@ -33,6 +33,17 @@ TEST(GeometryFile, AraimRuleConsolidationAndEmtConventionAreRead) {
   EXPECT_EQ(in.araim.rule, FaultModeRule::kJointEvents);
   EXPECT_DOUBLE_EQ(in.araim.fc_thres, 0.01);
   EXPECT_EQ(in.araim.emt_probability, EmtProbability::kEventProduct);
+  EXPECT_EQ(in.araim.exclusion_pl, ExclusionPl::kAllocated);  // the default
+  EXPECT_FALSE(in.araim.exclude_constellations);
+}
+
+TEST(GeometryFile, ExclusionPlRuleIsReadForRaimAndAraim) {
+  const GeometryInput in = parseGeometry(json::parse(R"({"satellites":[],
+      "raim":{"exclusion_pl":"remaining_geometry"},
+      "araim":{"exclusion_pl":"remaining_geometry","exclude_constellations":true}})"), "g.json");
+  EXPECT_EQ(in.raim.exclusion_pl, ExclusionPl::kRemainingGeometry);
+  EXPECT_EQ(in.araim.exclusion_pl, ExclusionPl::kRemainingGeometry);
+  EXPECT_TRUE(in.araim.exclude_constellations);
 }
 
 TEST(GeometryFile, OverridesArePerConstellation) {
@@ -69,6 +80,11 @@ TEST(GeometryFile, ErrorsNameTheFieldTheValueAndWhatWasExpected) {
        "field 'araim.fault_mode_rule': got '\"all\"', expected \"adds_until_threshold\", \"joint_events\" or \"blanch2012\""},
       {R"({"satellites":[],"araim":{"fc_thres":1}})", "field 'araim.fc_thres': got '1', expected a fraction in [0, 1)"},
       {R"({"satellites":[],"araim":{"emt_probability":"rate"}})", "field 'araim.emt_probability': got '\"rate\"'"},
+      {R"({"satellites":[],"araim":{"exclusion_pl":"plain"}})",
+       "field 'araim.exclusion_pl': got '\"plain\"', expected \"allocated\" or \"remaining_geometry\""},
+      {R"({"satellites":[],"raim":{"exclusion_pl":1}})", "field 'raim.exclusion_pl': got '1'"},
+      {R"({"satellites":[],"araim":{"exclude_constellations":"yes"}})",
+       "field 'araim.exclude_constellations': got '\"yes\"', expected true or false"},
   };
   for (const auto& c : cases) {
     const std::string msg = test::messageOf<ParseError>([&] { (void)parseGeometry(json::parse(c.doc), "g.json"); });

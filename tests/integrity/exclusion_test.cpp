@@ -1,0 +1,221 @@
+// Protection levels after fault exclusion (docs/method.md §3.2a, §4.3): the restricted fault
+// modes, the budget share ρ = 1/(N_exc + 1), and the PLs of RAIM and ARAIM FDE outcomes.
+#include "integrity/araim/exclusion.hpp"
+#include "integrity/araim/fde.hpp"
+#include "integrity/raim/raim.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace skylane::integrity {
+namespace {
+
+/// The ADD v3.0 Appendix D geometry (10 satellites, GPS + Galileo), as in araim_test.cpp.
+Geometry addExampleGeometry() {
+  const double rows[10][5] = {{0.0225, 0.9951, -0.0966, 1, 0},   {0.6750, -0.6900, -0.2612, 1, 0},
+                              {0.0723, -0.6601, -0.7477, 1, 0},  {-0.9398, 0.2553, -0.2269, 1, 0},
+                              {-0.5907, -0.7539, -0.2877, 1, 0}, {-0.3236, -0.0354, -0.9455, 0, 1},
+                              {-0.6748, 0.4356, -0.5957, 0, 1},  {0.0938, -0.7004, -0.7075, 0, 1},
+                              {0.5571, 0.3088, -0.7709, 0, 1},   {0.6622, 0.6958, -0.2780, 0, 1}};
+  const double c_int[10] = {3.8865, 1.4377, 0.8604, 1.6383, 1.3229, 0.8434, 0.8963, 0.8669, 0.8573, 1.3616};
+  Geometry g;
+  g.G.resize(10, 5);
+  g.sigma_int.resize(10);
+  g.sigma_acc.resize(10);
+  g.bnom = Eigen::VectorXd::Constant(10, 0.5);
+  g.clocks = {Constellation::kGps, Constellation::kGalileo};
+  for (int i = 0; i < 10; ++i) {
+    for (int j = 0; j < 5; ++j) g.G(i, j) = rows[i][j];
+    g.sigma_int[i] = std::sqrt(c_int[i]);
+    g.sigma_acc[i] = std::sqrt(c_int[i] - (0.75 * 0.75 - 0.5 * 0.5));
+    g.sats.push_back({i < 5 ? Constellation::kGps : Constellation::kGalileo, i % 5 + 1});
+    g.elevation_rad.push_back(0.5);
+  }
+  return g;
+}
+
+ErrorModel ismWith(double psat, double pconst) {
+  ErrorModel m;
+  for (Constellation c : kAllConstellations) {
+    m.of(c).psat = psat;
+    m.of(c).pconst = pconst;
+  }
+  return m;
+}
+
+TEST(ExclusionModes, RestrictionRenumbersDropsCoveredModesAndMergesCoincidingOnes) {
+  // GIVEN modes {0}, {1}, {0,1}, {2}, {1,3} on four satellites, P_nm 1e-9
+  FaultModeSet all;
+  all.p_not_monitored = 1e-9;
+  all.n_fault_max = 2;
+  all.modes = {{{0}, 1e-3, 1e-3, 1}, {{1}, 2e-3, 2e-3, 1}, {{0, 1}, 1e-6, 1e-6, 2}, {{2}, 3e-3, 3e-3, 1},
+               {{1, 3}, 5e-6, 5e-6, 2}};
+  // WHEN satellite 1 is excluded
+  const FaultModeSet r = restrictFaultModes(all, {1});
+  // THEN {1} is covered by the fault-free term, {0,1} merges into {0}, {2} → {1}, {1,3} → {2}
+  ASSERT_EQ(r.modes.size(), 3u);
+  EXPECT_EQ(r.modes[0].removed, std::vector<int>{0});
+  EXPECT_DOUBLE_EQ(r.modes[0].prior, 1e-3 + 1e-6);
+  EXPECT_EQ(r.modes[0].events, 1);
+  EXPECT_EQ(r.modes[1].removed, std::vector<int>{1});
+  EXPECT_DOUBLE_EQ(r.modes[1].prior, 3e-3);
+  EXPECT_EQ(r.modes[2].removed, std::vector<int>{2});
+  EXPECT_DOUBLE_EQ(r.modes[2].prior, 5e-6);
+  EXPECT_DOUBLE_EQ(r.p_not_monitored, 1e-9);
+  EXPECT_EQ(r.n_fault_max, 2);
+}
+
+TEST(ExclusionCandidates, EverySatelliteAndTheWideFaultsAboveTheBudget) {
+  const Geometry g = addExampleGeometry();
+  AraimConfig cfg;  // P_HMI 1e-7
+  EXPECT_EQ(exclusionCandidates(g, ismWith(1e-5, 1e-4), cfg).size(), 10u);  // satellites only by default
+  cfg.exclude_constellations = true;
+  // P_const 1e-4 > P_HMI: both constellations are candidates (MAAST: p_const > 1e-7)
+  EXPECT_EQ(exclusionCandidates(g, ismWith(1e-5, 1e-4), cfg).size(), 12u);
+  EXPECT_EQ(exclusionCandidates(g, ismWith(1e-5, 1e-4), cfg)[10], (std::vector<int>{0, 1, 2, 3, 4}));
+  // P_const 1e-8: only the satellites
+  EXPECT_EQ(exclusionCandidates(g, ismWith(1e-5, 1e-8), cfg).size(), 10u);
+  EXPECT_DOUBLE_EQ(exclusionBudgetShare(12), 1.0 / 13.0);
+  // and the prediction then has no PL: after Galileo is excluded a GPS fault (1e-4) is unmonitorable
+  const AraimResult wide = araimFdeProtectionLevels(g, ismWith(1e-5, 1e-4), cfg);
+  EXPECT_FALSE(wide.pl_computed);
+  EXPECT_NE(wide.reason.find("an exclusion outcome has no protection level"), std::string::npos) << wide.reason;
+}
+
+TEST(ExclusionPl, NoExclusionAtFullShareIsTheDetectionOnlyPl) {
+  const Geometry g = addExampleGeometry();
+  const ErrorModel model = ismWith(1e-5, 1e-4);
+  const AraimConfig cfg;
+  const AraimResult fd = araimProtectionLevels(g, model, cfg);
+  const AraimResult same = araimLevelsAfterExclusion(g, araimFaultModes(g, model, cfg), {}, cfg, 1.0);
+  ASSERT_TRUE(same.pl_computed);
+  EXPECT_DOUBLE_EQ(same.vpl_m, fd.vpl_m);
+  EXPECT_DOUBLE_EQ(same.hpl_m, fd.hpl_m);
+  EXPECT_EQ(same.fault_modes, fd.fault_modes);
+}
+
+// GIVEN the ADD example, P_sat 1e-5, P_const 1e-4 (10 candidates, ρ = 1/11)
+// WHEN satellite k is excluded
+// THEN the outcome's modes are the all-in-view modes without k's satellite, its VPL solves the
+// risk equation at ρ·𝓑_V, and it is above the plain PL of the remaining geometry
+TEST(ExclusionPl, AraimOutcomeSolvesTheRestrictedRiskEquationAtItsShare) {
+  const Geometry g = addExampleGeometry();
+  const ErrorModel model = ismWith(1e-5, 1e-4);
+  AraimConfig cfg;
+  cfg.requirements.tol_pl_m = 1e-6;
+  const FaultModeSet modes = araimFaultModes(g, model, cfg);
+  const double rho = exclusionBudgetShare(exclusionCandidates(g, model, cfg).size());
+  for (int k : {0, 5, 9}) {
+    const AraimResult r = araimLevelsAfterExclusion(g, modes, {k}, cfg, rho);
+    ASSERT_TRUE(r.pl_computed) << r.reason;
+    EXPECT_DOUBLE_EQ(r.budget_share, 1.0 / 11.0);
+    // the modes, mapped back to the all-in-view numbering and with k added back
+    std::set<std::vector<int>> expected, got;
+    for (const FaultMode& m : modes.modes) {
+      std::vector<int> with_k = m.removed;
+      if (std::find(with_k.begin(), with_k.end(), k) == with_k.end()) with_k.push_back(k);
+      std::sort(with_k.begin(), with_k.end());
+      if (with_k != std::vector<int>{k}) expected.insert(with_k);
+    }
+    for (const SubsetSolution& s : r.subsets) {
+      std::vector<int> back{k};
+      for (int i : s.removed) back.push_back(i < k ? i : i + 1);
+      std::sort(back.begin(), back.end());
+      got.insert(back);
+    }
+    EXPECT_EQ(got, expected) << "excluded " << k;
+    // the vertical risk at the VPL is the budget share (within the solver's tolerance)
+    std::vector<RiskTerm> terms{{2.0, 0.0, r.bias0[2], r.sigma0[2]}};
+    for (const SubsetSolution& s : r.subsets) terms.push_back({s.prior, s.threshold[2], s.bias[2], s.sigma[2]});
+    const Requirements& q = cfg.requirements;
+    const double budget = rho * q.phmi_vert * (1.0 - r.p_not_monitored / (q.phmi_vert + q.phmi_hor));
+    EXPECT_LE(integrityRisk(terms, r.vpl_m), budget);
+    EXPECT_GT(integrityRisk(terms, r.vpl_m - 2e-6), budget);
+    const AraimResult plain = araimProtectionLevels(g.without(k), model, cfg);
+    EXPECT_GT(r.vpl_m, plain.vpl_m) << "excluded " << k;
+  }
+}
+
+TEST(ExclusionPl, AraimFdeExcludesTheBiasedSatelliteAndReportsTheOutcomePl) {
+  const Geometry g = addExampleGeometry();
+  const ErrorModel model = ismWith(1e-5, 1e-4);
+  const AraimConfig cfg;  // ExclusionPl::kAllocated
+  Eigen::VectorXd x_true(5);
+  x_true << 3.0, -2.0, 5.0, 12.0, -7.0;
+  const Eigen::VectorXd clean = g.G * x_true;
+  const FaultModeSet modes = araimFaultModes(g, model, cfg);
+  for (int faulty : {0, 3, 6, 9}) {
+    Eigen::VectorXd y = clean;
+    y[faulty] += 60.0;
+    const AraimFdeResult r = araimFde(g, y, model, cfg);
+    ASSERT_TRUE(r.fault_excluded) << "satellite " << faulty;
+    ASSERT_EQ(r.excluded, std::vector<int>{faulty});
+    EXPECT_EQ(r.exclusion_candidates, 10);
+    for (int q = 0; q < 3; ++q) EXPECT_NEAR(r.dx[q], x_true[q], 1e-6);
+    const AraimResult outcome = araimLevelsAfterExclusion(g, modes, {faulty}, cfg, 1.0 / 11.0);
+    EXPECT_DOUBLE_EQ(r.pl.vpl_m, outcome.vpl_m);
+    EXPECT_DOUBLE_EQ(r.pl.hpl_m, outcome.hpl_m);
+    EXPECT_LE(r.max_test_ratio, 1.0);
+  }
+  // no fault: the no-exclusion outcome, also at ρ = 1/11, above the detection-only PL
+  const AraimFdeResult quiet = araimFde(g, clean, model, cfg);
+  EXPECT_FALSE(quiet.fault_detected);
+  EXPECT_DOUBLE_EQ(quiet.pl.budget_share, 1.0 / 11.0);
+  EXPECT_GT(quiet.pl.vpl_m, araimProtectionLevels(g, model, cfg).vpl_m);
+}
+
+TEST(ExclusionPl, AraimPredictionIsTheMaximumOverTheOutcomes) {
+  const Geometry g = addExampleGeometry();
+  const ErrorModel model = ismWith(1e-5, 1e-4);
+  const AraimConfig cfg;
+  const AraimResult fde = araimFdeProtectionLevels(g, model, cfg);
+  ASSERT_TRUE(fde.pl_computed) << fde.reason;
+  const FaultModeSet modes = araimFaultModes(g, model, cfg);
+  const double rho = 1.0 / 11.0;
+  double vpl = araimLevelsOverModes(g, modes, cfg, rho).vpl_m, hpl = araimLevelsOverModes(g, modes, cfg, rho).hpl_m;
+  for (const std::vector<int>& k : exclusionCandidates(g, model, cfg)) {
+    const AraimResult r = araimLevelsAfterExclusion(g, modes, k, cfg, rho);
+    ASSERT_TRUE(r.pl_computed) << r.reason;
+    vpl = std::max(vpl, r.vpl_m);
+    hpl = std::max(hpl, r.hpl_m);
+  }
+  EXPECT_DOUBLE_EQ(fde.vpl_m, vpl);
+  EXPECT_DOUBLE_EQ(fde.hpl_m, hpl);
+  EXPECT_GT(fde.vpl_m, araimProtectionLevels(g, model, cfg).vpl_m);
+}
+
+TEST(ExclusionPl, RaimCandidatesAreTheSetsThatLeaveRedundancy) {
+  EXPECT_EQ(raimExclusionCandidates(10, 4, 1), 10);
+  EXPECT_EQ(raimExclusionCandidates(10, 4, 2), 10 + 45);
+  EXPECT_EQ(raimExclusionCandidates(6, 4, 2), 6);  // two out leaves no redundancy
+  EXPECT_EQ(raimExclusionCandidates(5, 4, 1), 0);
+}
+
+TEST(ExclusionPl, RaimFdeOutcomeHasItsShareOfPmdAndPhmi) {
+  const Geometry g = addExampleGeometry();
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(g.numSats());
+  y[6] = 80.0;
+  const RaimConfig cfg;  // ExclusionPl::kAllocated, one exclusion: N_exc = 10
+  const RaimFdeResult r = raimFde(g, y, cfg);
+  ASSERT_TRUE(r.fault_excluded);
+  ASSERT_EQ(r.excluded, std::vector<int>{6});
+  EXPECT_EQ(r.exclusion_candidates, 10);
+  EXPECT_DOUBLE_EQ(r.budget_share, 1.0 / 11.0);
+  const RaimPl outcome = raimProtectionLevels(g.without(6), outcomeConfig(cfg, 1.0 / 11.0));
+  EXPECT_DOUBLE_EQ(r.pl.vpl_m, outcome.vpl_m);
+  EXPECT_DOUBLE_EQ(r.pl.hpl_m, outcome.hpl_m);
+  RaimConfig plain = cfg;
+  plain.exclusion_pl = ExclusionPl::kRemainingGeometry;
+  const RaimFdeResult p = raimFde(g, y, plain);
+  EXPECT_DOUBLE_EQ(p.pl.vpl_m, raimProtectionLevels(g.without(6), cfg).vpl_m);
+  EXPECT_GT(r.pl.vpl_m, p.pl.vpl_m);
+  // p_bias at ρ·P_md: the threshold (from P_fa) is the same
+  EXPECT_DOUBLE_EQ(r.pl.thresholds.threshold, p.pl.thresholds.threshold);
+  EXPECT_GT(r.pl.thresholds.p_bias, p.pl.thresholds.p_bias);
+}
+
+}  // namespace
+}  // namespace skylane::integrity
