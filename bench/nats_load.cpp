@@ -36,6 +36,7 @@ namespace fs = std::filesystem;
 
 struct Options {
   int flights = 10000, seconds = 60, workers = 2, partitions = 8;
+  bool drain = false;  ///< publish everything first, then start the workers: their throughput alone
   std::string skylane = SKYLANE_BINARY;
 };
 
@@ -48,6 +49,7 @@ Options parse(int argc, char** argv) {
     else if (k == "--workers") o.workers = std::stoi(v);
     else if (k == "--partitions") o.partitions = std::stoi(v);
     else if (k == "--skylane") o.skylane = v;
+    else if (k == "--drain") o.drain = v == "1";
     else throw std::invalid_argument("unknown option " + k);
   }
   return o;
@@ -146,15 +148,18 @@ int main(int argc, char** argv) try {
   const json rep = approveExample(o, server, dir, c);
   const std::vector<std::string> fixes = routeFixes(rep, o.seconds);
   std::vector<std::unique_ptr<ChildProcess>> workers;
-  for (int w = 0; w < o.workers; ++w) {
-    workers.push_back(std::make_unique<ChildProcess>(
-        std::vector<std::string>{o.skylane, "worker", "--nats", server.url(), "--role", "track", "--name", "tr" + std::to_string(w), "--cache",
-                                 (dir / ("cache" + std::to_string(w))).string()},
-        (dir / ("track" + std::to_string(w) + ".log")).string()));
-  }
-  std::this_thread::sleep_for(std::chrono::seconds(3));
   double idle_rss = 0;
-  for (auto& w : workers) idle_rss += rssMiB(w->pid());
+  const auto startWorkers = [&] {
+    for (int w = 0; w < o.workers; ++w) {
+      workers.push_back(std::make_unique<ChildProcess>(
+          std::vector<std::string>{o.skylane, "worker", "--nats", server.url(), "--role", "track", "--name", "tr" + std::to_string(w), "--cache",
+                                   (dir / ("cache" + std::to_string(w))).string()},
+          (dir / ("track" + std::to_string(w) + ".log")).string()));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    for (auto& w : workers) idle_rss += rssMiB(w->pid());
+  };
+  if (!o.drain) startWorkers();
   std::vector<std::vector<Clock::time_point>> published(static_cast<std::size_t>(o.seconds), std::vector<Clock::time_point>(static_cast<std::size_t>(o.flights)));
   EventReader reader;
   reader.published = &published;
@@ -182,7 +187,7 @@ int main(int argc, char** argv) try {
   const auto t0 = Clock::now();
   for (int k = 0; k < o.seconds; ++k) {
     for (int f = 0; f < o.flights; ++f) {
-      if (f % 100 == 0) std::this_thread::sleep_until(t0 + std::chrono::duration<double>(k + static_cast<double>(f) / o.flights));
+      if (f % 100 == 0 && !o.drain) std::this_thread::sleep_until(t0 + std::chrono::duration<double>(k + static_cast<double>(f) / o.flights));
       published[static_cast<std::size_t>(k)][static_cast<std::size_t>(f)] = Clock::now();
       c.publishAsync(subjects[static_cast<std::size_t>(f)], fixes[static_cast<std::size_t>(k)]);
     }
@@ -199,10 +204,15 @@ int main(int argc, char** argv) try {
     max_lag = std::max(max_lag, lag);
     if (k % 10 == 9) std::cerr << "  t=" << k + 1 << " s: " << reader.fixes.load() << " fix events, lag " << lag << " fixes\n";
   }
-  const double publish_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  double publish_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  auto t_judge = t0;
+  if (o.drain) {  // the workers start on a full stream: the time they take is their throughput
+    startWorkers();
+    t_judge = Clock::now();
+  }
   const std::size_t total = static_cast<std::size_t>(o.flights) * static_cast<std::size_t>(o.seconds);
   for (int i = 0; i < 600 && reader.fixes.load() < total; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  const double all_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  const double all_s = std::chrono::duration<double>(Clock::now() - t_judge).count();
   double rss = 0;
   for (auto& w : workers) rss += rssMiB(w->pid());
   std::this_thread::sleep_for(std::chrono::seconds(11));  // the workers' next counters line

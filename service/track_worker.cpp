@@ -83,7 +83,15 @@ class Worker {
   void refreshLeases();
   bool acquire(Partition& p);
   void drop(Partition& p, const std::string& why);
-  bool runBatch(Partition& p, std::chrono::milliseconds wait);
+  /// A partition's batch taken in a round.
+  struct Taken {
+    Partition* p;
+    std::vector<NatsMessage> msgs;
+  };
+  std::vector<Taken> fetchRound(std::chrono::milliseconds wait);
+  bool runRound(std::chrono::milliseconds wait);
+  void putFlightCheckpoints(Partition& p);
+  bool putPartitionCheckpoint(Partition& p, std::uint64_t last_seq);
   void judge(Partition& p, const NatsMessage& m, std::vector<Outgoing>& out);
   void judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, const json& body, std::vector<Outgoing>& out);
   void startFlight(Partition& p, FlightSlot& slot, const json& body);
@@ -92,7 +100,7 @@ class Worker {
   void checkZoneSets();
   void followZoneSets(Partition& p, const std::string& dir, ApprovalZones& a);
   void sweepStale(Partition& p, std::uint64_t last_seq, std::vector<Outgoing>& out);
-  void commit(Partition& p, std::vector<Outgoing>& out, std::uint64_t last_seq);
+  void commit(std::vector<Taken>& taken, const std::vector<Outgoing>& out);
   void reject(const NatsMessage& m, const std::string& subject, const std::string& why, std::vector<Outgoing>& out);
   void report(Clock::time_point& last) const;
 
@@ -386,13 +394,8 @@ void Worker::sweepStale(Partition& p, std::uint64_t last_seq, std::vector<Outgoi
   }
 }
 
-/// Events, then the flights' checkpoints, then the partition's (compare-and-set), each step
-/// acknowledged before the next.
-void Worker::commit(Partition& p, std::vector<Outgoing>& out, std::uint64_t last_seq) {
-  // The events first and acknowledged: a checkpoint never covers a fix whose events are not kept.
-  for (const Outgoing& o : out) nats_.publishAsync(o.subject, o.data, o.msg_id);
-  nats_.publishesComplete();
-  c_.events += out.size();
+/// The flights' checkpoints of a partition judged in this round (put without waiting).
+void Worker::putFlightCheckpoints(Partition& p) {
   for (auto& [id, slot] : p.flights) {
     if (!slot.dirty) continue;
     json cp = {{"approval", slot.approval}, {"seq", slot.covered_seq}};
@@ -409,31 +412,72 @@ void Worker::commit(Partition& p, std::vector<Outgoing>& out, std::uint64_t last
     nats_.putAsync(nats::kFlightBucket, id, cp.dump());
     slot.dirty = false;
   }
-  nats_.publishesComplete();
+}
+
+/// The partition's checkpoint (compare-and-set on its revision): false when another worker has
+/// written it since — this one has lost the partition.
+bool Worker::putPartitionCheckpoint(Partition& p, std::uint64_t last_seq) {
   const std::string value = json{{"seq", last_seq}, {"worker", o_.name}}.dump();
   const auto rev = p.checkpoint_rev == 0 ? nats_.create(nats::kPartitionBucket, leaseKey(p.index), value)
                                          : nats_.update(nats::kPartitionBucket, leaseKey(p.index), value, p.checkpoint_rev);
-  if (!rev) {
-    drop(p, "another worker checkpointed it");
-    return;
-  }
+  if (!rev) return false;
   p.checkpoint_rev = *rev;
   p.covered_seq = last_seq;
+  return true;
 }
 
-bool Worker::runBatch(Partition& p, std::chrono::milliseconds wait) {
-  const std::vector<NatsMessage> msgs = p.pull->fetch(o_.batch, wait);
-  if (msgs.empty()) return false;
-  checkZoneSets();  // a zone set put before these fixes were fetched is in force for them
-  // Without acknowledgements a delivery lost with a connection is not sent again: a gap in the
-  // consumer's count starts the partition again from its checkpoint.
-  for (const NatsMessage& m : msgs) {
-    if (m.consumer_seq != ++p.deliveries) throw NatsError("delivery " + std::to_string(m.consumer_seq) + " came where " + std::to_string(p.deliveries) + " was due");
+/// Events, then the flights' checkpoints, then each partition's, each step acknowledged before
+/// the next: a checkpoint never covers a fix whose events are not kept.
+void Worker::commit(std::vector<Taken>& taken, const std::vector<Outgoing>& out) {
+  for (const Outgoing& o : out) nats_.publishAsync(o.subject, o.data, o.msg_id);
+  nats_.publishesComplete();
+  c_.events += out.size();
+  for (Taken& t : taken) putFlightCheckpoints(*t.p);
+  nats_.publishesComplete();
+  for (Taken& t : taken) {
+    if (!putPartitionCheckpoint(*t.p, t.msgs.back().stream_seq)) drop(*t.p, "another worker checkpointed it");
   }
-  std::vector<Outgoing> out;
-  for (const NatsMessage& m : msgs) judge(p, m, out);
-  sweepStale(p, msgs.back().stream_seq, out);
-  commit(p, out, msgs.back().stream_seq);
+}
+
+/// Each held partition's next batch. Without acknowledgements a delivery lost with a connection
+/// is not sent again: a gap in a consumer's count starts its partition again from its checkpoint.
+std::vector<Worker::Taken> Worker::fetchRound(std::chrono::milliseconds wait) {
+  std::vector<Taken> taken;
+  for (Partition& p : parts_) {
+    if (!p.held) continue;
+    try {
+      std::vector<NatsMessage> msgs = p.pull->fetch(o_.batch, wait);
+      for (const NatsMessage& m : msgs) {
+        if (m.consumer_seq != ++p.deliveries) {
+          throw NatsError("delivery " + std::to_string(m.consumer_seq) + " came where " + std::to_string(p.deliveries) + " was due");
+        }
+      }
+      if (!msgs.empty()) taken.push_back({&p, std::move(msgs)});
+    } catch (const std::exception& e) {
+      drop(p, e.what());
+      ++c_.restarts;
+    }
+  }
+  return taken;
+}
+
+/// One round: every held partition's batch judged, then committed together (the round trips to
+/// the server are per round, not per partition).
+bool Worker::runRound(std::chrono::milliseconds wait) {
+  std::vector<Taken> taken = fetchRound(wait);
+  if (taken.empty()) return false;
+  try {
+    checkZoneSets();  // a zone set put before these fixes were fetched is in force for them
+    std::vector<Outgoing> out;
+    for (Taken& t : taken) {
+      for (const NatsMessage& m : t.msgs) judge(*t.p, m, out);
+      sweepStale(*t.p, t.msgs.back().stream_seq, out);
+    }
+    commit(taken, out);
+  } catch (const std::exception& e) {  // NATS gone or refused: the partitions start again from their checkpoints
+    for (Taken& t : taken) drop(*t.p, e.what());
+    ++c_.restarts;
+  }
   return true;
 }
 
@@ -448,6 +492,7 @@ void Worker::report(Clock::time_point& last) const {
 void Worker::run(const std::atomic<bool>& stop) {
   choosePartitions();
   Clock::time_point last_refresh{}, last_report = Clock::now();
+  bool busy = false;
   while (!stop.load()) {
     if (Clock::now() - last_refresh >= std::chrono::seconds(1)) {
       refreshLeases();
@@ -455,19 +500,10 @@ void Worker::run(const std::atomic<bool>& stop) {
     }
     const int held = c_.partitions_held.load();
     // A fetch waits for a full batch or this long: short, so that a quiet partition does not
-    // hold up the others (a batch is also judged as soon as it is full).
-    const auto wait = std::chrono::milliseconds(held > 0 ? std::max(2, 20 / held) : 0);
-    bool busy = false;
-    for (Partition& p : parts_) {
-      if (!p.held) continue;
-      try {
-        busy = runBatch(p, wait) || busy;
-      } catch (const std::exception& e) {  // NATS gone or refused: start the partition again from its checkpoint
-        drop(p, e.what());
-        ++c_.restarts;
-      }
-    }
-    if (held == 0 || (!busy && c_.partitions_held.load() == 0)) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    // hold up the others; 1 ms while there is work.
+    const auto wait = std::chrono::milliseconds(busy ? 1 : held > 0 ? std::max(2, 20 / held) : 0);
+    busy = held > 0 && runRound(wait);
+    if (held == 0) std::this_thread::sleep_for(std::chrono::milliseconds(200));
     report(last_report);
   }
   for (Partition& p : parts_) {
