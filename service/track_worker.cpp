@@ -297,6 +297,11 @@ void Worker::followZoneSets(Partition& p, const std::string& dir, ApprovalZones&
     } catch (const std::exception& ex) {  // a version the fence cannot use: the one before stays
       maps::writeFileAtomically(path, before, "zone set file");
       log("zone set " + name + " version " + std::to_string(e->revision) + " not taken: " + ex.what());
+      const std::string subject = "$KV." + nats::kZoneSetBucket + "." + name;
+      json r = planner::rejectedInputEvent(subject, 0, std::string("version ") + std::to_string(e->revision) + " not taken, version " +
+                                                             std::to_string(f.version) + " stays in force: " + ex.what()).toJson();
+      r["subject"] = subject;
+      nats_.publishAsync(nats::kRejectedSubject, r.dump(), "zoneset." + name + "." + std::to_string(e->revision));
     }
   }
   maps::writeFileAtomically((fs::path(dir) / "zonesets.json").string(), zoneSetsText(a.zonesets) + "\n", "zone sets");

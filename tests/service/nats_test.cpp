@@ -346,6 +346,25 @@ TEST_F(NatsWorkers, AZoneSetUpdateIsInForceForEveryFixPublishedAfterIt) {
     }();
   }
   EXPECT_LT(seconds, 30.0);
+  // A version the fence cannot use, put straight into the bucket (no CLI validation): rejected by
+  // name, and the fixes after it are still judged against version 2.
+  const std::uint64_t v3 = client_->put(nats::kZoneSetBucket, "authority.zurich", "{\"UASZoneList\": [{\"identifier\": 3}]}");
+  for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), fixAt(rep, 30).dump());
+  const std::vector<json> after = waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= 124 && count(e, "rejected_input") >= 1; });
+  ASSERT_EQ(count(after, "fix"), 124u);
+  const auto departure = *maps::parseRfc3339(rep.at("departure").get<std::string>());
+  std::size_t judged_after = 0;
+  for (const json& e : after) {
+    if (e.at("event") == "fix" && *maps::parseRfc3339(e.at("time").get<std::string>()) - departure > 29.5) {
+      EXPECT_EQ(e.at("zonesets").at("authority.zurich"), v2);
+      ++judged_after;
+    }
+    if (e.at("event") == "rejected_input") {
+      EXPECT_EQ(e.at("subject"), "$KV.skylane_zonesets.authority.zurich");
+      EXPECT_NE(e.at("error").get<std::string>().find("version " + std::to_string(v3) + " not taken"), std::string::npos) << e.dump();
+    }
+  }
+  EXPECT_EQ(judged_after, flights.size());
   EXPECT_NE((w1->log() + w2->log()).find("zone set authority.zurich version " + std::to_string(v2) + " in force"), std::string::npos);
 }
 
