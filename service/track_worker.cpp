@@ -49,6 +49,7 @@ struct Partition {
   bool held = false;
   std::uint64_t lease_rev = 0, checkpoint_rev = 0, covered_seq = 0;
   std::uint64_t deliveries = 0;  ///< messages taken from the consumer since it was made
+  std::uint64_t judged_seq = 0;  ///< the last fix sequence judged (its events kept)
   std::unique_ptr<NatsPull> pull;
   std::unique_ptr<planner::Tracker> tracker;
   std::map<std::string, FlightSlot> flights;  ///< by tracker id "<operator>.<flight>"
@@ -101,6 +102,7 @@ class Worker {
   void followZoneSets(Partition& p, const std::string& dir, ApprovalZones& a);
   void sweepStale(Partition& p, std::uint64_t last_seq, std::vector<Outgoing>& out);
   void commit(std::vector<Taken>& taken, const std::vector<Outgoing>& out);
+  void checkpointAll();
   void reject(const NatsMessage& m, const std::string& subject, const std::string& why, std::vector<Outgoing>& out);
   void report(Clock::time_point& last) const;
 
@@ -110,9 +112,14 @@ class Worker {
   std::vector<Partition> parts_;
   int partition_count_ = 0;
   std::uint64_t zone_seq_ = 0;  ///< the zone set bucket's last sequence when last looked at
+  Clock::time_point last_checkpoint_{};
 };
 
 std::string leaseKey(int k) { return "p" + std::to_string(k); }
+
+/// How often the flights' and partitions' checkpoints are written (one key-value put per flight
+/// judged since: at 1 Hz fixes, a put per flight every period instead of per fix).
+constexpr std::chrono::seconds kCheckpointPeriod{2};
 
 void Worker::choosePartitions() {
   const int count = nats::partitionCount(nats_);
@@ -148,6 +155,7 @@ bool Worker::acquire(Partition& p) {
   const std::vector<std::string> keys = nats_.keys(nats::kFlightBucket);
   p.known = std::set<std::string>(keys.begin(), keys.end());
   p.deliveries = 0;
+  p.judged_seq = p.covered_seq;
   p.pull = nats_.pullFrom(nats::kFixStream, "track-" + leaseKey(p.index), nats::partitionFilter(p.index), p.covered_seq + 1);
   p.held = true;
   ++c_.partitions_held;
@@ -431,16 +439,27 @@ bool Worker::putPartitionCheckpoint(Partition& p, std::uint64_t last_seq) {
   return true;
 }
 
-/// Events, then the flights' checkpoints, then each partition's, each step acknowledged before
-/// the next: a checkpoint never covers a fix whose events are not kept.
+/// The events of a round, acknowledged (a checkpoint never covers a fix whose events are not
+/// kept); every checkpoint_period, the flights' checkpoints and then each partition's. Between
+/// checkpoints a crash costs a replay of at most that long (the same events: repeats, dropped).
 void Worker::commit(std::vector<Taken>& taken, const std::vector<Outgoing>& out) {
   for (const Outgoing& o : out) nats_.publishAsync(o.subject, o.data, o.msg_id);
   nats_.publishesComplete();
   c_.events += out.size();
-  for (Taken& t : taken) putFlightCheckpoints(*t.p);
+  for (Taken& t : taken) t.p->judged_seq = t.msgs.back().stream_seq;
+  if (Clock::now() - last_checkpoint_ < kCheckpointPeriod) return;
+  checkpointAll();
+}
+
+void Worker::checkpointAll() {
+  last_checkpoint_ = Clock::now();
+  for (Partition& p : parts_) {
+    if (p.held && p.judged_seq > p.covered_seq) putFlightCheckpoints(p);
+  }
   nats_.publishesComplete();
-  for (Taken& t : taken) {
-    if (!putPartitionCheckpoint(*t.p, t.msgs.back().stream_seq)) drop(*t.p, "another worker checkpointed it");
+  for (Partition& p : parts_) {
+    if (!p.held || p.judged_seq <= p.covered_seq) continue;
+    if (!putPartitionCheckpoint(p, p.judged_seq)) drop(p, "another worker checkpointed it");
   }
 }
 
@@ -497,7 +516,6 @@ void Worker::report(Clock::time_point& last) const {
 void Worker::run(const std::atomic<bool>& stop) {
   choosePartitions();
   Clock::time_point last_refresh{}, last_report = Clock::now();
-  bool busy = false;
   while (!stop.load()) {
     if (Clock::now() - last_refresh >= std::chrono::seconds(1)) {
       refreshLeases();
@@ -505,11 +523,22 @@ void Worker::run(const std::atomic<bool>& stop) {
     }
     const int held = c_.partitions_held.load();
     // A fetch waits for a full batch or this long: short, so that a quiet partition does not
-    // hold up the others; 1 ms while there is work.
-    const auto wait = std::chrono::milliseconds(busy ? 1 : held > 0 ? std::max(2, 20 / held) : 0);
-    busy = held > 0 && runRound(wait);
+    // hold up the others, long enough that a batch gathers the fixes of several milliseconds.
+    const auto wait = std::chrono::milliseconds(held > 0 ? std::max(5, 40 / held) : 0);
+    if (held > 0) (void)runRound(wait);
+    if (held > 0 && Clock::now() - last_checkpoint_ >= kCheckpointPeriod) {
+      try {
+        checkpointAll();  // a quiet worker's last fixes get their checkpoints too
+      } catch (const std::exception& e) {
+        for (Partition& p : parts_) drop(p, e.what());
+      }
+    }
     if (held == 0) std::this_thread::sleep_for(std::chrono::milliseconds(200));
     report(last_report);
+  }
+  try {
+    checkpointAll();  // a clean stop leaves nothing to judge again
+  } catch (const std::exception&) {
   }
   for (Partition& p : parts_) {
     if (!p.held) continue;
