@@ -1,12 +1,13 @@
 #pragma once
 /// \file
-/// \brief Zones and obstacles as convex pieces in the mission map frame, indexed by FCL (a
-/// dynamic AABB tree over one collision object per piece), and the separation of a protection
+/// \brief Zones and obstacles as convex pieces in the mission map frame, one FCL collision object
+/// per piece indexed by a flat grid over their FCL AABBs, and the separation of a protection
 /// volume from them: FCL narrow phase (GJK distance between the volume's cylinder and the
 /// piece), with the exact predicates of airspace/ deciding near contact and whenever FCL fails.
 ///
-/// FCL stays inside scene.cpp. The map frame is the one of geofence/corridor.hpp: x east and
-/// y north [m] in the mission's azimuthal equidistant plane, z the ellipsoidal height [m].
+/// FCL stays inside geofence/fcl_module.cpp (libskylane_fcl.so, loaded with the first Scene).
+/// The map frame is the one of geofence/corridor.hpp: x east and y north [m] in the mission's
+/// azimuthal equidistant plane, z the ellipsoidal height [m].
 ///
 /// **Touching** (the decision): zones and obstacles are closed sets, so a volume that touches a
 /// piece meets it (airspace::cylinderMeetsPrism is exact about it). Its deciding margin is 0,
@@ -80,7 +81,7 @@ struct SceneHit {
   Separation separation;
 };
 
-/// \brief Convex pieces behind an FCL dynamic AABB tree.
+/// \brief Convex pieces behind a grid over their FCL AABBs.
 class Scene {
  public:
   /// \brief Builds one FCL object per piece (a convex mesh for a ring, a cylinder for a disk;
@@ -99,7 +100,7 @@ class Scene {
   /// \brief Every zone and obstacle (owner) that `accept(owner, owner_index)` takes with a piece
   /// that meets the volume or lies within `horizon_m` of it; one hit per owner, sorted by owner.
   ///
-  /// Broad phase: the volume's cylinder grown by the horizon against the AABB tree. Then, per
+  /// Broad phase: the volume's cylinder grown by the horizon against the AABB grid. Then, per
   /// owner, the direct margins (separationMargins) rank its pieces; the narrow phase — FCL's
   /// GJK distance, with the exact predicate at or below kExactBand_m, when FCL and the closed
   /// form disagree, or when FCL throws — runs on every piece the margins put within kExactBand_m of

@@ -1,17 +1,15 @@
 #include "maps/geoid.hpp"
 
-#include "maps/gdal_support.hpp"
 #include "maps/geodesy.hpp"
+#include "maps/gtx_grid.hpp"
 #include "maps/parse_error.hpp"
-
-#include <cpl_error.h>
-#include <gdal_priv.h>
-#include <ogr_spatialref.h>
+#include "maps/raster_module.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -36,31 +34,29 @@ constexpr double kPoleTol_deg = 1e-9;
 /// degree (to rounding); other angular units (grads, radians) are refused.
 constexpr double kDegreeUnitTol = 1e-9;
 
-/// The grid file, opened read-only, with at least one band.
-GDALDatasetUniquePtr openGrid(const std::string& path) {
-  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(),
-                                            GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR));
-  if (!ds) throw ParseError(path, 0, "grid", "unreadable (" + detail::gdalMessage("GDAL cannot open it") + ")", kExpectedGrid);
-  if (ds->GetRasterCount() < 1) throw ParseError(path, 0, "grid", "no raster band", kExpectedGrid);
+/// The grid file, opened read-only, with at least one band: a GTX file by skylane's own
+/// reader (maps/gtx_grid.hpp), anything else through the GDAL module.
+std::unique_ptr<detail::RasterDataset> openGrid(const std::string& path) {
+  if (std::unique_ptr<detail::RasterDataset> gtx = detail::openGtxGrid(path)) return gtx;
+  std::string error;
+  std::unique_ptr<detail::RasterDataset> ds = detail::rasterModule().open(path, error);
+  if (!ds) throw ParseError(path, 0, "grid", error, kExpectedGrid);
   return ds;
 }
 
 /// A grid's CRS, when it has one, must be geographic in degrees.
-void requireGeographicDegrees(GDALDataset& ds, const std::string& path) {
-  const OGRSpatialReference* srs = ds.GetSpatialRef();
-  if (srs == nullptr || srs->IsEmpty()) return;
-  const double unit_rad = srs->GetAngularUnits(nullptr);
-  if (!srs->IsGeographic() || std::abs(rad2deg(unit_rad) - 1.0) > kDegreeUnitTol) {
-    const char* name = srs->GetName();
-    throw ParseError(path, 0, "grid.crs", name != nullptr ? name : "not geographic",
-                     std::string("a geographic CRS in degrees; ") + kExpectedGrid);
+void requireGeographicDegrees(const detail::RasterDataset& ds, const std::string& path) {
+  const detail::RasterCrs srs = ds.crs();
+  if (!srs.present) return;
+  if (!srs.geographic || std::abs(rad2deg(srs.angular_unit_rad) - 1.0) > kDegreeUnitTol) {
+    throw ParseError(path, 0, "grid.crs", srs.name, std::string("a geographic CRS in degrees; ") + kExpectedGrid);
   }
 }
 
 /// The geotransform of an axis-aligned grid (GDAL layout).
-std::array<double, 6> axisAlignedGeoTransform(GDALDataset& ds, const std::string& path) {
+std::array<double, 6> axisAlignedGeoTransform(const detail::RasterDataset& ds, const std::string& path) {
   std::array<double, 6> gt = {0, 1, 0, 0, 0, 1};
-  if (ds.GetGeoTransform(gt.data()) != CE_None || gt[2] != 0.0 || gt[4] != 0.0 || !(gt[1] > 0.0) || gt[5] == 0.0) {
+  if (!ds.geoTransform(gt.data()) || gt[2] != 0.0 || gt[4] != 0.0 || !(gt[1] > 0.0) || gt[5] == 0.0) {
     std::ostringstream v;
     v << "geotransform (" << gt[0] << ", " << gt[1] << ", " << gt[2] << ", " << gt[3] << ", " << gt[4]
       << ", " << gt[5] << ")";
@@ -98,28 +94,24 @@ void requirePoleRows(double lat0_deg, int rows, double dlat_deg, const std::stri
 }
 
 /// Band 1, row-major, scaled and offset; a void node is an error.
-std::vector<float> readUndulations(GDALRasterBand& band, int rows, int cols, const std::string& path) {
-  int has_nodata = 0;
-  const double nodata = band.GetNoDataValue(&has_nodata);
-  int has_scale = 0, has_offset = 0;
-  const double scale = band.GetScale(&has_scale);
-  const double offset = band.GetOffset(&has_offset);
+std::vector<float> readUndulations(detail::RasterDataset& ds, int rows, int cols, const std::string& path) {
+  const detail::BandScaling b = ds.band1Scaling();
   std::vector<double> row(static_cast<std::size_t>(cols));
   std::vector<float> n_m(static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols));
   for (int r = 0; r < rows; ++r) {
-    if (band.RasterIO(GF_Read, 0, r, cols, 1, row.data(), cols, 1, GDT_Float64, 0, 0, nullptr) != CE_None) {
+    if (!ds.readBand1Row(r, row.data())) {
       throw ParseError(path, 0, "grid.band1", "unreadable row " + std::to_string(r) + " (" +
-                       detail::gdalMessage("read error") + ")", kExpectedGrid);
+                       ds.lastError("read error") + ")", kExpectedGrid);
     }
     for (int c = 0; c < cols; ++c) {
       const double raw = row[static_cast<std::size_t>(c)];
-      if (!std::isfinite(raw) || (has_nodata != 0 && raw == nodata)) {
+      if (!std::isfinite(raw) || (b.has_nodata && raw == b.nodata)) {
         std::ostringstream v;
         v << "void (nodata) node at row " << r << ", column " << c;
         throw ParseError(path, 0, "grid.band1", v.str(), std::string("a void-free grid; ") + kExpectedGrid);
       }
       n_m[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c)] =
-          static_cast<float>(raw * (has_scale != 0 ? scale : 1.0) + (has_offset != 0 ? offset : 0.0));
+          static_cast<float>(raw * (b.has_scale ? b.scale : 1.0) + (b.has_offset ? b.offset : 0.0));
     }
   }
   return n_m;
@@ -128,16 +120,11 @@ std::vector<float> readUndulations(GDALRasterBand& band, int rows, int cols, con
 }  // namespace
 
 Geoid::Geoid(const std::string& grid_path) : path_(grid_path) {
-  detail::registerGdalOnce();
-  // GDAL reports through a thread-local handler stack: keep its messages off stderr, they go
-  // into the ParseError instead.
-  CPLErrorHandlerPusher quiet(CPLQuietErrorHandler);
-  CPLErrorReset();
-  GDALDatasetUniquePtr ds = openGrid(path_);
+  const std::unique_ptr<detail::RasterDataset> ds = openGrid(path_);
   requireGeographicDegrees(*ds, path_);
   const std::array<double, 6> gt = axisAlignedGeoTransform(*ds, path_);
-  rows_ = ds->GetRasterYSize();
-  cols_ = ds->GetRasterXSize();
+  rows_ = ds->rows();
+  cols_ = ds->cols();
   dlon_deg_ = gt[1];
   dlat_deg_ = gt[5];
   // GDAL pixel centres are the grid nodes (for GTX, GDAL shifts the origin by half a cell).
@@ -145,7 +132,7 @@ Geoid::Geoid(const std::string& grid_path) : path_(grid_path) {
   lat0_deg_ = gt[3] + 0.5 * gt[5];
   period_cols_ = globalPeriodColumns(cols_, dlon_deg_, path_);
   requirePoleRows(lat0_deg_, rows_, dlat_deg_, path_);
-  n_m_ = readUndulations(*ds->GetRasterBand(1), rows_, cols_, path_);
+  n_m_ = readUndulations(*ds, rows_, cols_, path_);
 }
 
 const Geoid& Geoid::egm96() {

@@ -1,14 +1,10 @@
 #include "maps/terrain.hpp"
 
-#include "maps/gdal_support.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/geoid.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/plane_frame.hpp"
-
-#include <cpl_error.h>
-#include <gdal_priv.h>
-#include <ogr_spatialref.h>
+#include "maps/raster_module.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -40,18 +36,7 @@ double wrapDeg(double x_deg, double centre_deg) {
   return x_deg - 360.0 * std::floor((x_deg - centre_deg + 180.0) / 360.0);
 }
 
-struct CtDeleter {
-  void operator()(OGRCoordinateTransformation* ct) const { OGRCoordinateTransformation::DestroyCT(ct); }
-};
-using CtPtr = std::unique_ptr<OGRCoordinateTransformation, CtDeleter>;
-
-/// WGS-84 geographic, longitude first (what skylane's radians become before GDAL sees them).
-OGRSpatialReference wgs84LonLat() {
-  OGRSpatialReference srs;
-  srs.SetWellKnownGeogCS("WGS84");
-  srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  return srs;
-}
+using CtPtr = std::unique_ptr<detail::CrsTransform>;
 
 /// A raster's geotransform: pixel (u, v) → raster CRS (x, y), GDAL layout.
 struct GeoTransform {
@@ -61,12 +46,11 @@ struct GeoTransform {
   [[nodiscard]] double y(double u, double v) const { return gt[3] + u * gt[4] + v * gt[5]; }
 };
 
-/// The raster file, opened read-only, with at least one band.
-GDALDatasetUniquePtr openRaster(const std::string& path) {
-  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(),
-                                            GDAL_OF_RASTER | GDAL_OF_READONLY | GDAL_OF_VERBOSE_ERROR));
-  if (!ds) throw ParseError(path, 0, "raster", "unreadable (" + detail::gdalMessage("GDAL cannot open it") + ")", kExpectedRaster);
-  if (ds->GetRasterCount() < 1) throw ParseError(path, 0, "raster", "no raster band", kExpectedRaster);
+/// The raster file, opened read-only (through the GDAL module), with at least one band.
+std::unique_ptr<detail::RasterDataset> openRaster(const std::string& path) {
+  std::string error;
+  std::unique_ptr<detail::RasterDataset> ds = detail::rasterModule().open(path, error);
+  if (!ds) throw ParseError(path, 0, "raster", error, kExpectedRaster);
   return ds;
 }
 
@@ -99,7 +83,7 @@ struct Terrain::Raster {
     double x = lon_deg, y = lat_deg;
     if (!identity) {
       const std::lock_guard<std::mutex> lock(ct_mutex);
-      if (!to_raster->Transform(1, &x, &y) || !std::isfinite(x) || !std::isfinite(y)) return std::nullopt;
+      if (!to_raster->transform(x, y) || !std::isfinite(x) || !std::isfinite(y)) return std::nullopt;
     }
     if (wrap_lon) x = wrapDeg(x, lon_centre_deg);
     return std::make_pair(inv_gt[0] + inv_gt[1] * x + inv_gt[2] * y, inv_gt[3] + inv_gt[4] * x + inv_gt[5] * y);
@@ -120,73 +104,69 @@ struct Terrain::Raster {
 
   // Loading steps of Terrain::fromRaster, in order.
   /// Driver and size (at most kMaxRasterCells).
-  void readSize(GDALDataset& ds);
+  void readSize(const detail::RasterDataset& ds);
   /// The geotransform; its inverse goes into inv_gt.
-  [[nodiscard]] GeoTransform readGeoTransform(GDALDataset& ds);
+  [[nodiscard]] GeoTransform readGeoTransform(const detail::RasterDataset& ds);
   /// The CRS and the transformation WGS-84 lon/lat → raster CRS; returns the way back (null
   /// when the raster CRS is WGS-84 lon/lat).
-  [[nodiscard]] CtPtr readCrs(GDALDataset& ds);
+  [[nodiscard]] CtPtr readCrs(const detail::RasterDataset& ds);
   /// The WGS-84 footprint, traced along the raster's edges.
-  void traceFootprint(const GeoTransform& gt, OGRCoordinateTransformation* to_wgs84);
+  void traceFootprint(const GeoTransform& gt, detail::CrsTransform* to_wgs84);
   /// Cell size on the ground at the centre: geodesics to the neighbouring cell centres.
-  void measureCell(const GeoTransform& gt, OGRCoordinateTransformation* to_wgs84);
+  void measureCell(const GeoTransform& gt, detail::CrsTransform* to_wgs84);
   /// Band 1, whole, voids as NaN.
-  void readBand(GDALRasterBand& band);
+  void readBand(detail::RasterDataset& ds);
 };
 
-void Terrain::Raster::readSize(GDALDataset& ds) {
-  driver = ds.GetDriver() != nullptr ? ds.GetDriver()->GetDescription() : "?";
-  cols = ds.GetRasterXSize();
-  rows = ds.GetRasterYSize();
+void Terrain::Raster::readSize(const detail::RasterDataset& ds) {
+  driver = ds.driver();
+  cols = ds.cols();
+  rows = ds.rows();
   if (static_cast<long long>(cols) * rows > kMaxRasterCells) {
     throw ParseError(path, 0, "raster.size", std::to_string(cols) + " x " + std::to_string(rows) + " cells",
                      "at most " + std::to_string(kMaxRasterCells) + " cells (crop the DEM to the mission area)");
   }
 }
 
-GeoTransform Terrain::Raster::readGeoTransform(GDALDataset& ds) {
+GeoTransform Terrain::Raster::readGeoTransform(const detail::RasterDataset& ds) {
   GeoTransform g;
-  if (ds.GetGeoTransform(g.gt) != CE_None || GDALInvGeoTransform(g.gt, inv_gt) == FALSE) {
+  if (!ds.geoTransform(g.gt) || !ds.invertGeoTransform(g.gt, inv_gt)) {
     throw ParseError(path, 0, "raster.geotransform", "none or singular", kExpectedRaster);
   }
   return g;
 }
 
-CtPtr Terrain::Raster::readCrs(GDALDataset& ds) {
-  const OGRSpatialReference wgs84 = wgs84LonLat();
+CtPtr Terrain::Raster::readCrs(const detail::RasterDataset& ds) {
   CtPtr to_wgs84;
-  const OGRSpatialReference* ds_srs = ds.GetSpatialRef();
-  if (ds_srs == nullptr || ds_srs->IsEmpty()) {
+  const detail::RasterCrs srs = ds.crs();
+  if (!srs.present) {
     identity = true;
     wrap_lon = true;
     crs = "none (assumed WGS-84 lon/lat, degrees)";
     return to_wgs84;
   }
-  OGRSpatialReference srs(*ds_srs);
-  srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  const char* name = srs.GetName();
-  crs = name != nullptr ? name : "unnamed";
-  wrap_lon = srs.IsGeographic() && std::abs(rad2deg(srs.GetAngularUnits(nullptr)) - 1.0) <= kDegreeUnitTol;
-  identity = srs.IsSame(&wgs84);
+  crs = srs.name;
+  wrap_lon = srs.geographic && std::abs(rad2deg(srs.angular_unit_rad) - 1.0) <= kDegreeUnitTol;
+  identity = srs.same_as_wgs84;
   if (!identity) {
-    to_raster.reset(OGRCreateCoordinateTransformation(&wgs84, &srs));
-    to_wgs84.reset(OGRCreateCoordinateTransformation(&srs, &wgs84));
+    to_raster = ds.wgs84Transform(true);
+    to_wgs84 = ds.wgs84Transform(false);
     if (!to_raster || !to_wgs84) {
-      throw ParseError(path, 0, "raster.crs", crs + " (" + detail::gdalMessage("no transformation from WGS-84") + ")",
+      throw ParseError(path, 0, "raster.crs", crs + " (" + ds.lastError("no transformation from WGS-84") + ")",
                        "a CRS PROJ can transform WGS-84 longitude/latitude into");
     }
   }
   return to_wgs84;
 }
 
-void Terrain::Raster::traceFootprint(const GeoTransform& gt, OGRCoordinateTransformation* to_wgs84) {
+void Terrain::Raster::traceFootprint(const GeoTransform& gt, detail::CrsTransform* to_wgs84) {
   bool first = true;
   for (int k = 0; k <= kEdgeSamples; ++k) {
     const double f = static_cast<double>(k) / kEdgeSamples;
     const double uv[4][2] = {{f * cols, 0.0}, {f * cols, 1.0 * rows}, {0.0, f * rows}, {1.0 * cols, f * rows}};
     for (const auto& p : uv) {
       double x = gt.x(p[0], p[1]), y = gt.y(p[0], p[1]);
-      if (to_wgs84 && (!to_wgs84->Transform(1, &x, &y) || !std::isfinite(x) || !std::isfinite(y))) continue;
+      if (to_wgs84 && (!to_wgs84->transform(x, y) || !std::isfinite(x) || !std::isfinite(y))) continue;
       if (first) {
         lon_min_deg = lon_max_deg = x;
         lat_min_deg = lat_max_deg = y;
@@ -201,7 +181,7 @@ void Terrain::Raster::traceFootprint(const GeoTransform& gt, OGRCoordinateTransf
   if (first) throw ParseError(path, 0, "raster.crs", crs, "a raster whose footprint maps to WGS-84 longitude/latitude");
 }
 
-void Terrain::Raster::measureCell(const GeoTransform& gt, OGRCoordinateTransformation* to_wgs84) {
+void Terrain::Raster::measureCell(const GeoTransform& gt, detail::CrsTransform* to_wgs84) {
   const double uc = std::floor(0.5 * cols) + 0.5, vc = std::floor(0.5 * rows) + 0.5;
   const double uv[3][2] = {{uc, vc}, {uc + 1.0, vc}, {uc, vc + 1.0}};
   double lon[3], lat[3];
@@ -209,7 +189,7 @@ void Terrain::Raster::measureCell(const GeoTransform& gt, OGRCoordinateTransform
   for (int k = 0; k < 3; ++k) {
     lon[k] = gt.x(uv[k][0], uv[k][1]);
     lat[k] = gt.y(uv[k][0], uv[k][1]);
-    if (to_wgs84 && (!to_wgs84->Transform(1, &lon[k], &lat[k]))) ok = false;
+    if (to_wgs84 && (!to_wgs84->transform(lon[k], lat[k]))) ok = false;
     ok = ok && std::isfinite(lon[k]) && std::abs(lat[k]) <= 90.0;
   }
   if (ok) {
@@ -218,24 +198,21 @@ void Terrain::Raster::measureCell(const GeoTransform& gt, OGRCoordinateTransform
   }
 }
 
-void Terrain::Raster::readBand(GDALRasterBand& band) {
-  int has_nodata = 0, has_scale = 0, has_offset = 0;
-  const double nodata = band.GetNoDataValue(&has_nodata);
-  const double scale = band.GetScale(&has_scale);
-  const double offset = band.GetOffset(&has_offset);
+void Terrain::Raster::readBand(detail::RasterDataset& ds) {
+  const detail::BandScaling b = ds.band1Scaling();
   std::vector<double> row(static_cast<std::size_t>(cols));
   z_m.resize(static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows));
   for (int j = 0; j < rows; ++j) {
-    if (band.RasterIO(GF_Read, 0, j, cols, 1, row.data(), cols, 1, GDT_Float64, 0, 0, nullptr) != CE_None) {
-      throw ParseError(path, 0, "raster.band1", "unreadable row " + std::to_string(j) + " (" + detail::gdalMessage("read error") + ")",
+    if (!ds.readBand1Row(j, row.data())) {
+      throw ParseError(path, 0, "raster.band1", "unreadable row " + std::to_string(j) + " (" + ds.lastError("read error") + ")",
                        kExpectedRaster);
     }
     float* out = z_m.data() + static_cast<std::size_t>(j) * static_cast<std::size_t>(cols);
     for (int i = 0; i < cols; ++i) {
       const double raw = row[static_cast<std::size_t>(i)];
-      const bool is_void = !std::isfinite(raw) || (has_nodata != 0 && raw == nodata);
+      const bool is_void = !std::isfinite(raw) || (b.has_nodata && raw == b.nodata);
       out[i] = is_void ? std::numeric_limits<float>::quiet_NaN()
-                       : static_cast<float>(raw * (has_scale != 0 ? scale : 1.0) + (has_offset != 0 ? offset : 0.0));
+                       : static_cast<float>(raw * (b.has_scale ? b.scale : 1.0) + (b.has_offset ? b.offset : 0.0));
     }
   }
 }
@@ -248,12 +225,7 @@ Terrain Terrain::flat(double alt_amsl_m) {
 }
 
 Terrain Terrain::fromRaster(const std::string& path, HeightDatum datum) {
-  detail::registerGdalOnce();
-  // GDAL reports through a thread-local handler stack: keep its messages off stderr, they go
-  // into the ParseError instead.
-  CPLErrorHandlerPusher quiet(CPLQuietErrorHandler);
-  CPLErrorReset();
-  GDALDatasetUniquePtr ds = openRaster(path);
+  const std::unique_ptr<detail::RasterDataset> ds = openRaster(path);
   auto r = std::make_shared<Raster>();
   r->path = path;
   r->readSize(*ds);
@@ -262,7 +234,7 @@ Terrain Terrain::fromRaster(const std::string& path, HeightDatum datum) {
   r->lon_centre_deg = gt.x(0.5 * r->cols, 0.5 * r->rows);
   r->traceFootprint(gt, to_wgs84.get());
   r->measureCell(gt, to_wgs84.get());
-  r->readBand(*ds->GetRasterBand(1));
+  r->readBand(*ds);
 
   Terrain t;
   t.raster_ = std::move(r);

@@ -1,32 +1,19 @@
 #include "planner/route_planner.hpp"
 
-#include <ompl/base/Planner.h>
-#include <ompl/base/PlannerTerminationCondition.h>
-#include <ompl/base/objectives/PathLengthOptimizationObjective.h>
-#include <ompl/base/objectives/StateCostIntegralObjective.h>
-#include <ompl/base/spaces/RealVectorStateSpace.h>
-#include <ompl/geometric/PathGeometric.h>
-#include <ompl/geometric/PathSimplifier.h>
-#include <ompl/geometric/SimpleSetup.h>
-#include <ompl/geometric/planners/informedtrees/BITstar.h>
-#include <ompl/geometric/planners/prm/PRMstar.h>
-#include <ompl/geometric/planners/rrt/InformedRRTstar.h>
-#include <ompl/geometric/planners/rrt/RRTstar.h>
-#include <ompl/util/Console.h>
-#include <ompl/util/RandomNumbers.h>
-#include <ompl/util/Time.h>
+#include "maps/module_loader.hpp"
+#include "planner/ompl_module.hpp"
 
-#include <atomic>
-#include <chrono>
 #include <cmath>
-#include <mutex>
 #include <optional>
 #include <stdexcept>
 
-namespace skylane::planner {
+#ifndef SKYLANE_OMPL_MODULE_BUILD_PATH
+// CMake defines both for skylane_planner: the module in the build tree and where it is installed.
+#define SKYLANE_OMPL_MODULE_BUILD_PATH ""
+#define SKYLANE_OMPL_MODULE_INSTALL_PATH ""
+#endif
 
-namespace ob = ompl::base;
-namespace og = ompl::geometric;
+namespace skylane::planner {
 
 std::string_view plannerName(PlannerKind k) {
   switch (k) {
@@ -64,47 +51,6 @@ double polylineLength(const std::vector<Eigen::Vector3d>& points) {
 
 namespace {
 
-Eigen::Vector3d toVector(const ob::State* s) {
-  const auto* r = s->as<ob::RealVectorStateSpace::StateType>();
-  return {r->values[0], r->values[1], r->values[2]};
-}
-
-/// ∫ (1 + extra_cost) ds along the path; Euclidean distance is an admissible heuristic.
-class IntegrityCostObjective : public ob::StateCostIntegralObjective {
- public:
-  IntegrityCostObjective(const ob::SpaceInformationPtr& si, std::function<double(const Eigen::Vector3d&)> extra,
-                         double step_m)
-      : ob::StateCostIntegralObjective(si, false), extra_(std::move(extra)), step_m_(step_m) {
-    description_ = "path length + integrity cost";
-  }
-  ob::Cost stateCost(const ob::State* s) const override { return ob::Cost(1.0 + extra_(toVector(s))); }
-  /// Trapezoid rule over steps of at most step_m (the cost field's own resolution), rather than
-  /// OMPL's validity-checking resolution, which would evaluate it every few metres.
-  ob::Cost motionCost(const ob::State* s1, const ob::State* s2) const override {
-    const Eigen::Vector3d a = toVector(s1), b = toVector(s2);
-    const double len = (b - a).norm();
-    const int n = std::max(1, static_cast<int>(std::ceil(len / step_m_)));
-    double sum = 0.5 * (extra_(a) + extra_(b));
-    for (int i = 1; i < n; ++i) sum += extra_(a + (b - a) * (static_cast<double>(i) / n));
-    return ob::Cost(len * (1.0 + sum / n));
-  }
-  ob::Cost motionCostHeuristic(const ob::State* s1, const ob::State* s2) const override {
-    return ob::Cost(si_->distance(s1, s2));
-  }
-
- private:
-  std::function<double(const Eigen::Vector3d&)> extra_;
-  double step_m_;
-};
-
-/// OMPL's seed generator is process-wide; one query at a time re-seeds it so that a seed gives
-/// the same route whatever ran before (OMPL logs an error when re-seeding after first use; its
-/// generator is re-seeded all the same — see ompl/util/RandomNumbers.cpp).
-std::mutex& omplMutex() {
-  static std::mutex m;
-  return m;
-}
-
 bool motionValid(const PathProblem& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const double len = (b - a).norm();
   const int steps = std::max(1, static_cast<int>(std::ceil(len / p.resolution_m)));
@@ -136,115 +82,18 @@ std::optional<PathStatus> invalidEnd(const PathProblem& p) {
   return std::nullopt;
 }
 
-/// The search box as an OMPL state space.
-std::shared_ptr<ob::RealVectorStateSpace> searchSpace(const PathProblem& p) {
-  auto space = std::make_shared<ob::RealVectorStateSpace>(3);
-  ob::RealVectorBounds bounds(3);
-  for (int i = 0; i < 3; ++i) {
-    bounds.setLow(i, p.lower_enu_m[i]);
-    bounds.setHigh(i, p.upper_enu_m[i]);
-  }
-  space->setBounds(bounds);
-  return space;
-}
-
-/// Validity checker, motion resolution, start and goal.
-void setProblem(og::SimpleSetup& ss, const ob::StateSpacePtr& space, const PathProblem& p) {
-  ss.setStateValidityChecker([&p](const ob::State* s) { return p.is_valid(toVector(s)); });
-  // Motions are checked every resolution_m metres: OMPL takes it as a fraction of the extent.
-  ss.getSpaceInformation()->setStateValidityCheckingResolution(
-      std::min(1.0, p.resolution_m / space->getMaximumExtent()));
-  ob::ScopedState<> start(space), goal(space);
-  for (int i = 0; i < 3; ++i) {
-    start[i] = p.start_enu_m[i];
-    goal[i] = p.goal_enu_m[i];
-  }
-  ss.setStartAndGoalStates(start, goal, 1e-6);
-}
-
-/// Path length, or length + integrity cost; "good enough" at good_enough_factor × the straight line.
-ob::OptimizationObjectivePtr objectiveFor(const ob::SpaceInformationPtr& si, const PathProblem& p) {
-  ob::OptimizationObjectivePtr objective;
-  if (p.extra_cost) {
-    objective = std::make_shared<IntegrityCostObjective>(si, p.extra_cost, p.cost_step_m);
-  } else {
-    objective = std::make_shared<ob::PathLengthOptimizationObjective>(si);
-  }
-  const double straight = (p.goal_enu_m - p.start_enu_m).norm();
-  objective->setCostThreshold(ob::Cost(p.good_enough_factor > 1.0 ? p.good_enough_factor * straight : 0.0));
-  return objective;
-}
-
-ob::PlannerPtr makePlanner(PlannerKind kind, const ob::SpaceInformationPtr& si) {
-  ob::PlannerPtr planner;
-  switch (kind) {
-    case PlannerKind::kRrtStar: planner = std::make_shared<og::RRTstar>(si); break;
-    case PlannerKind::kInformedRrtStar: planner = std::make_shared<og::InformedRRTstar>(si); break;
-    case PlannerKind::kBitStar: planner = std::make_shared<og::BITstar>(si); break;
-    case PlannerKind::kPrmStar: planner = std::make_shared<og::PRMstar>(si); break;
-  }
-  return planner;
-}
-
-/// Solves until the iteration budget or the time limit; records time, iterations and which
-/// limit stopped it.
-ob::PlannerStatus solveWithinLimits(og::SimpleSetup& ss, const PathProblem& p, PathResult& out) {
-  const auto t0 = std::chrono::steady_clock::now();
-  std::atomic<std::uint64_t> checks{0};
-  std::atomic<bool> by_time{false};
-  const ob::PlannerTerminationCondition timed = ob::timedPlannerTerminationCondition(p.time_limit_s);
-  const ob::PlannerTerminationCondition ptc([&]() {
-    if (++checks > p.max_iterations) return true;
-    if (timed()) {
-      by_time = true;
-      return true;
-    }
-    return false;
-  });
-  const ob::PlannerStatus status = ss.solve(ptc);
-  out.planning_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  out.iterations = checks;
-  out.stopped_by_time = by_time;
-  return status;
-}
-
-/// The solution path (simplified when asked), its length and cost.
-void takeSolution(og::SimpleSetup& ss, const ob::OptimizationObjectivePtr& objective, const PathProblem& p,
-                  PathResult& out) {
-  og::PathGeometric& path = ss.getSolutionPath();
-  if (p.simplify) {
-    const auto t1 = std::chrono::steady_clock::now();
-    og::PathSimplifier simplifier(ss.getSpaceInformation(), ob::GoalPtr(), objective);
-    simplifier.simplifyMax(path);
-    out.simplify_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
-  }
-  for (std::size_t i = 0; i < path.getStateCount(); ++i) out.points.push_back(toVector(path.getState(i)));
-  out.length_m = polylineLength(out.points);
-  out.cost = path.cost(objective).value();
-}
-
-/// Plans with OMPL (the straight line did not do).
-void planWithOmpl(const PathProblem& p, PathResult& out) {
-  const std::lock_guard<std::mutex> lock(omplMutex());
-  ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
-  ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(p.seed % 4294967291ULL + 1));
-
-  const std::shared_ptr<ob::RealVectorStateSpace> space = searchSpace(p);
-  og::SimpleSetup ss(space);
-  setProblem(ss, space, p);
-  const ob::SpaceInformationPtr si = ss.getSpaceInformation();
-  const ob::OptimizationObjectivePtr objective = objectiveFor(si, p);
-  ss.setOptimizationObjective(objective);
-  ss.setPlanner(makePlanner(p.planner, si));
-  ss.setup();
-
-  const ob::PlannerStatus status = solveWithinLimits(ss, p, out);
-  if (status != ob::PlannerStatus::EXACT_SOLUTION && status != ob::PlannerStatus::APPROXIMATE_SOLUTION) {
-    out.status = PathStatus::kNoSolution;
-    return;
-  }
-  out.status = status == ob::PlannerStatus::EXACT_SOLUTION ? PathStatus::kExact : PathStatus::kApproximate;
-  takeSolution(ss, objective, p, out);
+/// The OMPL module's entry points (libskylane_ompl.so, planner/ompl_module.cpp), loaded on the
+/// first route that is not a straight line.
+const detail::OmplModule& omplModule() {
+  static const detail::OmplModule& module = [] () -> const detail::OmplModule& {
+    const maps::detail::ModuleSpec spec{detail::kOmplModuleFile, "SKYLANE_OMPL_MODULE", "skylane_ompl_module_v1",
+                                        SKYLANE_OMPL_MODULE_BUILD_PATH, SKYLANE_OMPL_MODULE_INSTALL_PATH,
+                                        "planning a route around obstacles"};
+    static_assert(detail::kOmplModuleAbi == 1, "rename the entry point with the ABI version");
+    using Entry = const detail::OmplModule* (*)();
+    return *reinterpret_cast<Entry>(maps::detail::loadModuleEntry(spec))();
+  }();
+  return module;
 }
 
 }  // namespace
@@ -264,7 +113,8 @@ PathResult planPath(const PathProblem& p) {
     out.straight_line = true;
     return out;
   }
-  planWithOmpl(p, out);
+  omplModule().plan(p, out);
+  out.length_m = polylineLength(out.points);
   return out;
 }
 

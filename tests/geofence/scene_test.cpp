@@ -865,3 +865,82 @@ TEST(Scene, AcceptFilterAndErrors) {
 
 }  // namespace
 }  // namespace skylane::geofence
+
+namespace skylane::geofence {
+namespace {
+
+/// A convex regular n-gon, counter-clockwise, of circumradius r about c.
+PlanarRing regularRing(const Eigen::Vector2d& c, double r, int n, double phase) {
+  PlanarRing ring;
+  for (int k = 0; k < n; ++k) {
+    const double a = phase + 2 * kPi * k / n;
+    ring.emplace_back(c.x() + r * std::cos(a), c.y() + r * std::sin(a));
+  }
+  return ring;
+}
+
+/// The broad phase over thousands of pieces (a grid in scene.cpp) finds every zone a brute
+/// force over all pieces finds: GIVEN 600 zones of 1–3 pieces (rings and disks, 20–900 m, a few
+/// of 8–15 km that span many grid cells) in 30 km × 30 km, WHEN volumes anywhere and next to
+/// pieces are queried, THEN a zone is reported iff one of its pieces meets the volume or lies
+/// within the horizon (closed-form margins, away from the boundary cases).
+TEST(Scene, BroadPhaseOverManyPiecesFindsWhatBruteForceFinds) {
+  std::mt19937 rng(22);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  constexpr double kArea_m = 30000.0, kHorizon_m = 100.0;
+  std::vector<ScenePiece> pieces;
+  constexpr std::size_t kZones = 600;
+  for (std::size_t z = 0; z < kZones; ++z) {
+    const Eigen::Vector2d c(kArea_m * u(rng), kArea_m * u(rng));
+    const double size = z % 100 == 7 ? 8000.0 + 7000.0 * u(rng) : 20.0 + 880.0 * u(rng);
+    const int parts = 1 + static_cast<int>(rng() % 3);
+    for (int k = 0; k < parts; ++k) {
+      PlanarPrism q;
+      q.floor_h_ell_m = u(rng) < 0.2 ? -kInf : 400.0 + 100.0 * u(rng);
+      q.ceiling_h_ell_m = u(rng) < 0.2 ? kInf : 600.0 + 300.0 * u(rng);
+      const Eigen::Vector2d ck = c + Eigen::Vector2d(size * (u(rng) - 0.5), size * (u(rng) - 0.5));
+      if (u(rng) < 0.25) {
+        q.centre = ck;
+        q.radius_m = 0.5 * size * (0.2 + 0.8 * u(rng));
+      } else {
+        q.ring = regularRing(ck, 0.5 * size * (0.2 + 0.8 * u(rng)), 3 + static_cast<int>(rng() % 10), 2 * kPi * u(rng));
+      }
+      pieces.push_back({q, PieceOwner::kZone, z});
+    }
+  }
+  const Scene scene(pieces);
+  long reported = 0, checked = 0;
+  for (int i = 0; i < 3000; ++i) {
+    Eigen::Vector3d p(kArea_m * u(rng), kArea_m * u(rng), 350.0 + 700.0 * u(rng));
+    if (i % 2 == 1) {  // next to a piece's centre or vertex
+      const PlanarPrism& q = pieces[rng() % pieces.size()].prism;
+      const Eigen::Vector2d at = q.ring.empty() ? q.centre : q.ring[rng() % q.ring.size()];
+      p.head<2>() = at + Eigen::Vector2d(300.0 * (u(rng) - 0.5), 300.0 * (u(rng) - 0.5));
+    }
+    const ProtectionVolume v{p, 2.0 + 60.0 * u(rng), 2.0 + 60.0 * u(rng)};
+    const std::vector<SceneHit> hits = scene.query(v, kHorizon_m, kAcceptAll);
+    std::vector<double> nearest(kZones, kInf);
+    std::vector<bool> meets(kZones, false), boundary(kZones, false);
+    for (const ScenePiece& piece : pieces) {
+      const Separation m = separationMargins(v, piece.prism);
+      const double deciding = std::max(m.margin_h_m, m.margin_v_m);
+      meets[piece.owner_index] = meets[piece.owner_index] || deciding <= 0;
+      boundary[piece.owner_index] = boundary[piece.owner_index] || std::abs(deciding) <= kContactBand_m ||
+                                    std::abs(m.clearance_m - kHorizon_m) <= kContactBand_m;
+      nearest[piece.owner_index] = std::min(nearest[piece.owner_index], m.clearance_m);
+    }
+    for (std::size_t z = 0; z < kZones; ++z) {
+      if (boundary[z]) continue;
+      const bool expected = meets[z] || nearest[z] <= kHorizon_m;
+      const bool found = std::any_of(hits.begin(), hits.end(), [&](const SceneHit& h) { return h.owner_index == z; });
+      ASSERT_EQ(found, expected) << "query " << i << " zone " << z << ": " << describe(v) << ", nearest " << nearest[z];
+      ++checked;
+      reported += found;
+    }
+  }
+  EXPECT_GT(reported, 1500);  // the queries reach zones, not only empty space
+  EXPECT_GT(checked, 1000000);
+}
+
+}  // namespace
+}  // namespace skylane::geofence

@@ -1,6 +1,9 @@
 #include "maps/geoid.hpp"
 
 #include "maps/geodesy.hpp"
+#include "maps/gtx_grid.hpp"
+#include "maps/module_loader.hpp"
+#include "maps/raster_module.hpp"
 #include "maps/parse_error.hpp"
 #include "tests/maps/raster_fixture.hpp"
 #include "tests/test_util.hpp"
@@ -9,6 +12,7 @@
 #include <ogr_spatialref.h>
 
 #include <cmath>
+#include <cstring>
 #include <cstdlib>
 #include <functional>
 #include <random>
@@ -146,6 +150,73 @@ TEST(Geoid, GdalPixelCentresAreTheNodesOfASyntheticGeoTiffGrid) {
   // … and latitudes beyond the outer centres are clamped to the outer rows.
   EXPECT_NEAR(g.undulation_m(M_PI / 2, deg2rad(-179.5)), 0.0, kExactTol_m);
   EXPECT_NEAR(g.undulation_m(-M_PI / 2, deg2rad(-179.5)), 179000.0, kExactTol_m);
+}
+
+/// Every node, the geotransform and the band's nodata of a GTX file, bit for bit, from skylane's
+/// own reader and from GDAL's GTX driver (through the GDAL module).
+void expectGtxReadersAgree(const std::string& path) {
+  const std::unique_ptr<detail::RasterDataset> own = detail::openGtxGrid(path);
+  std::string error;
+  const std::unique_ptr<detail::RasterDataset> gdal = detail::rasterModule().open(path, error);
+  ASSERT_TRUE(own) << path;
+  ASSERT_TRUE(gdal) << error;
+  EXPECT_EQ(own->driver(), gdal->driver());
+  ASSERT_EQ(own->rows(), gdal->rows());
+  ASSERT_EQ(own->cols(), gdal->cols());
+  double gt_own[6], gt_gdal[6];
+  ASSERT_TRUE(own->geoTransform(gt_own));
+  ASSERT_TRUE(gdal->geoTransform(gt_gdal));
+  EXPECT_EQ(0, std::memcmp(gt_own, gt_gdal, sizeof gt_own));
+  const detail::RasterCrs c_own = own->crs(), c_gdal = gdal->crs();
+  EXPECT_EQ(c_own.present, c_gdal.present);
+  EXPECT_EQ(c_own.geographic, c_gdal.geographic);
+  EXPECT_EQ(c_own.angular_unit_rad, c_gdal.angular_unit_rad);
+  EXPECT_EQ(c_own.same_as_wgs84, c_gdal.same_as_wgs84);
+  const detail::BandScaling b_own = own->band1Scaling(), b_gdal = gdal->band1Scaling();
+  EXPECT_EQ(b_own.has_nodata, b_gdal.has_nodata);
+  EXPECT_EQ(b_own.nodata, b_gdal.nodata);
+  EXPECT_EQ(b_own.has_scale, b_gdal.has_scale);
+  EXPECT_EQ(b_own.has_offset, b_gdal.has_offset);
+  std::vector<double> row_own(static_cast<std::size_t>(own->cols())), row_gdal(row_own.size());
+  for (int r = 0; r < own->rows(); ++r) {
+    ASSERT_TRUE(own->readBand1Row(r, row_own.data()));
+    ASSERT_TRUE(gdal->readBand1Row(r, row_gdal.data()));
+    ASSERT_EQ(0, std::memcmp(row_own.data(), row_gdal.data(), row_own.size() * sizeof(double))) << "row " << r;
+  }
+}
+
+TEST(Geoid, OwnGtxReaderMatchesGdalOnTheEgm96GridBitForBit) {
+  expectGtxReadersAgree(Geoid::egm96().path());
+}
+
+TEST(Geoid, OwnGtxReaderMatchesGdalOnAGridWrittenByGdal) {
+  // GIVEN a 7 × 5 GTX grid written by GDAL's own GTX driver, origin in (0, 360) longitude
+  GDALAllRegister();
+  const std::string path = test::scratchPath("skylane_geoid_small.gtx");
+  {
+    GDALDriver* gtx = GetGDALDriverManager()->GetDriverByName("GTX");
+    ASSERT_NE(gtx, nullptr);
+    GDALDatasetUniquePtr ds(gtx->Create(path.c_str(), 7, 5, 1, GDT_Float32, nullptr));
+    ASSERT_TRUE(ds);
+    double gt[6] = {200.125, 0.25, 0.0, 48.375, 0.0, -0.25};
+    ASSERT_EQ(ds->SetGeoTransform(gt), CE_None);
+    std::vector<float> z(35);
+    for (int i = 0; i < 35; ++i) z[static_cast<std::size_t>(i)] = 0.1f * static_cast<float>(i) - 1.7f;
+    ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, 7, 5, z.data(), 7, 5, GDT_Float32, 0, 0, nullptr), CE_None);
+  }
+  // THEN both readers see the same grid
+  expectGtxReadersAgree(path);
+  // … and a file that is not *.gtx is left to GDAL
+  EXPECT_FALSE(detail::openGtxGrid(test::scratchPath("skylane_geoid_synthetic.tif")));
+}
+
+TEST(Geoid, MissingModuleIsAnErrorNamingTheModuleAndWhereItWasLookedFor) {
+  const detail::ModuleSpec spec{"libskylane_no_such_module.so", "SKYLANE_NO_SUCH_MODULE", "entry_v1", "", "",
+                                "reading rasters"};
+  const std::string msg = test::messageOf<std::runtime_error>([&] { (void)detail::loadModuleEntry(spec); });
+  EXPECT_NE(msg.find("reading rasters needs skylane's module libskylane_no_such_module.so"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("SKYLANE_NO_SUCH_MODULE"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("absent"), std::string::npos) << msg;
 }
 
 TEST(Geoid, MissingGridIsAParseErrorNamingTheFileAndWhereToGetIt) {

@@ -1,0 +1,106 @@
+/// \file
+/// \brief libskylane_fcl.so: the FCL side of geofence/fcl_module.hpp, loaded with dlopen when
+/// the first Scene is built (the only file of skylane that includes FCL).
+
+#include "geofence/fcl_module.hpp"
+
+#include <fcl/geometry/shape/convex.h>
+#include <fcl/geometry/shape/cylinder.h>
+#include <fcl/narrowphase/collision_object.h>
+#include <fcl/narrowphase/distance.h>
+
+#include <memory>
+#include <vector>
+
+namespace skylane::geofence::detail {
+namespace {
+
+/// The piece as an FCL shape placed at its centre: a cylinder for a disk; for a ring, the
+/// convex prism with its faces listed FCL's way (count, then vertex indices, outward winding).
+std::unique_ptr<fcl::CollisionObjectd> fclObject(const airspace::PlanarPrism& q, double z_lo, double z_hi) {
+  const double z_mid = 0.5 * (z_lo + z_hi), half = 0.5 * (z_hi - z_lo);
+  if (q.ring.empty()) {
+    auto shape = std::make_shared<fcl::Cylinderd>(q.radius_m, 2 * half);
+    fcl::Transform3d X_WP = fcl::Transform3d::Identity();
+    X_WP.translation() = fcl::Vector3d(q.centre.x(), q.centre.y(), z_mid);
+    return std::make_unique<fcl::CollisionObjectd>(shape, X_WP);
+  }
+  const std::size_t n = q.ring.size();
+  Eigen::Vector2d p_WP = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& v : q.ring) p_WP += v;
+  p_WP /= static_cast<double>(n);
+  auto vertices = std::make_shared<std::vector<fcl::Vector3d>>();
+  vertices->reserve(2 * n);
+  for (double z : {-half, half}) {
+    for (const Eigen::Vector2d& v : q.ring) vertices->emplace_back(v.x() - p_WP.x(), v.y() - p_WP.y(), z);
+  }
+  auto faces = std::make_shared<std::vector<int>>();
+  faces->reserve(2 * (n + 1) + 5 * n);
+  faces->push_back(static_cast<int>(n));  // bottom, clockwise from above = outward (down)
+  for (std::size_t k = n; k-- > 0;) faces->push_back(static_cast<int>(k));
+  faces->push_back(static_cast<int>(n));  // top, counter-clockwise from above
+  for (std::size_t k = 0; k < n; ++k) faces->push_back(static_cast<int>(n + k));
+  for (std::size_t k = 0; k < n; ++k) {  // walls
+    const int a = static_cast<int>(k), b = static_cast<int>((k + 1) % n);
+    faces->insert(faces->end(), {4, a, b, b + static_cast<int>(n), a + static_cast<int>(n)});
+  }
+  auto shape = std::make_shared<fcl::Convexd>(vertices, static_cast<int>(n + 2), faces);
+  fcl::Transform3d X_WP = fcl::Transform3d::Identity();
+  X_WP.translation() = fcl::Vector3d(p_WP.x(), p_WP.y(), z_mid);
+  return std::make_unique<fcl::CollisionObjectd>(shape, X_WP);
+}
+
+FclBox boxOf(const fcl::CollisionObjectd& o) {
+  const fcl::AABBd& b = o.getAABB();
+  return {{b.min_[0], b.min_[1], b.min_[2]}, {b.max_[0], b.max_[1], b.max_[2]}};
+}
+
+/// This thread's query cylinder (one allocation per thread, not per query).
+struct QueryCylinder {
+  std::shared_ptr<fcl::Cylinderd> shape = std::make_shared<fcl::Cylinderd>(1.0, 1.0);
+  fcl::CollisionObjectd object{shape};
+};
+
+QueryCylinder& queryCylinder() {
+  thread_local QueryCylinder q;
+  return q;
+}
+
+class Pieces final : public FclPieces {
+ public:
+  FclBox add(const airspace::PlanarPrism& piece, double z_lo, double z_hi) override {
+    objects_.push_back(fclObject(piece, z_lo, z_hi));
+    objects_.back()->computeAABB();
+    return boxOf(*objects_.back());
+  }
+  FclBox placeCylinder(const Eigen::Vector3d& p, double radius_m, double half_m) const override {
+    QueryCylinder& q = queryCylinder();
+    q.shape->radius = radius_m;
+    q.shape->lz = 2 * half_m;
+    q.shape->computeLocalAABB();
+    q.object.setTranslation(p);
+    q.object.computeAABB();
+    return boxOf(q.object);
+  }
+  double distance(std::size_t i, GjkSolver solver) const override {
+    fcl::DistanceRequestd request;
+    request.gjk_solver_type = solver == GjkSolver::kLibccd ? fcl::GST_LIBCCD : fcl::GST_INDEP;
+    fcl::DistanceResultd result;
+    fcl::distance(&queryCylinder().object, objects_[i].get(), request, result);
+    return result.min_distance;
+  }
+
+ private:
+  std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects_;
+};
+
+std::unique_ptr<FclPieces> makePieces() { return std::make_unique<Pieces>(); }
+
+}  // namespace
+}  // namespace skylane::geofence::detail
+
+/// The module's one exported symbol (its name carries kFclModuleAbi).
+extern "C" __attribute__((visibility("default"))) const skylane::geofence::detail::FclModule* skylane_fcl_module_v1() {
+  static const skylane::geofence::detail::FclModule module{&skylane::geofence::detail::makePieces};
+  return &module;
+}
