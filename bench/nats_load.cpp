@@ -24,6 +24,8 @@
 #include <regex>
 #include <sstream>
 
+#include <unistd.h>
+
 namespace {
 
 using nlohmann::json;
@@ -61,6 +63,19 @@ double rssMiB(pid_t pid) {
     if (line.rfind("VmRSS:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
   }
   return 0.0;
+}
+
+/// User + system CPU seconds a process has used (/proc/PID/stat fields 14 and 15).
+double cpuSeconds(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::istringstream rest(stat.substr(stat.rfind(')') + 2));
+  std::string field;
+  double ticks = 0;
+  for (int i = 3; i <= 15 && rest >> field; ++i) {
+    if (i >= 14) ticks += std::stod(field);
+  }
+  return ticks / static_cast<double>(sysconf(_SC_CLK_TCK));
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -184,6 +199,7 @@ int main(int argc, char** argv) try {
   std::cerr << "nats_load: " << o.flights << " flights on " << o.partitions << " partitions, " << o.workers << " track workers, " << o.seconds
             << " s at 1 Hz\n";
   std::uint64_t max_lag = 0;
+  const double server_cpu0 = cpuSeconds(server.pid());
   const auto t0 = Clock::now();
   for (int k = 0; k < o.seconds; ++k) {
     for (int f = 0; f < o.flights; ++f) {
@@ -213,8 +229,12 @@ int main(int argc, char** argv) try {
   const std::size_t total = static_cast<std::size_t>(o.flights) * static_cast<std::size_t>(o.seconds);
   for (int i = 0; i < 600 && reader.fixes.load() < total; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
   const double all_s = std::chrono::duration<double>(Clock::now() - t_judge).count();
-  double rss = 0;
-  for (auto& w : workers) rss += rssMiB(w->pid());
+  double rss = 0, worker_cpu = 0;
+  for (auto& w : workers) {
+    rss += rssMiB(w->pid());
+    worker_cpu += cpuSeconds(w->pid());
+  }
+  const double server_cpu = cpuSeconds(server.pid()) - server_cpu0;
   std::this_thread::sleep_for(std::chrono::seconds(11));  // the workers' next counters line
   reader.stop = true;
   events.join();
@@ -228,6 +248,8 @@ int main(int argc, char** argv) try {
   std::printf("publish -> fix event latency: p50 %.1f ms, p99 %.1f ms, max %.1f ms\n", percentile(reader.latency_ms, 0.5),
               percentile(reader.latency_ms, 0.99), percentile(reader.latency_ms, 1.0));
   std::printf("consumer lag (sampled each second): max %llu fixes\n", static_cast<unsigned long long>(max_lag));
+  std::printf("CPU per fix: workers %.1f us (all their CPU since start), nats-server %.1f us (during the run)\n",
+              worker_cpu / static_cast<double>(total) * 1e6, server_cpu / static_cast<double>(total) * 1e6);
   std::printf("worker memory: %.1f MiB idle, %.1f MiB with the flights: %.1f MiB per 1,000 flights\n", idle_rss, rss,
               (rss - idle_rss) / (o.flights / 1000.0));
   for (auto& w : workers) w->kill(SIGTERM);

@@ -107,6 +107,7 @@ class NatsServer {
     if (!tcpAccepts(port_)) throw std::runtime_error("nats-server did not start: " + process_->log());
   }
   void kill() { process_->kill(SIGKILL); }
+  [[nodiscard]] pid_t pid() const { return process_->pid(); }
   [[nodiscard]] std::string url() const { return "nats://127.0.0.1:" + std::to_string(port_); }
   /// Whether nats-server is installed (the tests skip without it only outside CI).
   static bool installed() { return std::system("command -v nats-server > /dev/null 2>&1") == 0; }
