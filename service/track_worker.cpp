@@ -275,7 +275,10 @@ void Worker::loadApproval(Partition& p, FlightSlot& slot, const std::string& id)
   slot.approval_dir = dir.string();
   if (p.approvals.count(slot.approval_dir) == 0) {
     auto sets = readZoneSets(dir);
-    if (!sets.empty()) p.approvals[slot.approval_dir] = {id, std::move(sets)};
+    if (sets.empty()) return;
+    // Brought up to the zone sets' current versions at once: the bundle (or this worker's copy
+    // of it) may be older than a version put before this partition came here.
+    followZoneSets(p, slot.approval_dir, p.approvals[slot.approval_dir] = {id, std::move(sets)});
   }
 }
 
