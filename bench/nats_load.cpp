@@ -11,7 +11,7 @@
 #include "maps/time.hpp"
 #include "service/nats_client.hpp"
 #include "service/nats_layout.hpp"
-#include "tests/service/nats_process.hpp"
+#include "tests/service/child_process.hpp"
 
 #include <nlohmann/json.hpp>
 

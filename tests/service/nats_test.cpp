@@ -8,7 +8,7 @@
 #include "service/approval_bundle.hpp"
 #include "service/nats_client.hpp"
 #include "service/nats_layout.hpp"
-#include "tests/service/nats_process.hpp"
+#include "tests/service/child_process.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>

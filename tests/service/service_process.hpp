@@ -3,6 +3,7 @@
 /// \brief `skylane serve` as a child process of a test: started on a free loopback port with a
 /// database and tokens in a folder of the test's own, stopped (or killed) by the test.
 
+#include "tests/service/child_process.hpp"
 #include "tests/test_util.hpp"
 
 #include <signal.h>
@@ -81,14 +82,7 @@ class ServiceProcess {
     port_ = std::stoi(line.substr(colon + 1));
   }
   /// Sends `sig` and waits for the process; its exit status (128 + signal when killed).
-  int kill(int sig) {
-    if (pid_ <= 0) return -1;
-    ::kill(pid_, sig);
-    int st = 0;
-    waitpid(pid_, &st, 0);
-    pid_ = -1;
-    return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-  }
+  int kill(int sig) { return killAndWait(pid_, sig); }
   [[nodiscard]] int port() const { return port_; }
   [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
 

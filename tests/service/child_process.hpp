@@ -1,7 +1,8 @@
 #pragma once
 /// \file
-/// \brief A real `nats-server -js` on a free loopback port with a file store in the test's folder
-/// (killed and restarted by the test on the same store), and skylane workers as child processes.
+/// \brief Child processes of the tests: any command with its output in a log (skylane workers),
+/// and a real `nats-server -js` on a free loopback port with a file store in the test's folder
+/// (killed and restarted by the test on the same store).
 
 #include <netinet/in.h>
 #include <signal.h>
@@ -20,7 +21,7 @@
 
 namespace skylane::test {
 
-// (Shared by tests/service/nats_test.cpp and the load generator bench/nats_load.cpp.)
+// (Shared by the service and NATS tests and the load generator bench/nats_load.cpp.)
 
 /// A free TCP port on 127.0.0.1 (bound and released: the kernel does not hand it out again at once).
 inline int freeTcpPort() {
@@ -46,6 +47,17 @@ inline bool tcpAccepts(int port) {
   return ok;
 }
 
+/// Sends `sig` to a child and waits for it: its exit status (128 + signal when killed); −1 when
+/// there is none. `pid` is cleared.
+inline int killAndWait(pid_t& pid, int sig) {
+  if (pid <= 0) return -1;
+  ::kill(pid, sig);
+  int st = 0;
+  waitpid(pid, &st, 0);
+  pid = -1;
+  return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+}
+
 /// A child process with its standard error (and output) in a log file.
 class ChildProcess {
  public:
@@ -69,14 +81,7 @@ class ChildProcess {
     }
   }
   /// Sends `sig` and waits; the exit status (128 + signal when killed).
-  int kill(int sig) {
-    if (pid_ <= 0) return -1;
-    ::kill(pid_, sig);
-    int st = 0;
-    waitpid(pid_, &st, 0);
-    pid_ = -1;
-    return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-  }
+  int kill(int sig) { return killAndWait(pid_, sig); }
   [[nodiscard]] pid_t pid() const { return pid_; }
   [[nodiscard]] bool running() const { return pid_ > 0 && ::waitpid(pid_, nullptr, WNOHANG) == 0; }
   [[nodiscard]] std::string log() const {
