@@ -489,8 +489,6 @@ void runAvailability(const AvailabilityOptions& o) {
     cells.push_back({c.lat_deg, c.lon_deg, c.percent()});
   }
   const double cov = map.coveragePercent(99.5);
-  std::cerr << "skylane: " << map.user_epochs << " user-epochs; " << std::fixed << std::setprecision(2) << cov
-            << " % of the Earth's area has >= 99.5 % availability\n";
   if (map_svg) {
     char title[200];
     std::snprintf(title, sizeof title, "%s availability%s, %s + %s, mask %.0f°, step %s", o.method == "araim" ? "ARAIM" : "RAIM",
@@ -501,7 +499,9 @@ void runAvailability(const AvailabilityOptions& o) {
                   o.grid_deg, map.user_epochs, cov);
     *map_svg << renderAvailabilityMapSvg(title, cells, o.grid_deg, footer);
   }
-  outputs.commit();
+  outputs.commit();  // the summary only after the outputs are in place: a failed write is the one line said
+  std::cerr << "skylane: " << map.user_epochs << " user-epochs; " << std::fixed << std::setprecision(2) << cov
+            << " % of the Earth's area has >= 99.5 % availability\n";
 }
 
 }  // namespace

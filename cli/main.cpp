@@ -48,8 +48,12 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
+    // --help and --version print what was asked for; a bad option or option file is one line
+    // naming the option and the value (CLI11's own message, e.g. "mission: File does not
+    // exist: m.json"), as every other bad input (no "Run with --help" second line).
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "skylane: error: " << skylane::maps::printable(e.what()) << "\n";
+    return 2;
   } catch (const skylane::cli::ExitStatus& e) {
     return afterStandardOutput(e.status);
   } catch (const skylane::integrity::ParseError& e) {

@@ -45,7 +45,7 @@ void raiseOpenFileLimit() {
 }
 
 /// One --input: FORMAT:ADDRESS[#FLIGHT] → its source and the flight it feeds (empty: named per record).
-std::pair<std::unique_ptr<planner::FixSource>, std::string> openInput(const std::string& spec) {
+std::pair<std::unique_ptr<planner::FixSource>, std::string> openInput(const std::string& spec, const planner::DatagramOptions& udp) {
   const std::size_t colon = spec.find(':');
   const std::size_t hash = spec.rfind('#');
   const std::string format = spec.substr(0, colon);
@@ -53,16 +53,16 @@ std::pair<std::unique_ptr<planner::FixSource>, std::string> openInput(const std:
   const std::string address = colon == std::string::npos ? std::string() : spec.substr(colon + 1, hash == std::string::npos ? std::string::npos : hash - colon - 1);
   const char* expected = "FORMAT:ADDRESS[#FLIGHT]: jsonl:udp://IP:PORT (lines name their flight), mavlink:ADDRESS#FLIGHT or ubx:ADDRESS#FLIGHT";
   if (address.empty()) throw maps::ParseError("--input", 0, "--input", spec, expected);
-  if (format == "jsonl") return {std::make_unique<planner::JsonLinesFixSource>(planner::openLineInput(address)), flight};
+  if (format == "jsonl") return {std::make_unique<planner::JsonLinesFixSource>(planner::openLineInput(address, udp)), flight};
   if ((format == "mavlink" || format == "ubx") && !flight.empty()) {
-    auto link = link::openByteLink(address, 57600);
+    auto link = link::openByteLink(address, 57600, udp);
     if (format == "ubx") return {std::make_unique<link::ubx::UbxFixSource>(std::move(link), flight), flight};
     return {std::make_unique<link::mavlink::MavlinkFixSource>(std::move(link), flight), flight};
   }
   throw maps::ParseError("--input", 0, "--input", spec, expected);
 }
 
-void runServe(service::ServeOptions o, const std::vector<std::string>& inputs, bool quiet) {
+void runServe(service::ServeOptions o, const std::vector<std::string>& inputs, int udp_buffer, bool quiet) {
   o.program = selfExecutable();
   raiseOpenFileLimit();
   if (o.web_dir == "none") o.web_dir.clear();
@@ -77,7 +77,7 @@ void runServe(service::ServeOptions o, const std::vector<std::string>& inputs, b
   }
   service::Service& s = *made;
   for (const std::string& spec : inputs) {
-    auto [source, flight] = openInput(spec);
+    auto [source, flight] = openInput(spec, planner::DatagramOptions{udp_buffer, log});
     s.addInput(std::move(source), flight);
   }
   g_service = &s;
@@ -119,10 +119,15 @@ void addServeCommands(CLI::App& app) {
   c->add_option("--input", *inputs,
                 "a fix input besides HTTP, judged by the same engine: jsonl:udp://IP:PORT (or a file or FIFO; each line names "
                 "its flight), mavlink:ADDRESS#FLIGHT, ubx:ADDRESS#FLIGHT (ADDRESS: udp://IP:PORT or a serial device)");
+  auto udp_buffer = std::make_shared<int>(0);
+  c->add_option("--udp-buffer", *udp_buffer,
+                "each udp:// input's socket receive buffer in bytes (default: the system's; capped by net.core.rmem_max, "
+                "the granted size said when smaller); kernel drops are input_dropped events and a metric")
+      ->check(CLI::Range(planner::kMinReceiveBufferBytes, planner::kMaxReceiveBufferBytes));
   c->add_flag("--quiet", *quiet, "no log lines on stderr");
-  c->callback([o, quiet, timeout_s, inputs] {
+  c->callback([o, quiet, timeout_s, inputs, udp_buffer] {
     o->limits.request_timeout = std::chrono::seconds(*timeout_s);
-    runServe(*o, *inputs, *quiet);
+    runServe(*o, *inputs, *udp_buffer, *quiet);
   });
 }
 

@@ -53,6 +53,7 @@ struct TrackOptions {
   std::string input = "-";
   std::string format = "jsonl";
   int baud = 57600;
+  int udp_buffer = 0;  ///< a UDP input's receive buffer [bytes] (0: the system default)
   bool no_handoff = false;
   std::string plans;  ///< directory for each replan's .plan
   std::vector<std::string> navs;
@@ -256,8 +257,10 @@ void addApprovals(planner::TrackingSession& session, const TrackOptions& o) {
   }
 }
 
-/// The fix source of --input and --format.
-std::unique_ptr<planner::FixSource> openFixSource(const TrackOptions& o, const planner::Tracker& tracker) {
+/// The fix source of --input and --format (`log` hears of a smaller UDP buffer than asked for).
+std::unique_ptr<planner::FixSource> openFixSource(const TrackOptions& o, const planner::Tracker& tracker,
+                                                  const std::function<void(const std::string&)>& log) {
+  const planner::DatagramOptions udp{o.udp_buffer, log};
   if (o.format == "rinex") {
     // Replay: skylane's own position and PLs at every epoch, with the mission's integrity
     // method, mask and error model, as for its approval.
@@ -269,10 +272,10 @@ std::unique_ptr<planner::FixSource> openFixSource(const TrackOptions& o, const p
     return std::make_unique<planner::RinexReplayFixSource>(o.input, o.navs, cfg);
   }
   if (o.format == "mavlink") {
-    return std::make_unique<link::mavlink::MavlinkFixSource>(link::openByteLink(o.input, o.baud), std::string());
+    return std::make_unique<link::mavlink::MavlinkFixSource>(link::openByteLink(o.input, o.baud, udp), std::string());
   }
-  if (o.format == "ubx") return std::make_unique<link::ubx::UbxFixSource>(link::openByteLink(o.input, o.baud), std::string());
-  std::unique_ptr<planner::LineInput> in = planner::openLineInput(o.input);
+  if (o.format == "ubx") return std::make_unique<link::ubx::UbxFixSource>(link::openByteLink(o.input, o.baud, udp), std::string());
+  std::unique_ptr<planner::LineInput> in = planner::openLineInput(o.input, udp);
   if (o.format == "jsonl") return std::make_unique<planner::JsonLinesFixSource>(std::move(in));
   std::optional<integrity::NmeaDate> date;
   if (!o.date.empty()) {
@@ -369,7 +372,7 @@ void runTrack(const TrackOptions& o) {
   session.addSink(out.sink());
   if (!o.map.empty()) session.addSink(track_map);
   installStopSignals(session.stopFlag());
-  const std::unique_ptr<planner::FixSource> source = openFixSource(o, session.tracker());
+  const std::unique_ptr<planner::FixSource> source = openFixSource(o, session.tracker(), log);
   // A MAVLink vehicle gets each new route and fence by the mission protocol on the same link.
   std::unique_ptr<link::mavlink::MavlinkHandoff> handoff;
   if (session.tracker().options().handoff_by_link) {
@@ -390,7 +393,8 @@ void runTrack(const TrackOptions& o) {
     log("wrote " + o.map);
   }
   log(std::to_string(sum.accepted) + " fix" + (sum.accepted == 1 ? "" : "es") + " accepted, " + std::to_string(sum.rejected) +
-      " rejected, " + std::to_string(sum.events) + " events" +
+      " rejected, " + (sum.dropped ? std::to_string(*sum.dropped) + " datagrams dropped by the kernel, " : std::string()) +
+      std::to_string(sum.events) + " events" +
       (sum.output_closed ? " (stopped: the output was closed; state saved)" : sum.stopped ? " (stopped by a signal; state saved)" : ""));
 }
 
@@ -477,6 +481,11 @@ void addTrackCommands(CLI::App& app) {
                 "jsonl, nmea (GGA + GST [+ GBS]), rinex (observation replay; needs --nav), mavlink (MAVLink 1/2 telemetry) or "
                 "ubx (u-blox NAV-PVT with NAV-PL)");
   c->add_option("--baud", o->baud, "serial device speed for --format mavlink or ubx (default 57600)");
+  c->add_option("--udp-buffer", o->udp_buffer,
+                "a udp:// input's socket receive buffer in bytes (default: the system's; the kernel caps it at "
+                "net.core.rmem_max and the granted size is said when smaller); datagrams dropped when it is full are "
+                "reported as input_dropped events")
+      ->check(CLI::Range(planner::kMinReceiveBufferBytes, planner::kMaxReceiveBufferBytes));
   c->add_flag("--no-handoff", o->no_handoff, "--format mavlink: do not upload replanned routes to the vehicle");
   c->add_option("--plans", o->plans, "write each accepted replan as DIR/<flight>-route<N>.plan (QGroundControl)");
   c->add_option("--join-timeout", o->tracker.join_timeout_s,

@@ -165,14 +165,20 @@ struct BestPiece {
   std::size_t reached = 0;  ///< pieces whose alert limit the volume reaches
 };
 
-BestPiece bestSinglePiece(const MarginField& f, const Eigen::Vector2d& c2, double hpl, Containment& out) {
+BestPiece bestSinglePiece(const MarginField& f, const Eigen::Vector2d& c2, double hpl, double tolerance_m, Containment& out) {
   BestPiece best;
   std::size_t segment = 0;
+  double best_other_m = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < f.segmentCount(); ++i) {
     const PieceAt p = f.piece(i, c2, hpl);
     const auto [h, v] = f.marginsOf(p, hpl);
-    if (std::min(h, v) > best.margin_m) {
-      best.margin_m = std::min(h, v);
+    // Pieces whose min(h, v) agree within the tolerance are tied (often the same quantity by
+    // other sums: two level legs' shared vertical margin); the tie goes to the larger other
+    // margin, not to the last bit of rounding, which depends on the frame.
+    const double m = std::min(h, v), other = std::max(h, v);
+    if (m > best.margin_m + tolerance_m || (m >= best.margin_m - tolerance_m && other > best_other_m)) {
+      best.margin_m = m;
+      best_other_m = other;
       segment = i;
       out.margin_h_m = h;
       out.margin_v_m = v;
@@ -321,12 +327,17 @@ Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_
   const Eigen::Vector2d c2 = c.head<2>();
 
   Containment out;
-  const BestPiece best = bestSinglePiece(field, c2, hpl, out);
+  const BestPiece best = bestSinglePiece(field, c2, hpl, tolerance_m, out);
   if (best.margin_m < tolerance_m && best.reached >= 2) {
     const UnionMargin u = unionMargin(field, c2, hpl, std::max(tolerance_m, 1e-3 * hal));
     // lower ≤ the union margin ≤ upper (a point of the volume has margin `upper`); report the
-    // certified lower bound.
-    if (u.lower > best.margin_m) {
+    // certified lower bound when it beats the best piece by more than the tolerance. Where the
+    // other pieces add nothing (the common case well outside), the union's margin equals the
+    // best piece's min(h, v) and the two are the same quantity summed in different orders: a
+    // bare `>` was decided by their last bit, which depends on the frame's rounding, and flipped
+    // the report between the piece's (h, v) and the union's (L, L) — margin_h -11.3 m in one
+    // frame, -26.4 m in the rotated one (clang ASan build). A gain within the tolerance is none.
+    if (u.lower > best.margin_m + tolerance_m) {
       out.across_joint = true;
       out.margin_h_m = out.margin_v_m = u.lower;
       out.verdict = u.lower > tolerance_m ? Verdict::kInside

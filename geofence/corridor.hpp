@@ -96,7 +96,8 @@ struct Containment {
   /// (On a sloping segment a larger HPL also moves the vertical band: margin_h is the horizontal
   /// room alone.) Hence a volume that reaches one piece only — a path's ends among them — is
   /// decided exactly, up to the tolerance. Across a joint (the volume reaches several pieces and
-  /// none holds it) both fields hold the one combined margin: min over the volume's columns
+  /// their union holds it better than any one piece, by more than the tolerance) both fields
+  /// hold the one combined margin: min over the volume's columns
   /// (the vertical segments through its disk) of how far the column lies inside the union of
   /// the pieces — the largest δ such that the column grown by δ up and down lies in the height
   /// bands of pieces whose horizontal margin there is ≥ δ (two pieces' bands may cover a column

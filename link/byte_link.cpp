@@ -1,7 +1,6 @@
 #include "link/byte_link.hpp"
 
 #include "maps/parse_error.hpp"
-#include "planner/tracking/line_input.hpp"
 
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -38,18 +37,20 @@ speed_t speedOf(int baud) {
 
 class PosixByteLink final : public ByteLink {
  public:
-  PosixByteLink(const std::string& input, int baud) : name_(input) {
+  PosixByteLink(const std::string& input, int baud, const planner::DatagramOptions& udp) : name_(input) {
     if (input == "-") {
       fd_ = STDIN_FILENO;
       live_ = true;
     } else if (input.rfind("udp://", 0) == 0) {
-      bindUdp(input.substr(6));
+      udp_ = std::make_unique<planner::DatagramSocket>(input.substr(6), name_, udp);
+      fd_ = udp_->fd();
+      live_ = writable_ = true;
     } else {
       openPath(baud);
     }
   }
   ~PosixByteLink() override {
-    if (fd_ > STDIN_FILENO) close(fd_);
+    if (fd_ > STDIN_FILENO && !udp_) close(fd_);
   }
   PosixByteLink(const PosixByteLink&) = delete;
   PosixByteLink& operator=(const PosixByteLink&) = delete;
@@ -59,23 +60,21 @@ class PosixByteLink final : public ByteLink {
   [[nodiscard]] bool live() const override { return live_; }
   [[nodiscard]] bool rereadable() const override { return regular_; }
   [[nodiscard]] const std::string& name() const override { return name_; }
+  [[nodiscard]] std::optional<std::uint64_t> droppedDatagrams() const override {
+    return udp_ ? std::optional<std::uint64_t>(udp_->dropped()) : std::nullopt;
+  }
 
  private:
-  void bindUdp(const std::string& hostport);
   void openPath(int baud);
   void makeRaw(int baud);
 
   std::string name_;
   int fd_ = -1;
-  bool live_ = false, udp_ = false, regular_ = false, writable_ = false;
+  std::unique_ptr<planner::DatagramSocket> udp_;  ///< a UDP link (fd_ is its socket)
+  bool live_ = false, regular_ = false, writable_ = false;
   sockaddr_in peer_{};
   bool have_peer_ = false;
 };
-
-void PosixByteLink::bindUdp(const std::string& hostport) {
-  fd_ = planner::bindUdpSocket(hostport, name_);
-  udp_ = live_ = writable_ = true;
-}
 
 void PosixByteLink::openPath(int baud) {
   struct stat info {};
@@ -110,14 +109,16 @@ ByteLink::Status PosixByteLink::read(std::vector<std::uint8_t>& out, int timeout
   if (live_) {
     pollfd p{fd_, POLLIN, 0};
     const int r = poll(&p, 1, timeout_ms);
-    if (r == 0 || (r < 0 && errno == EINTR)) return Status::kTimeout;
+    if (r == 0 || (r < 0 && errno == EINTR)) {
+      if (udp_) udp_->refreshDrops();  // drops after the last datagram read
+      return Status::kTimeout;
+    }
   }
   std::uint8_t chunk[65536];
   ssize_t n = 0;
   if (udp_) {
     sockaddr_in from{};
-    socklen_t len = sizeof from;
-    n = recvfrom(fd_, chunk, sizeof chunk, 0, reinterpret_cast<sockaddr*>(&from), &len);
+    n = udp_->receive(chunk, sizeof chunk, &from);
     if (n > 0) {
       peer_ = from;  // replies go to where the vehicle's datagrams come from
       have_peer_ = true;
@@ -142,8 +143,8 @@ bool PosixByteLink::write(const std::uint8_t* data, std::size_t n) {
 
 }  // namespace
 
-std::unique_ptr<ByteLink> openByteLink(const std::string& input, int baud) {
-  return std::make_unique<PosixByteLink>(input, baud);
+std::unique_ptr<ByteLink> openByteLink(const std::string& input, int baud, const planner::DatagramOptions& udp) {
+  return std::make_unique<PosixByteLink>(input, baud, udp);
 }
 
 }  // namespace skylane::link

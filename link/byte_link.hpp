@@ -5,9 +5,12 @@
 /// mode, 8N1, at a chosen baud rate), a file, a FIFO or stdin (read only). The transport under the
 /// binary links (MAVLink, UBX).
 
+#include "planner/tracking/datagram_socket.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,11 +30,15 @@ class ByteLink {
   [[nodiscard]] virtual bool live() const = 0;
   [[nodiscard]] virtual bool rereadable() const = 0;
   [[nodiscard]] virtual const std::string& name() const = 0;
+  /// \brief A UDP link: the datagrams the kernel dropped before they could be read
+  /// (planner/tracking/datagram_socket.hpp); empty for any other link.
+  [[nodiscard]] virtual std::optional<std::uint64_t> droppedDatagrams() const { return std::nullopt; }
 };
 
-/// \brief Opens "udp://IPv4:PORT" (binds it), "-" (stdin), a serial device (a character device:
-/// raw mode at `baud`) or a file.
-/// \throws maps::ParseError naming --input and what was expected.
-[[nodiscard]] std::unique_ptr<ByteLink> openByteLink(const std::string& input, int baud = 57600);
+/// \brief Opens "udp://IPv4:PORT" (binds it, with `udp`'s receive buffer), "-" (stdin), a serial
+/// device (a character device: raw mode at `baud`) or a file.
+/// \throws maps::ParseError naming --input (or --baud, --udp-buffer) and what was expected.
+[[nodiscard]] std::unique_ptr<ByteLink> openByteLink(const std::string& input, int baud = 57600,
+                                                     const planner::DatagramOptions& udp = {});
 
 }  // namespace skylane::link

@@ -46,6 +46,8 @@ std::string Metrics::text() const {
   for (const auto& [code, n] : responses) out << "skylane_http_responses_total{code=\"" << code << "\"} " << n << "\n";
   counter(out, "skylane_fixes_accepted_total", "Fixes judged by the tracking engine (fix events).", fixes_accepted);
   counter(out, "skylane_inputs_rejected_total", "Records refused (rejected_input events).", inputs_rejected);
+  counter(out, "skylane_input_datagrams_dropped_total",
+          "Datagrams of the UDP inputs dropped by the kernel, their receive buffer full (input_dropped events).", datagrams_dropped);
   counter(out, "skylane_events_total", "Tracking events committed.", events);
   counter(out, "skylane_approvals_submitted_total", "Approvals queued.", approvals_submitted);
   counter(out, "skylane_approvals_refused_total", "Approvals refused because the queue was full (429).", approvals_refused_queue_full);

@@ -31,6 +31,7 @@ struct Metrics {
   std::uint64_t requests = 0;
   std::map<int, std::uint64_t> responses;  ///< by status code
   std::uint64_t fixes_accepted = 0, inputs_rejected = 0, events = 0;
+  std::uint64_t datagrams_dropped = 0;  ///< by the kernel on the UDP inputs (input_dropped events)
   std::uint64_t approvals_submitted = 0, approvals_refused_queue_full = 0, rate_limited = 0;
   Histogram approval_seconds{{0.25, 0.5, 1, 2, 5, 10, 30, 60, 120, 300}};
   Histogram fix_request_seconds{{0.0005, 0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.25, 1}};

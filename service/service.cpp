@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -149,8 +150,25 @@ ServiceImpl::~ServiceImpl() {
 
 void ServiceImpl::startInput(Input& in) {
   in.thread = std::thread([this, &in] {
+    // A UDP input's kernel drops go to the service's thread once a second at most while
+    // datagrams flow, and whenever the input is quiet (as in TrackingSession::run).
+    std::uint64_t posted_drops = 0;
+    auto last_drops = std::chrono::steady_clock::now();
+    const auto postDrops = [&](bool now) {
+      const auto dropped = in.source->droppedDatagrams();
+      const auto wall = std::chrono::steady_clock::now();
+      if (!dropped || *dropped <= posted_drops || (!now && wall - last_drops < std::chrono::seconds(1))) return;
+      last_drops = wall;
+      server->post([this, name = in.source->name(), total = *dropped, step = *dropped - posted_drops] {
+        metrics.datagrams_dropped += step;
+        session->reportDropped(name, total);
+        session->commit();
+      });
+      posted_drops = *dropped;
+    };
     while (!stopping) {
       planner::SourceRecord r = in.source->next(250);
+      postDrops(r.kind != planner::SourceRecord::Kind::kFix && r.kind != planner::SourceRecord::Kind::kBad);
       if (r.kind == planner::SourceRecord::Kind::kEnd) break;
       if (r.kind == planner::SourceRecord::Kind::kIdle) continue;
       server->post([this, r = std::move(r), flight = in.flight] { takeRecord(r, flight); });

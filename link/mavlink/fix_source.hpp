@@ -49,6 +49,7 @@ class MavlinkFixSource final : public planner::FixSource {
   [[nodiscard]] bool rereadable() const override { return link_->rereadable(); }
   void resumeAfter(std::size_t line) override { resume_frame_ = line; }
   [[nodiscard]] std::size_t checkpointLine() const override { return frame_; }
+  [[nodiscard]] std::optional<std::uint64_t> droppedDatagrams() const override { return link_->droppedDatagrams(); }
 
   [[nodiscard]] const VehicleState& vehicle() const { return vehicle_; }
   [[nodiscard]] const ParserStats& stats() const { return parser_.stats(); }

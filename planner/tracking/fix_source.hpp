@@ -11,6 +11,7 @@
 #include "planner/tracking/track_fix.hpp"
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -52,6 +53,9 @@ class FixSource {
   /// \brief The line a checkpoint stores: everything up to it is processed (an NMEA epoch still
   /// open is not: the line stays before it).
   [[nodiscard]] virtual std::size_t checkpointLine() const = 0;
+  /// \brief A UDP input: the datagrams the kernel dropped before they could be read so far
+  /// (datagram_socket.hpp); empty for any other input.
+  [[nodiscard]] virtual std::optional<std::uint64_t> droppedDatagrams() const { return std::nullopt; }
 };
 
 /// \brief One fix per JSON line (track_fix.hpp's schema); blank lines are skipped.
@@ -64,6 +68,7 @@ class JsonLinesFixSource final : public FixSource {
   [[nodiscard]] bool rereadable() const override { return in_->rereadable(); }
   void resumeAfter(std::size_t line) override { resume_line_ = line; }
   [[nodiscard]] std::size_t checkpointLine() const override { return line_; }
+  [[nodiscard]] std::optional<std::uint64_t> droppedDatagrams() const override { return in_->droppedDatagrams(); }
 
  private:
   std::unique_ptr<LineInput> in_;
@@ -84,6 +89,7 @@ class NmeaFixSource final : public FixSource {
   [[nodiscard]] bool rereadable() const override { return in_->rereadable(); }
   void resumeAfter(std::size_t line) override { resume_line_ = line; }
   [[nodiscard]] std::size_t checkpointLine() const override;
+  [[nodiscard]] std::optional<std::uint64_t> droppedDatagrams() const override { return in_->droppedDatagrams(); }
 
  private:
   /// The record of a closed epoch that opened at `first_line` (none before the resume line).

@@ -3,17 +3,12 @@
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
 
-#include <arpa/inet.h>
 #include <fcntl.h>
-#include <netinet/in.h>
 #include <poll.h>
-#include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstdint>
-#include <cstdlib>
 #include <cstring>
 
 namespace skylane::planner {
@@ -25,18 +20,20 @@ using maps::ParseError;
 /// Lines from a POSIX file descriptor: a file, stdin, a FIFO or a bound UDP socket.
 class PosixLineInput final : public LineInput {
  public:
-  explicit PosixLineInput(const std::string& input) : name_(input) {
+  PosixLineInput(const std::string& input, const DatagramOptions& udp) : name_(input) {
     if (input == "-") {
       fd_ = STDIN_FILENO;
       live_ = true;
     } else if (input.rfind("udp://", 0) == 0) {
-      bindUdp(input.substr(6));
+      udp_ = std::make_unique<DatagramSocket>(input.substr(6), name_, udp);
+      fd_ = udp_->fd();
+      live_ = true;
     } else {
       openFile();
     }
   }
   ~PosixLineInput() override {
-    if (fd_ > STDIN_FILENO) close(fd_);
+    if (fd_ > STDIN_FILENO && !udp_) close(fd_);
   }
   PosixLineInput(const PosixLineInput&) = delete;
   PosixLineInput& operator=(const PosixLineInput&) = delete;
@@ -45,9 +42,11 @@ class PosixLineInput final : public LineInput {
   [[nodiscard]] bool live() const override { return live_; }
   [[nodiscard]] bool rereadable() const override { return regular_; }
   [[nodiscard]] const std::string& name() const override { return name_; }
+  [[nodiscard]] std::optional<std::uint64_t> droppedDatagrams() const override {
+    return udp_ ? std::optional<std::uint64_t>(udp_->dropped()) : std::nullopt;
+  }
 
  private:
-  void bindUdp(const std::string& hostport);
   void openFile();
   /// The next complete line in the buffer (a line too long is dropped up to its end).
   bool takeLine(std::string& line, Status& status);
@@ -56,14 +55,10 @@ class PosixLineInput final : public LineInput {
 
   std::string name_;
   int fd_ = -1;
-  bool live_ = false, udp_ = false, eof_ = false, skipping_ = false, regular_ = false;
+  std::unique_ptr<DatagramSocket> udp_;  ///< a UDP input (fd_ is its socket)
+  bool live_ = false, eof_ = false, skipping_ = false, regular_ = false;
   std::string buffer_;
 };
-
-void PosixLineInput::bindUdp(const std::string& hostport) {
-  fd_ = bindUdpSocket(hostport, name_);
-  udp_ = live_ = true;
-}
 
 void PosixLineInput::openFile() {
   maps::requireNotAFolder(name_, "--input");
@@ -104,10 +99,13 @@ bool PosixLineInput::fill(int timeout_ms) {
   if (live_) {
     pollfd p{fd_, POLLIN, 0};
     const int r = poll(&p, 1, timeout_ms);
-    if (r == 0 || (r < 0 && errno == EINTR)) return false;
+    if (r == 0 || (r < 0 && errno == EINTR)) {
+      if (udp_) udp_->refreshDrops();  // drops after the last datagram read
+      return false;
+    }
   }
   char chunk[65536];
-  const ssize_t n = udp_ ? recv(fd_, chunk, sizeof chunk, 0) : read(fd_, chunk, sizeof chunk);
+  const ssize_t n = udp_ ? udp_->receive(chunk, sizeof chunk, nullptr) : read(fd_, chunk, sizeof chunk);
   if (n < 0 && errno == EINTR) return false;
   if (n <= 0) {
     if (!udp_) eof_ = true;
@@ -135,28 +133,9 @@ LineInput::Status PosixLineInput::next(std::string& line, int timeout_ms) {
 
 }  // namespace
 
-int bindUdpSocket(const std::string& hostport, const std::string& input) {
-  const auto colon = hostport.rfind(':');
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  const std::string host = colon == std::string::npos ? "" : hostport.substr(0, colon);
-  const std::string port = colon == std::string::npos ? "" : hostport.substr(colon + 1);
-  char* end = nullptr;
-  const long p = std::strtol(port.c_str(), &end, 10);
-  if (host.empty() || port.empty() || *end != '\0' || p < 1 || p > 65535 || inet_pton(AF_INET, host.c_str(), &addr.sin_addr) != 1) {
-    throw ParseError("--input", 0, "--input", input, "udp://IPv4:PORT, e.g. udp://127.0.0.1:5005");
-  }
-  addr.sin_port = htons(static_cast<std::uint16_t>(p));
-  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
-  if (fd < 0 || bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-    const std::string why = std::strerror(errno);
-    if (fd >= 0) close(fd);
-    throw ParseError("--input", 0, "--input", input, "a UDP port to listen on (" + why + ")");
-  }
-  return fd;
+std::unique_ptr<LineInput> openLineInput(const std::string& input, const DatagramOptions& udp) {
+  return std::make_unique<PosixLineInput>(input, udp);
 }
-
-std::unique_ptr<LineInput> openLineInput(const std::string& input) { return std::make_unique<PosixLineInput>(input); }
 
 LineInput::Status MemoryLineInput::next(std::string& line, int /*timeout_ms*/) {
   if (lines_.empty()) return Status::kEnd;

@@ -5,9 +5,13 @@
 /// input (stdin, FIFO, socket, UDP) returns kTimeout when it is quiet, so that a stop request and
 /// stale flights are noticed.
 
+#include "planner/tracking/datagram_socket.hpp"
+
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,15 +35,15 @@ class LineInput {
   [[nodiscard]] virtual bool rereadable() const = 0;
   /// \brief The input's name in messages and in the resume table ("-", a path, udp://…).
   [[nodiscard]] virtual const std::string& name() const = 0;
+  /// \brief A UDP input: the datagrams the kernel dropped before they could be read, as of the
+  /// last datagram read or quiet poll (datagram_socket.hpp); empty for any other input.
+  [[nodiscard]] virtual std::optional<std::uint64_t> droppedDatagrams() const { return std::nullopt; }
 };
 
-/// \brief A UDP socket bound to `hostport` ("IPv4:PORT"); `input` names it in errors.
-/// \throws maps::ParseError naming --input and what was expected.
-[[nodiscard]] int bindUdpSocket(const std::string& hostport, const std::string& input);
-
-/// \brief Opens "-" (stdin), "udp://IPv4:PORT" (binds the port) or a file path.
-/// \throws maps::ParseError naming --input and what was expected (an address, a readable file).
-[[nodiscard]] std::unique_ptr<LineInput> openLineInput(const std::string& input);
+/// \brief Opens "-" (stdin), "udp://IPv4:PORT" (binds the port, with `udp`'s receive buffer) or
+/// a file path.
+/// \throws maps::ParseError naming --input (an address, a readable file) or --udp-buffer.
+[[nodiscard]] std::unique_ptr<LineInput> openLineInput(const std::string& input, const DatagramOptions& udp = {});
 
 /// \brief Lines held in memory (tests, a service's request body). Not live, not rereadable.
 class MemoryLineInput final : public LineInput {

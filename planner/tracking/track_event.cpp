@@ -36,6 +36,15 @@ TrackEvent rejectedInputEvent(const std::string& source, std::size_t line, const
   return e;
 }
 
+TrackEvent inputDroppedEvent(const std::string& source, std::uint64_t count, std::uint64_t total) {
+  TrackEvent e;
+  e.type = "input_dropped";
+  e["source"] = source;
+  e["count"] = count;
+  e["total"] = total;
+  return e;
+}
+
 void to_json(json& j, const FixRecord& f) {
   j["line"] = f.line;
   j["lat"] = roundToDeg8(f.lat_rad);
@@ -86,15 +95,15 @@ namespace {
 
 const std::string kEventSource = "track event";
 /// The event types the engine writes (TrackEvent::type points at one of them).
-constexpr std::array<const char*, 7> kEventTypes{"fix", "violation", "recovered", "monitoring_rerun",
-                                                 "replan", "stale", "rejected_input"};
+constexpr std::array<const char*, 8> kEventTypes{"fix",   "violation",      "recovered",    "monitoring_rerun",
+                                                 "replan", "stale", "rejected_input", "input_dropped"};
 
 const char* eventTypeOf(const maps::JsonNode& n) {
   const std::string s = n.str();
   for (const char* t : kEventTypes) {
     if (s == t) return t;
   }
-  n.fail("fix, violation, recovered, monitoring_rerun, replan, stale or rejected_input");
+  n.fail("fix, violation, recovered, monitoring_rerun, replan, stale, rejected_input or input_dropped");
 }
 
 PlSource plSourceOf(const maps::JsonNode& n) {

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -56,6 +57,10 @@ struct TrackEvent {
 
 /// \brief A `rejected_input` event: a record of `source` (line `line`, 0: none) that could not be taken, and why.
 [[nodiscard]] TrackEvent rejectedInputEvent(const std::string& source, std::size_t line, const std::string& why);
+
+/// \brief An `input_dropped` event: `count` datagrams of UDP input `source` dropped by the kernel
+/// (its receive buffer was full) since the last such event, `total` since the input was opened.
+[[nodiscard]] TrackEvent inputDroppedEvent(const std::string& source, std::uint64_t count, std::uint64_t total);
 
 /// \brief FixRecord's members as JSON (merged into the `fix` event's object).
 void to_json(nlohmann::json& j, const FixRecord& f);

@@ -112,6 +112,18 @@ void TrackingSession::reject(const std::string& where, std::size_t line, const s
   ++pending_;
 }
 
+void TrackingSession::reportDropped(const std::string& source, std::uint64_t total) {
+  std::uint64_t& reported = dropped_[source];
+  if (total <= reported) return;
+  beginBatch();
+  emit({inputDroppedEvent(source, total - reported, total)});
+  log_(source + ": " + std::to_string(total - reported) + " datagrams dropped by the kernel (receive buffer full; " +
+       std::to_string(total) + " in all)");
+  reported = total;
+  summary_.dropped = total;
+  ++pending_;
+}
+
 void TrackingSession::sweepWhileQuiet(double quiet_s) {
   // A quiet live input: stream time runs on with the wall clock for the stale check.
   if (!tracker_.streamTime()) return;
@@ -158,8 +170,22 @@ SessionSummary TrackingSession::run(FixSource& source) {
   }
   constexpr int kIdlePollMs = 250;  // how often a quiet live input looks at the stop flag and the clock
   auto last_wall = std::chrono::steady_clock::now();
+  auto last_drop_report = last_wall;
+  // A UDP input's kernel drops: one event per second at most while datagrams flow (a flood
+  // drops thousands a second), and whenever the input goes quiet, and at the end.
+  constexpr double kDropReportPeriod_s = 1.0;
+  const auto reportDrops = [&](bool now) {
+    const auto dropped = source.droppedDatagrams();
+    if (!dropped) return;
+    const auto wall = std::chrono::steady_clock::now();
+    if (!now && std::chrono::duration<double>(wall - last_drop_report).count() < kDropReportPeriod_s) return;
+    last_drop_report = wall;
+    reportDropped(source.name(), *dropped);
+  };
+  if (source.droppedDatagrams()) summary_.dropped = 0;
   while (!stop_) {
     SourceRecord r = source.next(kIdlePollMs);
+    reportDrops(r.kind == SourceRecord::Kind::kIdle);
     tick();
     if (r.kind == SourceRecord::Kind::kEnd) break;
     if (r.kind == SourceRecord::Kind::kIdle) {
@@ -173,6 +199,7 @@ SessionSummary TrackingSession::run(FixSource& source) {
       submit(r.fix);
     }
   }
+  reportDrops(true);
   requirePositionWithinInput(source, resume_line);
   summary_.stopped = stop_ && !summary_.output_closed;
   finish();

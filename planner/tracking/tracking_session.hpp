@@ -19,9 +19,11 @@
 
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -33,6 +35,9 @@ struct SessionSummary {
   std::size_t accepted = 0;  ///< `fix` events
   std::size_t rejected = 0;  ///< `rejected_input` events
   std::size_t events = 0;
+  /// A UDP input: datagrams the kernel dropped (its receive buffer was full), reported as
+  /// `input_dropped` events; empty for any other input.
+  std::optional<std::uint64_t> dropped;
   bool stopped = false;        ///< by requestStop()
   bool output_closed = false;  ///< a sink's reader went away
 };
@@ -71,6 +76,9 @@ class TrackingSession {
   void submit(const TrackFix& fix);
   /// \brief One record the caller could not read (`flight`: the flight it named, if any).
   void reject(const std::string& where, std::size_t line, const std::string& why, const std::string& flight = {});
+  /// \brief A UDP input's kernel drops: `total` datagrams of `source` dropped so far (a counter
+  /// that only grows); an `input_dropped` event with what is new since the last call, if any.
+  void reportDropped(const std::string& source, std::uint64_t total);
   /// \brief The stale sweep at the stream time and a checkpoint (the end of a run).
   void finish();
   /// \brief A checkpoint now: what was submitted is committed and handed to the sinks (a
@@ -101,6 +109,7 @@ class TrackingSession {
   std::vector<Ticker> tickers_;
   std::map<std::string, std::string> report_of_;  ///< flight id → approval report file
   std::set<std::string> touched_;                 ///< flights changed since the last checkpoint
+  std::map<std::string, std::uint64_t> dropped_;  ///< UDP input → kernel drops reported so far
   int pending_ = 0;
   FixSource* source_ = nullptr;  ///< the source being run (its checkpoint line)
   bool resumable_ = false;

@@ -17,8 +17,14 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <chrono>
+#include <thread>
 
 namespace skylane {
 namespace {
@@ -529,6 +535,92 @@ TEST_F(TrackCli, UdpInputAndAStaleFlightOnAQuietLink) {
   EXPECT_EQ(ofType(ev, "fix").size(), 5u);
   ASSERT_EQ(ofType(ev, "stale").size(), 1u);
   EXPECT_EQ(ofType(ev, "stale")[0].at("last_fix"), "2020-01-01T14:00:04.000Z");
+}
+
+/// Sends each line as one datagram to 127.0.0.1:port as fast as the socket takes them.
+void floodUdp(int port, const std::vector<std::string>& lines) {
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(static_cast<std::uint16_t>(port));
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  for (const std::string& l : lines) sendto(fd, l.data(), l.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+  close(fd);
+}
+
+/// `skylane track` on a UDP port, run in the background until the returned stop() (SIGTERM).
+struct BackgroundTrack {
+  std::string pid_file;
+  std::thread runner;
+  RunResult result;
+  BackgroundTrack(const std::string& command, const std::string& pid_file_path, int port) : pid_file(pid_file_path) {
+    std::filesystem::remove(pid_file);
+    runner = std::thread([this, command] { result = sh(command + " & echo $! > " + pid_file + "; wait $!; echo status=$?"); });
+    (void)sh(waitForUdpPort(port));
+  }
+  RunResult stop() {
+    const RunResult r = sh("kill -TERM $(cat " + pid_file + ")");
+    runner.join();
+    return result;
+  }
+};
+
+TEST_F(TrackCli, UdpFloodIntoASmallBufferReportsEveryDroppedDatagram) {
+  // GIVEN the tracker on a UDP port with a small receive buffer
+  const int port = 47833;
+  const std::string events = *dir_ + "/flood_events.jsonl", err = *dir_ + "/flood_err.txt";
+  BackgroundTrack track(kBin + " track --approval " + approval() + " --input udp://127.0.0.1:" + std::to_string(port) +
+                            " --udp-buffer 4096 --no-replan --max-time-jump 86400 > " + events + " 2> " + err,
+                        *dir_ + "/flood.pid", port);
+  // WHEN 5,000 fixes come flat out, one datagram each
+  constexpr int kSent = 5000;
+  std::vector<std::string> lines;
+  for (int k = 0; k < kSent; ++k) lines.push_back(goodFix(k).dump() + "\n");
+  floodUdp(port, lines);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the queue drains, the input goes quiet
+  const RunResult r = track.stop();
+  EXPECT_NE(r.out.find("status=0"), std::string::npos) << r.out << test::readFile(err);
+  // THEN the drops are events, and every datagram sent is accepted, rejected or counted dropped
+  const auto ev = readEvents(events);
+  std::uint64_t dropped = 0, last_total = 0;
+  for (const json& e : ofType(ev, "input_dropped")) {
+    EXPECT_EQ(e.at("source"), "udp://127.0.0.1:" + std::to_string(port));
+    dropped += e.at("count").get<std::uint64_t>();
+    EXPECT_EQ(e.at("total").get<std::uint64_t>(), dropped);  // running total
+    last_total = e.at("total").get<std::uint64_t>();
+  }
+  const std::size_t accepted = ofType(ev, "fix").size(), rejected = ofType(ev, "rejected_input").size();
+  EXPECT_GT(dropped, 0u);
+  EXPECT_EQ(accepted + rejected + dropped, static_cast<std::size_t>(kSent))
+      << accepted << " accepted, " << rejected << " rejected, " << dropped << " dropped";
+  // AND the summary says so
+  const std::string summary = std::to_string(accepted) + " fixes accepted, " + std::to_string(rejected) + " rejected, " +
+                              std::to_string(last_total) + " datagrams dropped by the kernel";
+  EXPECT_NE(test::readFile(err).find(summary), std::string::npos) << test::readFile(err);
+  std::printf("UDP flood: %d sent, %zu accepted, %zu rejected, %llu dropped by the kernel\n", kSent, accepted, rejected,
+              static_cast<unsigned long long>(dropped));
+}
+
+TEST_F(TrackCli, UdpAtAModestRateIntoABigBufferDropsNothing) {
+  const int port = 47834;
+  const std::string events = *dir_ + "/modest_events.jsonl", err = *dir_ + "/modest_err.txt";
+  BackgroundTrack track(kBin + " track --approval " + approval() + " --input udp://127.0.0.1:" + std::to_string(port) +
+                            " --udp-buffer 4194304 --no-replan > " + events + " 2> " + err,
+                        *dir_ + "/modest.pid", port);
+  constexpr int kSent = 1000;
+  for (int k = 0; k < kSent; k += 50) {  // 50 fixes every 10 ms: 5,000 a second
+    std::vector<std::string> lines;
+    for (int j = k; j < k + 50; ++j) lines.push_back(goodFix(j).dump() + "\n");
+    floodUdp(port, lines);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  const RunResult r = track.stop();
+  EXPECT_NE(r.out.find("status=0"), std::string::npos) << r.out << test::readFile(err);
+  const auto ev = readEvents(events);
+  EXPECT_EQ(ofType(ev, "input_dropped").size(), 0u);
+  EXPECT_EQ(ofType(ev, "fix").size(), static_cast<std::size_t>(kSent));
+  EXPECT_NE(test::readFile(err).find("0 datagrams dropped by the kernel"), std::string::npos) << test::readFile(err);
 }
 
 TEST_F(TrackCli, BadApprovalsExitTwoNamingTheField) {

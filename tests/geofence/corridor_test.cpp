@@ -125,6 +125,40 @@ Eigen::Vector3d moved(const Eigen::Vector3d& p, double yaw, const Eigen::Vector3
   return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * p + t;
 }
 
+TEST(Corridor, MarginsDoNotJumpWhereTheUnionStopsHelpingAtAJoint) {
+  // GIVEN a volume at a turn, horizontally well inside both pieces (h 16 m and 18 m) but 27 m
+  // below both (v -27 m for both): the union's margin equals the best piece's min(h, v) = v, so
+  // whether the union is "better", and which piece is best, rested on the last bit of sums whose
+  // rounding depends on the frame.
+  const std::vector<Eigen::Vector3d> path{{0, 0, 100}, {100, 0, 100}, {100, 100, 100}};
+  const ProtectionVolume volume{{99, 3, 60}, 5.0, 5.0};
+  const AlertLimits limits{24.0, 18.0};
+  const Containment base = Corridor(path, limits).contains(volume);
+  ASSERT_EQ(base.verdict, Verdict::kOutside);
+  // WHEN the scene is moved to 2,000 frames (rotated, translated up to 100 km)
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < 2000; ++k) {
+    const double yaw = 2 * kPi * u(rng);
+    const Eigen::Vector3d t(-1e5 + 2e5 * u(rng), -1e5 + 2e5 * u(rng), 0.0);
+    std::vector<Eigen::Vector3d> p2;
+    for (const Eigen::Vector3d& p : path) p2.push_back(moved(p, yaw, t));
+    const Containment c = Corridor(p2, limits).contains({moved(volume.p_map, yaw, t), volume.hpl_m, volume.vpl_m});
+    // THEN the union gains nothing in any frame: the best piece's exact margins, the same in every
+    // frame (before the fix, a clang build took the union's (v, v) in some frames on a last-bit
+    // difference of two equal sums)
+    EXPECT_FALSE(c.across_joint) << "frame " << k;
+    ASSERT_NEAR(c.margin_h_m, base.margin_h_m, 1e-6) << "frame " << k;
+    ASSERT_NEAR(c.margin_v_m, base.margin_v_m, 1e-6) << "frame " << k;
+    ASSERT_EQ(c.verdict, Verdict::kOutside);
+  }
+  // The tie on v goes to the piece with more horizontal room: the second leg, 1 m away (not the
+  // first, 3 m away, which came first).
+  EXPECT_NEAR(base.margin_h_m, 24.0 - 1.0 - 5.0, 1e-9);  // HAL - offset from the second leg - HPL
+  EXPECT_EQ(base.segment, 1u);
+  EXPECT_NEAR(base.margin_v_m, (60.0 - 5.0) - (100.0 - 18.0), 1e-9);  // volume bottom - band floor
+}
+
 TEST(Corridor, VerdictsAndMarginsAreFrameInvariant) {
   const std::vector<Eigen::Vector3d> path{{0, 0, 50}, {100, 0, 60}, {100, 100, 60}, {30, 150, 40}};
   const std::vector<ProtectionVolume> volumes{{{50, 2, 56}, 3.0, 2.0}, {{103, -3, 60}, 1.0, 1.0},

@@ -520,6 +520,49 @@ TEST_F(ServiceUdpInput, FixesFromAUdpInputAreJudgedByTheSameEngineAndStream) {
   EXPECT_NE(metrics.body.find("skylane_inputs_rejected_total 1\n"), std::string::npos) << metrics.body;
 }
 
+/// A counter's value in the /metrics text (-1 when absent).
+long long metricValue(const std::string& text, const std::string& name) {
+  const auto at = text.find("\n" + name + " ");
+  return at == std::string::npos ? -1 : std::stoll(text.substr(at + name.size() + 2));
+}
+
+TEST_F(ServiceUdpInput, KernelDropsOnAFloodedUdpInputAreEventsAndAMetric) {
+  // GIVEN the service restarted with a UDP input whose receive buffer is the smallest allowed
+  const std::string fl = startFlight(TestTokens::kAcme, approve(TestTokens::kAcme, publishZones()));
+  std::vector<std::string> lines;
+  constexpr int kSent = 3000;
+  for (int k = 1; k <= kSent; ++k) {
+    json f = fixAt(fl, k);
+    f["flight"] = fl;
+    lines.push_back(f.dump() + "\n");
+  }
+  ASSERT_EQ(server_->kill(SIGTERM), 0);
+  const int port = freeUdpPort();
+  server_->start({"--input", "jsonl:udp://127.0.0.1:" + std::to_string(port), "--udp-buffer", "1024"});
+  client_ = std::make_unique<HttpClient>(server_->port());
+  // WHEN 3,000 fixes arrive flat out
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  for (const std::string& l : lines) ::sendto(fd, l.data(), l.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  ::close(fd);
+  // THEN every datagram is accepted, rejected or counted dropped, and the drops are a metric
+  long long accepted = 0, rejected = 0, dropped = 0;
+  for (int i = 0; i < 100 && accepted + rejected + dropped < kSent; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    const std::string m = call("GET", "/metrics", TestTokens::kAuthority).body;
+    accepted = metricValue(m, "skylane_fixes_accepted_total");
+    rejected = metricValue(m, "skylane_inputs_rejected_total");
+    dropped = metricValue(m, "skylane_input_datagrams_dropped_total");
+  }
+  EXPECT_GT(dropped, 0);
+  EXPECT_EQ(accepted + rejected + dropped, kSent) << accepted << " accepted, " << rejected << " rejected, " << dropped << " dropped";
+  std::printf("service UDP flood: %d sent, %lld accepted, %lld rejected, %lld dropped by the kernel\n", kSent, accepted, rejected,
+              dropped);
+}
+
 }  // namespace
 }  // namespace skylane
 
