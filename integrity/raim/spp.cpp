@@ -14,8 +14,7 @@ namespace {
 constexpr double kFreqL1_hz = 1575.42e6;
 constexpr double kFreqL2_hz = 1227.60e6;
 constexpr double kFreqE5a_hz = 1176.45e6;
-/// Gauss-Newton stops when the position update is below this [m].
-constexpr double kConvergence_m = 1e-4;
+/// Iterations of the initial-position search (phase A) at most.
 constexpr int kMaxIterations = 12;
 /// Before this the receiver is too far from the Earth's surface for look angles to mean anything.
 constexpr double kMinEarthRadius_m = 6.0e6;
