@@ -16,7 +16,7 @@ build="${1:-$root/build-fuzz}"
 seconds="${2:-60}"
 shift $(( $# > 2 ? 2 : $# ))
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(yuma sem rinex_nav rinex_obs geometry text_fields zones buildings fence scenario mission nmea track mavlink ubx)
+[ ${#targets[@]} -eq 0 ] && targets=(yuma sem rinex_nav rinex_obs geometry text_fields zones buildings fence scenario mission nmea track mavlink ubx service nats)
 work="${SKYLANE_FUZZ_WORK:-/tmp/skylane-fuzz}"
 data="$root/tests/data"
 shopt -s nullglob  # a pattern that matches nothing is no file (not the pattern itself)
@@ -59,7 +59,7 @@ seed() {  # target corpus-dir
       done ;;
     zones) copy_seeds "$c" "$data"/geozones/*.json "$data"/geozones/*.geojson "$data"/geozones/*.plan ;;
     buildings) copy_seeds "$c" "$root"/fuzz/corpus/buildings/* "$root"/examples/skymask/*.geojson ;;
-    sem | geometry | text_fields | fence | scenario | nmea | mission | track | mavlink | ubx)
+    sem | geometry | text_fields | fence | scenario | nmea | mission | track | mavlink | ubx | service | nats)
       copy_seeds "$c" "$root"/fuzz/corpus/"$t"/* ;;
     *) echo "unknown target $t" >&2; return 1 ;;
   esac
