@@ -14,6 +14,7 @@
 // geometry, on the same draws, and both sets of figures are printed.
 #include "integrity/araim/exclusion.hpp"
 #include "integrity/araim/fde.hpp"
+#include "tests/integrity/araim_example.hpp"
 #include "integrity/gnss/almanac.hpp"
 #include "integrity/gnss/orbit_source.hpp"
 #include "integrity/raim/raim.hpp"
@@ -142,27 +143,11 @@ TEST(ExclusionMonteCarlo, RaimPlAfterExclusionBoundsTheErrorAtTheStatedRate) {
 
 // ---------------------------------------------------------------- ARAIM FDE
 
-/// The geometry of the ADD v3.0 Appendix D example (10 satellites, GPS + Galileo).
+/// The ADD v3.0 Appendix D example geometry with the simulated errors' own σ and no bias.
 Geometry addExampleGeometry() {
-  const double rows[10][5] = {{0.0225, 0.9951, -0.0966, 1, 0},   {0.6750, -0.6900, -0.2612, 1, 0},
-                              {0.0723, -0.6601, -0.7477, 1, 0},  {-0.9398, 0.2553, -0.2269, 1, 0},
-                              {-0.5907, -0.7539, -0.2877, 1, 0}, {-0.3236, -0.0354, -0.9455, 0, 1},
-                              {-0.6748, 0.4356, -0.5957, 0, 1},  {0.0938, -0.7004, -0.7075, 0, 1},
-                              {0.5571, 0.3088, -0.7709, 0, 1},   {0.6622, 0.6958, -0.2780, 0, 1}};
-  const double c_int[10] = {3.8865, 1.4377, 0.8604, 1.6383, 1.3229, 0.8434, 0.8963, 0.8669, 0.8573, 1.3616};
-  Geometry g;
-  g.G.resize(10, 5);
-  g.sigma_int.resize(10);
-  g.sigma_acc.resize(10);
+  Geometry g = araim_example::addExampleGeometry();
   g.bnom = Eigen::VectorXd::Zero(10);  // no nominal bias: the simulated errors are zero-mean
-  g.clocks = {Constellation::kGps, Constellation::kGalileo};
-  for (int i = 0; i < 10; ++i) {
-    for (int j = 0; j < 5; ++j) g.G(i, j) = rows[i][j];
-    g.sigma_int[i] = std::sqrt(c_int[i]);
-    g.sigma_acc[i] = g.sigma_int[i];  // the simulated errors have the integrity σ's
-    g.sats.push_back({i < 5 ? Constellation::kGps : Constellation::kGalileo, i % 5 + 1});
-    g.elevation_rad.push_back(0.5);
-  }
+  g.sigma_acc = g.sigma_int;           // the simulated errors have the integrity σ's
   return g;
 }
 
