@@ -58,25 +58,31 @@ double solutionSeparationRatio(const AraimResult& r, const Eigen::VectorXd& y) {
 
 namespace {
 
+/// The all-in-view solution and the solution-separation test against `out.pl`; false when there
+/// is nothing further to do (no solution, no PL, or no detection).
+bool testAllInView(const Geometry& g, const Eigen::VectorXd& y, AraimFdeResult& out) {
+  const Fit all = fit(g, y);
+  if (!all.ok) {
+    out.pl.pl_computed = out.pl.available = false;
+    if (out.pl.reason.empty()) out.pl.reason = "singular geometry";
+    return false;
+  }
+  out.solution_ok = true;
+  out.dx = all.dx;
+  out.final_geometry = g;
+  if (!out.pl.pl_computed) return false;  // nothing to test against; the reason says why
+  out.max_test_ratio = solutionSeparationRatio(out.pl, y);
+  out.fault_detected = out.max_test_ratio > 1.0;
+  return out.fault_detected;
+}
+
 /// ExclusionPl::kRemainingGeometry: candidates are the monitored modes, the PL after an
 /// exclusion is the plain PL of the remaining geometry (skylane before issue 18).
 AraimFdeResult fdeWithRemainingGeometryPl(const Geometry& g, const Eigen::VectorXd& y, const ErrorModel& model,
                                           const AraimConfig& cfg) {
   AraimFdeResult out;
   out.pl = araimProtectionLevels(g, model, cfg);
-  const Fit all = fit(g, y);
-  if (!all.ok) {
-    out.pl.pl_computed = out.pl.available = false;
-    if (out.pl.reason.empty()) out.pl.reason = "singular geometry";
-    return out;
-  }
-  out.solution_ok = true;
-  out.dx = all.dx;
-  out.final_geometry = g;
-  if (!out.pl.pl_computed) return out;  // nothing to test against; the reason says why
-  out.max_test_ratio = solutionSeparationRatio(out.pl, y);
-  if (out.max_test_ratio <= 1.0) return out;
-  out.fault_detected = true;
+  if (!testAllInView(g, y, out)) return out;
 
   // Exclusion: candidates are the monitored modes, fewest satellites first.
   double best_wsse = std::numeric_limits<double>::infinity();
@@ -115,19 +121,7 @@ AraimFdeResult fdeWithRemainingGeometryPl(const Geometry& g, const Eigen::Vector
 bool detect(const Geometry& g, const Eigen::VectorXd& y, const FaultModeSet& modes, const AraimConfig& cfg, double rho,
             AraimFdeResult& out) {
   out.pl = araimLevelsOverModes(g, modes, cfg, rho);
-  const Fit all = fit(g, y);
-  if (!all.ok) {
-    out.pl.pl_computed = out.pl.available = false;
-    if (out.pl.reason.empty()) out.pl.reason = "singular geometry";
-    return false;
-  }
-  out.solution_ok = true;
-  out.dx = all.dx;
-  out.final_geometry = g;
-  if (!out.pl.pl_computed) return false;  // nothing to test against; the reason says why
-  out.max_test_ratio = solutionSeparationRatio(out.pl, y);
-  out.fault_detected = out.max_test_ratio > 1.0;
-  return out.fault_detected;
+  return testAllInView(g, y, out);
 }
 
 /// ExclusionPl::kAllocated (docs/method.md §4.3; Blanch, Walter & Enge 2017): the fixed
