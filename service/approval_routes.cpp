@@ -137,7 +137,15 @@ HttpResponse ServiceImpl::submitApproval(const HttpRequest& r, const Principal& 
   ApprovalState a;
   a.row = {id, who.owner(), name, "queued", nowUtc(), "approvals/" + id, "", ""};
   a.submitted = std::chrono::steady_clock::now();
-  if (!pool->submit({id, (dir / "mission.json").string(), dir.string()})) {
+  if (nats) {
+    try {
+      nats->requestApproval(who.owner(), id, (dir / "mission.json").string());
+    } catch (const std::exception& e) {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+      return errorResponse(503, withoutFolder(std::string("NATS: ") + e.what(), files, "the service folder"));
+    }
+  } else if (!pool->submit({id, (dir / "mission.json").string(), dir.string()})) {
     ++metrics.approvals_refused_queue_full;
     std::error_code ec;
     fs::remove_all(dir, ec);
@@ -156,7 +164,17 @@ HttpResponse ServiceImpl::submitApproval(const HttpRequest& r, const Principal& 
 void ServiceImpl::queueApproval(ApprovalState& a) {
   const fs::path dir = files / a.row.dir;
   a.row.status = "queued";
-  if (!pool->submit({a.row.id, (dir / "mission.json").string(), dir.string()})) {
+  if (nats) {
+    // The workers may have finished it while the service was down; else it is asked again (a
+    // repeat within the queue's duplicate window is dropped, a worker never redoes a final one).
+    if (natsTakeOutcome(a)) return;
+    try {
+      nats->requestApproval(a.row.owner, a.row.id, (dir / "mission.json").string());
+    } catch (const std::exception& e) {
+      a.row.status = "failed";
+      a.row.error = withoutFolder(std::string("NATS: ") + e.what(), files, "the service folder");
+    }
+  } else if (!pool->submit({a.row.id, (dir / "mission.json").string(), dir.string()})) {
     a.row.status = "failed";
     a.row.error = "the approval queue was full when the service restarted";
   }

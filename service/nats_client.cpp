@@ -270,11 +270,15 @@ void addConsumer(jsCtx* js, const std::string& stream, jsConsumerConfig& cc) {
 
 }  // namespace
 
-std::unique_ptr<NatsPull> NatsClient::pullFrom(const std::string& stream, const std::string& durable, const std::string& filter,
-                                               std::uint64_t start_seq) {
+void NatsClient::deleteConsumer(const std::string& stream, const std::string& durable) {
   jsErrCode jerr = static_cast<jsErrCode>(0);
   const natsStatus s = js_DeleteConsumer(impl_->js, stream.c_str(), durable.c_str(), nullptr, &jerr);
   if (s != NATS_OK && s != NATS_NOT_FOUND && jerr != kConsumerNotFound) fail("deleting consumer " + durable, s, jerr);
+}
+
+std::unique_ptr<NatsPull> NatsClient::pullFrom(const std::string& stream, const std::string& durable, const std::string& filter,
+                                               std::uint64_t start_seq, std::chrono::seconds inactive) {
+  deleteConsumer(stream, durable);
   jsConsumerConfig cc;
   jsConsumerConfig_Init(&cc);
   cc.Durable = durable.c_str();
@@ -282,6 +286,7 @@ std::unique_ptr<NatsPull> NatsClient::pullFrom(const std::string& stream, const 
   cc.OptStartSeq = std::max<std::uint64_t>(start_seq, 1);
   cc.AckPolicy = js_AckNone;
   cc.FilterSubject = filter.c_str();
+  cc.InactiveThreshold = inactive.count() * kNsPerS;
   addConsumer(impl_->js, stream, cc);
   return bindPull(impl_->js, stream, durable, filter);
 }

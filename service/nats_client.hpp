@@ -109,8 +109,12 @@ class NatsClient {
   /// message is the one at `start_seq` (1: the stream's first). An existing consumer of that name
   /// is deleted first: its deliveries pending are forgotten, the caller's checkpoint says where
   /// to go on from. No acknowledgements: the caller's checkpoint is the consumer's position.
+  /// `inactive` > 0: the server deletes the consumer after that long with no one fetching (a
+  /// reader that died leaves nothing behind).
   [[nodiscard]] std::unique_ptr<NatsPull> pullFrom(const std::string& stream, const std::string& durable, const std::string& filter,
-                                                   std::uint64_t start_seq);
+                                                   std::uint64_t start_seq, std::chrono::seconds inactive = std::chrono::seconds(0));
+  /// \brief Deletes a consumer (a no-op when absent).
+  void deleteConsumer(const std::string& stream, const std::string& durable);
   /// \brief A durable pull consumer shared by every worker that names it (a work queue):
   /// made when absent, joined when present.
   [[nodiscard]] std::unique_ptr<NatsPull> pullShared(const std::string& stream, const std::string& durable, const std::string& filter,

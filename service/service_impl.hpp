@@ -12,6 +12,7 @@
 #include "service/auth.hpp"
 #include "service/event_hub.hpp"
 #include "service/metrics.hpp"
+#include "service/nats_front.hpp"
 #include "service/service.hpp"
 #include "service/service_store.hpp"
 
@@ -75,6 +76,21 @@ class ServiceImpl {
   void startInput(Input& in);
   void takeRecord(const planner::SourceRecord& r, const std::string& input_flight);
   std::unique_ptr<HttpServer> server;
+  std::unique_ptr<NatsFront> nats;  ///< with --nats: the workers do the engine's work
+
+  // nats_routes.cpp (with --nats)
+  void startNats();
+  void natsEvent(const StreamEvent& e);
+  /// The approval's outcome when the workers have it; false while it is still to come.
+  bool natsTakeOutcome(ApprovalState& a);
+  HttpResponse natsPostFixes(const FlightRow& f, std::vector<std::string> lines);
+  [[nodiscard]] nlohmann::json natsFlightState(const FlightRow& f) const;
+  HttpResponse natsRoute(const FlightRow& f) const;
+  /// The events on NATS after `after` that `wants` accepts, as Server-Sent Events text; `sent`:
+  /// the last sequence of the operator's events read (so a live one up to it is not sent again).
+  std::optional<HttpResponse> natsBacklog(const Principal& who, const std::string& flight, std::int64_t after,
+                                          const std::function<bool(const std::string&)>& wants, std::string& body,
+                                          std::int64_t& sent) const;
 
   // service.cpp
   HttpResponse handle(const HttpRequest& r);

@@ -420,6 +420,7 @@ void Worker::putFlightCheckpoints(Partition& p) {
       cp["state"] = planner::flightStateJson(st);
       if (st.route_version != slot.checkpointed_route) {
         nats_.putAsync(nats::kFlightBucket, id + ".route", p.tracker->routeJson(id).dump());
+        nats_.putAsync(nats::kFlightBucket, id + ".geojson", p.tracker->routeGeoJson(id).dump());
         slot.checkpointed_route = st.route_version;
       }
     } else {
