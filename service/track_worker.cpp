@@ -100,6 +100,8 @@ class Worker {
   void loadApproval(Partition& p, FlightSlot& slot, const std::string& id);
   void checkZoneSets();
   void followZoneSets(Partition& p, const std::string& dir, ApprovalZones& a);
+  void announceZoneSet(const Partition& p, const std::string& dir, const std::string& name, std::uint64_t version);
+  void checkZoneSetsWhileIdle();
   void sweepStale(Partition& p, std::uint64_t last_seq, std::vector<Outgoing>& out);
   void commit(std::vector<Taken>& taken, const std::vector<Outgoing>& out);
   void checkpointAll();
@@ -112,6 +114,7 @@ class Worker {
   std::vector<Partition> parts_;
   int partition_count_ = 0;
   std::uint64_t zone_seq_ = 0;  ///< the zone set bucket's last sequence when last looked at
+  Clock::time_point last_zone_check_{};
   Clock::time_point last_checkpoint_{};
 };
 
@@ -120,6 +123,8 @@ std::string leaseKey(int k) { return "p" + std::to_string(k); }
 /// How often the flights' and partitions' checkpoints are written (one key-value put per flight
 /// judged since: at 1 Hz fixes, a put per flight every period instead of per fix).
 constexpr std::chrono::seconds kCheckpointPeriod{2};
+/// How often a worker with no fixes coming looks for new zone set versions (one request).
+constexpr std::chrono::milliseconds kIdleZoneCheck{250};
 
 void Worker::choosePartitions() {
   const int count = nats::partitionCount(nats_);
@@ -305,6 +310,7 @@ void Worker::followZoneSets(Partition& p, const std::string& dir, ApprovalZones&
       p.tracker->reloadZones(a.flight);
       log("partition " + std::to_string(p.index) + ": zone set " + name + " version " + std::to_string(e->revision) + " in force");
       f.version = e->revision;
+      announceZoneSet(p, dir, name, f.version);
     } catch (const std::exception& ex) {  // a version the fence cannot use: the one before stays
       maps::writeFileAtomically(path, before, "zone set file");
       log("zone set " + name + " version " + std::to_string(e->revision) + " not taken: " + ex.what());
@@ -316,6 +322,29 @@ void Worker::followZoneSets(Partition& p, const std::string& dir, ApprovalZones&
     }
   }
   maps::writeFileAtomically((fs::path(dir) / "zonesets.json").string(), zoneSetsText(a.zonesets) + "\n", "zone sets");
+}
+
+/// Each flight of the approval unpacked in `dir` is told by an event that a zone set's version
+/// is in force for it (its next fixes are judged against it).
+void Worker::announceZoneSet(const Partition& p, const std::string& dir, const std::string& name, std::uint64_t version) {
+  for (const auto& [id, slot] : p.flights) {
+    if (slot.approval_dir != dir) continue;
+    const json e = {{"event", "zoneset_in_force"}, {"flight", slot.flight}, {"zoneset", name}, {"version", version}};
+    nats_.publishAsync(nats::eventSubject(slot.op, slot.flight), e.dump(), "zoneset." + id + "." + name + "." + std::to_string(version));
+  }
+}
+
+/// A quiet worker looks at the zone sets too (every kIdleZoneCheck), so a new version is in
+/// force, and said, before the next fix comes.
+void Worker::checkZoneSetsWhileIdle() {
+  if (Clock::now() - last_zone_check_ < kIdleZoneCheck) return;
+  last_zone_check_ = Clock::now();
+  try {
+    checkZoneSets();
+    nats_.publishesComplete();
+  } catch (const std::exception& e) {
+    log(std::string("zone sets not looked at: ") + e.what());
+  }
 }
 
 void Worker::startFlight(Partition& p, FlightSlot& slot, const json& body) {
@@ -529,7 +558,7 @@ void Worker::run(const std::atomic<bool>& stop) {
     // A fetch waits for a full batch or this long: short, so that a quiet partition does not
     // hold up the others, long enough that a batch gathers the fixes of several milliseconds.
     const auto wait = std::chrono::milliseconds(held > 0 ? std::max(5, 40 / held) : 0);
-    if (held > 0) (void)runRound(wait);
+    if (held > 0 && !runRound(wait)) checkZoneSetsWhileIdle();
     if (held > 0 && Clock::now() - last_checkpoint_ >= kCheckpointPeriod) {
       try {
         checkpointAll();  // a quiet worker's last fixes get their checkpoints too

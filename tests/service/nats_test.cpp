@@ -280,23 +280,32 @@ TEST_F(NatsWorkers, DuplicateAndOutOfOrderFixesAreRejectedAndARepeatedMessageIdI
 /// A zone set's new version, put while two workers track four flights made from it: every fix
 /// published after the put is judged against it (its events name the version), a closure it adds
 /// on the route ahead gives a zone violation naming it, and the fixes before name the old version.
-TEST_F(NatsWorkers, AZoneSetUpdateIsInForceForEveryFixPublishedAfterIt) {
+/// Puts a zone set file as the authority's set "zurich" (`skylane nats zones`); its version.
+std::uint64_t putZurich(const std::string& url, const std::string& file) {
+  const test::CommandResult r = test::runCommand(std::string(SKYLANE_BINARY) + " nats zones " + file + " --nats " + url +
+                                                 " --owner authority --set zurich");
+  EXPECT_EQ(r.status, 0) << r.out;
+  return r.status == 0 ? json::parse(r.out).at("version").get<std::uint64_t>() : 0;
+}
+
+/// The example mission with its zones from the zone set authority.zurich, as a file in `dir`.
+std::string zurichMission(const std::string& dir) {
   const std::string examples = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/";
-  const auto put = [&](const std::string& file) {
-    const test::CommandResult r = test::runCommand(std::string(SKYLANE_BINARY) + " nats zones " + file + " --nats " + server_->url() +
-                                                   " --owner authority --set zurich");
-    EXPECT_EQ(r.status, 0) << r.out;
-    return json::parse(r.out).at("version").get<std::uint64_t>();
-  };
-  const std::uint64_t v1 = put(examples + "zones_ed269.json");
   json mission = json::parse(std::ifstream(examples + "mission.json"));
   mission.erase("zones");
   mission["zonesets"] = {"authority.zurich"};
   for (auto& o : mission["orbits"]) o = examples + o.get<std::string>();
   mission["buildings"] = examples + mission["buildings"].get<std::string>();
-  std::ofstream(dir_ + "/mission.json") << mission.dump();
+  std::ofstream(dir + "/mission.json") << mission.dump();
+  return dir + "/mission.json";
+}
+
+TEST_F(NatsWorkers, AZoneSetUpdateIsInForceForEveryFixPublishedAfterIt) {
+  const std::string examples = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/";
+  const auto put = [&](const std::string& file) { return putZurich(server_->url(), file); };
+  const std::uint64_t v1 = put(examples + "zones_ed269.json");
   auto approver = worker("approve", "ap1");
-  ASSERT_EQ(approve("a1", dir_ + "/mission.json").at("status"), "approved") << approver->log();
+  ASSERT_EQ(approve("a1", zurichMission(dir_)).at("status"), "approved") << approver->log();
   const json rep = report("a1");
   auto w1 = worker("track", "tr1");
   auto w2 = worker("track", "tr2");
@@ -366,6 +375,37 @@ TEST_F(NatsWorkers, AZoneSetUpdateIsInForceForEveryFixPublishedAfterIt) {
   }
   EXPECT_EQ(judged_after, flights.size());
   EXPECT_NE((w1->log() + w2->log()).find("zone set authority.zurich version " + std::to_string(v2) + " in force"), std::string::npos);
+}
+
+TEST_F(NatsWorkers, AZoneSetUpdateReachesQuietWorkersAndEachFlightIsToldWithoutAFix) {
+  const std::string examples = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/";
+  (void)putZurich(server_->url(), examples + "zones_ed269.json");
+  auto approver = worker("approve", "ap1");
+  ASSERT_EQ(approve("a1", zurichMission(dir_)).at("status"), "approved") << approver->log();
+  const json rep = report("a1");
+  auto w1 = worker("track", "tr1");
+  auto w2 = worker("track", "tr2");
+  const std::vector<std::string> flights = {"f1", "f2", "f3", "f4"};
+  for (const std::string& f : flights) {
+    client_->publish(nats::fixSubject("acme", f), json{{"start", {{"approval", "a1"}}}}.dump());
+    client_->publish(nats::fixSubject("acme", f), fixAt(rep, 0).dump());
+  }
+  (void)waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= flights.size(); });
+  // Both workers hold flights (the partitions are shared out), then no fix comes.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto t_put = std::chrono::steady_clock::now();
+  const std::uint64_t v2 = putZurich(server_->url(), examples + "zones_ed269.json");
+  const std::vector<json> ev = waitFor([&](const std::vector<json>& e) { return count(e, "zoneset_in_force") >= flights.size(); }, 30);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_put).count();
+  ASSERT_EQ(count(ev, "zoneset_in_force"), flights.size()) << w1->log() << w2->log();
+  for (const json& e : ev) {
+    if (e.at("event") != "zoneset_in_force") continue;
+    EXPECT_EQ(e.at("zoneset"), "authority.zurich");
+    EXPECT_EQ(e.at("version"), v2);
+  }
+  EXPECT_EQ(count(ev, "fix"), flights.size());  // no fix was needed for it
+  std::printf("zone set version in force at every quiet worker after %.3f s (the workers look every 0.25 s)\n", seconds);
+  EXPECT_LT(seconds, 10.0);  // 1 s on a quiet machine; the margin is for a loaded test run
 }
 
 TEST_F(NatsWorkers, TwoApproveWorkersDoEachRequestOnceAndABadRequestIsInvalidByName) {
