@@ -114,6 +114,11 @@ std::optional<NatsApprovalOutcome> NatsFront::takeApprovalOutcome(const std::str
   return out;
 }
 
+std::uint64_t NatsFront::putZoneSet(const std::string& key, const std::string& text) {
+  if (const auto e = nats_->get(nats::kZoneSetBucket, key); e && e->value == text) return e->revision;
+  return nats_->put(nats::kZoneSetBucket, key, text);
+}
+
 void NatsFront::startFlight(const std::string& op, const std::string& flight, const std::string& approval) {
   (void)nats_->publish(nats::fixSubject(op, flight), json{{"start", {{"approval", approval}}}}.dump(), "start." + op + "." + flight);
 }

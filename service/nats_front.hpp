@@ -57,6 +57,9 @@ class NatsFront {
   /// route.geojson, …) into `dir`.
   [[nodiscard]] std::optional<NatsApprovalOutcome> takeApprovalOutcome(const std::string& op, const std::string& id,
                                                                        const std::filesystem::path& dir);
+  /// \brief Puts a zone set version under `key` unless the bucket has that text already; its
+  /// revision (the version the workers name).
+  std::uint64_t putZoneSet(const std::string& key, const std::string& text);
   /// \brief Publishes a flight's start (its approval) on its fix subject.
   void startFlight(const std::string& op, const std::string& flight, const std::string& approval);
   /// \brief Publishes fix lines on the flight's subject and waits until the stream has them all.

@@ -8,6 +8,7 @@
 #include "planner/tracking/fix_source.hpp"
 #include "planner/tracking/flight_state.hpp"
 #include "planner/tracking/track_event.hpp"
+#include "maps/text_file.hpp"
 #include "service/nats_layout.hpp"
 #include "service/service_impl.hpp"
 
@@ -43,6 +44,8 @@ void ServiceImpl::startNats() {
     nats = std::make_unique<NatsFront>(options.nats_url, log, [this](StreamEvent e) {
       server->post([this, e = std::move(e)] { natsEvent(e); });
     });
+    // The sets uploaded before (or while NATS was away) are put in, so the workers follow them.
+    for (const ZoneSet& z : store->zoneSets()) natsPutZoneSet(z);
   } catch (const std::exception& e) {
     throw std::runtime_error("--nats " + options.nats_url + ": " + e.what());
   }
@@ -51,6 +54,28 @@ void ServiceImpl::startNats() {
       if (a.row.status == "queued" || a.row.status == "running") (void)natsTakeOutcome(a);
     }
   });
+}
+
+std::string ServiceImpl::natsZoneSetKey(const ZoneSet& z) { return (z.owner.empty() ? std::string("authority") : z.owner) + "." + z.id; }
+
+void ServiceImpl::natsPutZoneSet(const ZoneSet& z) {
+  const std::string text = maps::readTextFile((files / z.latest().file).string());
+  const std::uint64_t rev = nats->putZoneSet(natsZoneSetKey(z), text);
+  log("zone set " + z.id + " version " + std::to_string(z.latest().version) + " is " + natsZoneSetKey(z) + " revision " + std::to_string(rev) + " in NATS");
+}
+
+void ServiceImpl::natsWriteMission(const fs::path& dir, json mission, const std::vector<std::string>& follow) {
+  json zones = json::array(), sets = json::array();
+  for (std::size_t i = 0; i < mission["zones"].size(); ++i) {
+    if (i < follow.size() && !follow[i].empty()) {
+      sets.push_back(follow[i]);
+    } else {
+      zones.push_back(mission["zones"][i]);
+    }
+  }
+  mission["zones"] = zones;
+  if (!sets.empty()) mission["zonesets"] = sets;
+  writeFileAtomically(dir / "nats_mission.json", mission.dump(1) + "\n");
 }
 
 void ServiceImpl::natsEvent(const StreamEvent& e) {

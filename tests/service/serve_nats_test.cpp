@@ -14,6 +14,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <set>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -63,9 +65,10 @@ std::vector<Sse> parseSse(const std::string& text) {
   return out;
 }
 
-/// An event without what names the input and wall-clock times.
+/// An event without what names the input, wall-clock times and the zone set versions (which
+/// `skylane track` on a file does not have).
 json comparable(json e) {
-  for (const char* k : {"line", "source", "report", "error", "planning_time_s", "operator", "input_seq", "subject"}) e.erase(k);
+  for (const char* k : {"line", "source", "report", "error", "planning_time_s", "operator", "input_seq", "subject", "zonesets"}) e.erase(k);
   return e;
 }
 
@@ -189,6 +192,9 @@ TEST_F(ServeOnNats, TheWorkersApproveAndTrackAndTheEventsStreamWithStreamSequenc
     }
     EXPECT_EQ(got[i].type, got[i].data.at("event"));
     if (got[i].type == "flight_started") continue;
+    if (got[i].type == "fix") {  // judged against the zone set the mission named, followed by its NATS key
+      EXPECT_TRUE(got[i].data.at("zonesets").contains("authority." + zoneset_)) << got[i].data.dump();
+    }
     (got[i].type == "rejected_input" ? rejected : mine).push_back(comparable(got[i].data));
   }
   std::vector<json> expected, expected_rejected;
@@ -275,6 +281,60 @@ TEST_F(ServeOnNats, AServiceKilledAndRestartedKeepsItsApprovalsFlightsAndTheEven
   ASSERT_EQ(times.size(), 20u) << resumed.streamed();
   for (int k = 0; k < 20; ++k) EXPECT_NEAR(times[k], k, 1e-6) << k;
   EXPECT_TRUE(tracker_->running());
+}
+
+TEST_F(ServeOnNats, AZoneSetVersionUploadedToTheServiceIsInForceForTheFlightsOnTheWorkers) {
+  ASSERT_EQ(approve().at("status"), "approved") << approver_->log();
+  const json rep = json::parse(call("GET", "/v1/approvals/" + approval_ + "/report.json", TestTokens::kAcme).body);
+  const std::string fl = json::parse(call("POST", "/v1/flights", TestTokens::kAcme, json{{"approval", approval_}}.dump()).body).at("id");
+  HttpClient live(service_->port());
+  live.openStream("/v1/flights/" + fl + "/events", {auth(TestTokens::kAcme)});
+  ASSERT_TRUE(live.waitFor("retry: 1000", 2000));
+  std::string first;
+  for (int k = 0; k < 10; ++k) first += fixAt(rep, k).dump() + "\n";
+  ASSERT_EQ(call("POST", "/v1/flights/" + fl + "/fixes", TestTokens::kAcme, first, kNdjson).status, 200);
+  for (int i = 0; i < 300; ++i) {  // judged (the answer says they are kept, not yet judged)
+    const std::vector<Sse> ev = parseSse(live.streamed());
+    if (std::count_if(ev.begin(), ev.end(), [](const Sse& e) { return e.type == "fix"; }) >= 10) break;
+    live.readFor(100);
+  }
+  // Version 2 through the service: the same zones and a closure 120 m wide around the route 25 s
+  // after departure. The mission named the set without a version, so the flight follows it.
+  json zones = json::parse(readFile(std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/zones_ed269.json"));
+  json closure = zones["UASZoneList"][0];
+  const json at = fixAt(rep, 25);
+  const double lat = at["lat"], lon = at["lon"], dlat = 60.0 / 111'195.0, dlon = dlat / std::cos(lat * M_PI / 180.0);
+  closure["identifier"] = "EX-NEW-CLOSURE";
+  closure["geometry"][0]["horizontalProjection"]["coordinates"] =
+      json::array({json::array({{lon - dlon, lat - dlat}, {lon + dlon, lat - dlat}, {lon + dlon, lat + dlat}, {lon - dlon, lat + dlat}, {lon - dlon, lat - dlat}})});
+  zones["UASZoneList"].push_back(closure);
+  const HttpReply v2 = call("PUT", "/v1/zonesets/" + zoneset_, TestTokens::kAuthority, zones.dump());
+  ASSERT_EQ(v2.status, 200) << v2.body;
+  // The quiet track worker takes it and tells the flight, with no fix sent.
+  ASSERT_TRUE(live.waitFor("event: zoneset_in_force", 10000)) << live.streamed() << tracker_->log();
+  std::string second;
+  for (int k = 10; k < 30; ++k) second += fixAt(rep, k).dump() + "\n";
+  ASSERT_EQ(call("POST", "/v1/flights/" + fl + "/fixes", TestTokens::kAcme, second, kNdjson).status, 200);
+  std::vector<Sse> got;
+  for (int i = 0; i < 300; ++i) {
+    got = parseSse(live.streamed());
+    if (std::count_if(got.begin(), got.end(), [](const Sse& e) { return e.type == "fix"; }) >= 30) break;
+    live.readFor(100);
+  }
+  std::set<std::uint64_t> versions_before, versions_after;
+  bool closure_named = false;
+  for (const Sse& e : got) {
+    if (e.type == "fix") {
+      const int k = static_cast<int>(std::lround(*maps::parseRfc3339(e.data.at("time").get<std::string>()) -
+                                                 *maps::parseRfc3339(rep.at("departure").get<std::string>())));
+      (k < 10 ? versions_before : versions_after).insert(e.data.at("zonesets").at("authority." + zoneset_).get<std::uint64_t>());
+    }
+    closure_named = closure_named || (e.type == "violation" && e.data.dump().find("EX-NEW-CLOSURE") != std::string::npos);
+  }
+  ASSERT_EQ(versions_before.size(), 1u) << live.streamed();
+  ASSERT_EQ(versions_after.size(), 1u);
+  EXPECT_GT(*versions_after.begin(), *versions_before.begin());
+  EXPECT_TRUE(closure_named) << live.streamed();
 }
 
 TEST_F(ServeOnNats, WhatCannotWorkOnNatsIsRefusedAtStartByName) {
