@@ -199,6 +199,23 @@ std::optional<NatsEntry> NatsClient::get(const std::string& bucket, const std::s
   return out;
 }
 
+std::vector<NatsEntry> NatsClient::history(const std::string& bucket, const std::string& key) {
+  kvEntryList list{};
+  const natsStatus s = kvStore_History(&list, impl_->bucket(bucket), key.c_str(), nullptr);
+  if (s == NATS_NOT_FOUND) return {};
+  check("history of " + bucket + "/" + key, s);
+  std::vector<NatsEntry> out;
+  for (int i = 0; i < list.Count; ++i) {
+    kvEntry* e = list.Entries[i];
+    if (kvEntry_Operation(e) != kvOp_Put) continue;
+    const void* value = kvEntry_Value(e);
+    out.push_back({value == nullptr ? std::string() : std::string(static_cast<const char*>(value), static_cast<std::size_t>(kvEntry_ValueLen(e))),
+                   kvEntry_Revision(e)});
+  }
+  kvEntryList_Destroy(&list);
+  return out;
+}
+
 std::uint64_t NatsClient::put(const std::string& bucket, const std::string& key, const std::string& value) {
   std::uint64_t rev = 0;
   check("put " + bucket + "/" + key, kvStore_Put(&rev, impl_->bucket(bucket), key.c_str(), value.data(), static_cast<int>(value.size())));

@@ -90,6 +90,8 @@ class NatsClient {
 
   /// \brief A bucket's entry; none when the key is absent or deleted.
   [[nodiscard]] std::optional<NatsEntry> get(const std::string& bucket, const std::string& key);
+  /// \brief Every value a bucket keeps for a key (its history), oldest first; deletions left out.
+  [[nodiscard]] std::vector<NatsEntry> history(const std::string& bucket, const std::string& key);
   /// \brief Puts a value; returns its revision.
   std::uint64_t put(const std::string& bucket, const std::string& key, const std::string& value);
   /// \brief Puts a value without waiting (a publish to the bucket's subject; completed by

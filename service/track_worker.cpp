@@ -100,6 +100,8 @@ class Worker {
   void loadApproval(Partition& p, FlightSlot& slot, const std::string& id);
   void checkZoneSets();
   void followZoneSets(Partition& p, const std::string& dir, ApprovalZones& a);
+  bool tryZoneSetVersion(Partition& p, const std::string& dir, ApprovalZones& a, const std::string& name, const NatsEntry& e,
+                         std::string& why);
   void announceZoneSet(const Partition& p, const std::string& dir, const std::string& name, std::uint64_t version);
   void checkZoneSetsWhileIdle();
   void sweepStale(Partition& p, std::uint64_t last_seq, std::vector<Outgoing>& out);
@@ -299,27 +301,47 @@ void Worker::checkZoneSets() {
   }
 }
 
+/// Puts the zone set's version `e` in force for the approval unpacked in `dir`; false (the file
+/// as it was, `why` said) when the fence cannot use it.
+bool Worker::tryZoneSetVersion(Partition& p, const std::string& dir, ApprovalZones& a, const std::string& name, const NatsEntry& e,
+                               std::string& why) {
+  ApprovalBundle::ZoneSetFile& f = a.zonesets.at(name);
+  const std::string path = (fs::path(dir) / f.file).string();
+  const std::string before = maps::readTextFile(path);
+  maps::writeFileAtomically(path, e.value, "zone set file");
+  try {
+    p.tracker->reloadZones(a.flight);
+  } catch (const std::exception& ex) {
+    maps::writeFileAtomically(path, before, "zone set file");
+    why = ex.what();
+    return false;
+  }
+  log("partition " + std::to_string(p.index) + ": zone set " + name + " version " + std::to_string(e.revision) + " in force");
+  f.version = e.revision;
+  announceZoneSet(p, dir, name, f.version);
+  return true;
+}
+
 void Worker::followZoneSets(Partition& p, const std::string& dir, ApprovalZones& a) {
   for (auto& [name, f] : a.zonesets) {
     const auto e = nats_.get(nats::kZoneSetBucket, name);
     if (!e || e->revision == f.version) continue;
-    const std::string path = (fs::path(dir) / f.file).string();
-    const std::string before = maps::readTextFile(path);
-    maps::writeFileAtomically(path, e->value, "zone set file");
-    try {
-      p.tracker->reloadZones(a.flight);
-      log("partition " + std::to_string(p.index) + ": zone set " + name + " version " + std::to_string(e->revision) + " in force");
-      f.version = e->revision;
-      announceZoneSet(p, dir, name, f.version);
-    } catch (const std::exception& ex) {  // a version the fence cannot use: the one before stays
-      maps::writeFileAtomically(path, before, "zone set file");
-      log("zone set " + name + " version " + std::to_string(e->revision) + " not taken: " + ex.what());
-      const std::string subject = "$KV." + nats::kZoneSetBucket + "." + name;
-      json r = planner::rejectedInputEvent(subject, 0, std::string("version ") + std::to_string(e->revision) + " not taken, version " +
-                                                             std::to_string(f.version) + " stays in force: " + ex.what()).toJson();
-      r["subject"] = subject;
-      nats_.publishAsync(nats::kRejectedSubject, r.dump(), "zoneset." + name + "." + std::to_string(e->revision));
+    std::string why;
+    if (tryZoneSetVersion(p, dir, a, name, *e, why)) continue;
+    // A version the fence cannot use: the newest usable one before it (newer than the one in force
+    // here) is what every worker that followed the set has in force, so one that loads the
+    // approval only now goes there too.
+    const std::vector<NatsEntry> history = nats_.history(nats::kZoneSetBucket, name);
+    std::string ignored;
+    for (auto it = history.rbegin(); it != history.rend(); ++it) {
+      if (it->revision < e->revision && it->revision > f.version && tryZoneSetVersion(p, dir, a, name, *it, ignored)) break;
     }
+    log("zone set " + name + " version " + std::to_string(e->revision) + " not taken: " + why);
+    const std::string subject = "$KV." + nats::kZoneSetBucket + "." + name;
+    json r = planner::rejectedInputEvent(subject, 0, std::string("version ") + std::to_string(e->revision) + " not taken, version " +
+                                                         std::to_string(f.version) + " stays in force: " + why).toJson();
+    r["subject"] = subject;
+    nats_.publishAsync(nats::kRejectedSubject, r.dump(), "zoneset." + name + "." + std::to_string(e->revision));
   }
   maps::writeFileAtomically((fs::path(dir) / "zonesets.json").string(), zoneSetsText(a.zonesets) + "\n", "zone sets");
 }

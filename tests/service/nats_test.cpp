@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <csignal>
 #include <cmath>
 #include <atomic>
 #include <map>
@@ -375,6 +376,20 @@ TEST_F(NatsWorkers, AZoneSetUpdateIsInForceForEveryFixPublishedAfterIt) {
   }
   EXPECT_EQ(judged_after, flights.size());
   EXPECT_NE((w1->log() + w2->log()).find("zone set authority.zurich version " + std::to_string(v2) + " in force"), std::string::npos);
+  // Both workers stop; a new one (an empty cache: the approval's bundle names version 1) takes
+  // every partition. The newest version is still unusable: it goes back to version 2, the newest
+  // usable one, as the others had — not to the bundle's version 1.
+  EXPECT_EQ(w1->kill(SIGTERM), 0);
+  EXPECT_EQ(w2->kill(SIGTERM), 0);
+  auto w3 = worker("track", "tr3");
+  for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), fixAt(rep, 31).dump());
+  const std::vector<json> late = waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= 128; });
+  ASSERT_EQ(count(late, "fix"), 128u) << w3->log();
+  for (const json& e : late) {
+    if (e.at("event") == "fix" && *maps::parseRfc3339(e.at("time").get<std::string>()) - departure > 30.5) {
+      EXPECT_EQ(e.at("zonesets").at("authority.zurich"), v2) << w3->log();
+    }
+  }
 }
 
 TEST_F(NatsWorkers, AZoneSetUpdateReachesQuietWorkersAndEachFlightIsToldWithoutAFix) {
