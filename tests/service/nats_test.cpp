@@ -441,7 +441,19 @@ TEST_F(NatsWorkers, TwoApproveWorkersDoEachRequestOnceAndABadRequestIsInvalidByN
   for (auto& o : bad["orbits"]) o = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/" + o.get<std::string>();
   bad["buildings"] = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/" + bad["buildings"].get<std::string>();
   std::ofstream(dir_ + "/bad.json") << bad.dump();
-  const json invalid = approve("bad", dir_ + "/bad.json");
+  // `skylane nats approve` checks the mission before it sends it: exit 2 naming the field.
+  const test::CommandResult refused = test::runCommand(std::string(SKYLANE_BINARY) + " nats approve " + dir_ + "/bad.json --nats " +
+                                                       server_->url() + " --operator acme --id bad 2>&1");
+  EXPECT_EQ(refused.status, 2) << refused.out;
+  EXPECT_NE(refused.out.find("$.vehicle"), std::string::npos) << refused.out;
+  // Sent anyway (another client): the approve worker finds it invalid, by name.
+  client_->publish(nats::approvalSubject("acme", "bad"), service::bundleText(service::packMission(dir_ + "/bad.json")));
+  json invalid;
+  for (int i = 0; i < 600 && (invalid.is_null() || invalid.at("status") == "running"); ++i) {
+    if (const auto e = client_->get(nats::kApprovalBucket, "acme.bad")) invalid = json::parse(e->value);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_FALSE(invalid.is_null());
   EXPECT_EQ(invalid.at("status"), "invalid");
   EXPECT_NE(invalid.value("message", "").find("vehicle"), std::string::npos) << invalid.dump();
   const std::vector<json> ev = events();
