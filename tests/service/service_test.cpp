@@ -26,6 +26,7 @@ using test::HttpClient;
 using test::HttpReply;
 using test::ServiceProcess;
 using test::TestTokens;
+using test::freeUdpPort;
 
 std::string auth(const char* token) { return std::string("Authorization: ") + token; }
 const std::string kJson = "Content-Type: application/json";
@@ -466,18 +467,6 @@ namespace skylane {
 namespace {
 
 /// A free UDP port on the loopback (bound and released; the service binds it next).
-int freeUdpPort() {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t n = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
-
 void sendUdp(int port, const std::string& datagram) {
   const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
   sockaddr_in a{};
