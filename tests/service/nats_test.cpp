@@ -9,6 +9,7 @@
 #include "service/nats_client.hpp"
 #include "service/nats_layout.hpp"
 #include "tests/service/child_process.hpp"
+#include "tests/service/route_fix.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -32,6 +33,15 @@ using test::NatsServer;
 namespace nats = service::nats;
 
 constexpr int kPartitions = 4;
+
+/// The example zones put as authority.zurich, the example mission made from it approved as a1
+/// (its report), two track workers, and four flights of it started.
+struct ZurichFlights {
+  std::uint64_t v1 = 0;
+  json rep;
+  std::unique_ptr<ChildProcess> w1, w2;
+  std::vector<std::string> flights = {"f1", "f2", "f3", "f4"};
+};
 
 class NatsWorkers : public ::testing::Test {
  protected:
@@ -61,17 +71,7 @@ class NatsWorkers : public ::testing::Test {
     const auto b = client_->get(nats::kApprovalBucket, "acme." + id + ".bundle");
     return b ? json::parse(service::parseBundle(b->value, "bundle").report) : json();
   }
-  /// A fix k seconds after departure on the route, `off_m` north of it, with PLs `pl_m`.
-  static json fixAt(const json& rep, int k, double off_m = 0.0, double pl_m = 0.5) {
-    const json& pts = rep.at("route");
-    std::size_t i = 1;
-    while (i + 1 < pts.size() && k > pts[i].at("eta_s").get<double>()) ++i;
-    const json &a = pts[i - 1], &b = pts[i];
-    const double f = std::clamp((k - a.at("eta_s").get<double>()) / (b.at("eta_s").get<double>() - a.at("eta_s").get<double>()), 0.0, 1.0);
-    auto mix = [&](const char* key) { return a.at(key).get<double>() + f * (b.at(key).get<double>() - a.at(key).get<double>()); };
-    const std::string time = maps::formatRfc3339(maps::parseRfc3339(rep.at("departure").get<std::string>())->plus(k));
-    return {{"time", time}, {"lat", mix("lat") + off_m / 111'195.0}, {"lon", mix("lon")}, {"h_ell_m", mix("h_ell_m")}, {"hpl_m", pl_m}, {"vpl_m", pl_m}};
-  }
+  static json fixAt(const json& rep, int k, double off_m = 0.0, double pl_m = 0.5) { return test::fixAlongRoute(rep, k, off_m, pl_m); }
   /// Every event in the stream, each with its subject.
   std::vector<json> events() {
     std::vector<json> out;
@@ -125,6 +125,8 @@ class NatsWorkers : public ::testing::Test {
     if (e.at("event") == "rejected_input") e.erase("flight");
     return e;
   }
+  /// See ZurichFlights; its report is null when the approval failed.
+  ZurichFlights startZurichFlights();
   std::string dir_;
   std::unique_ptr<NatsServer> server_;
   std::unique_ptr<NatsClient> client_;
@@ -301,32 +303,37 @@ std::string zurichMission(const std::string& dir) {
   return dir + "/mission.json";
 }
 
+
+ZurichFlights NatsWorkers::startZurichFlights() {
+  ZurichFlights z;
+  z.v1 = putZurich(server_->url(), std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/zones_ed269.json");
+  auto approver = worker("approve", "ap1");
+  const json st = approve("a1", zurichMission(dir_));
+  EXPECT_EQ(st.at("status"), "approved") << approver->log();
+  if (st.at("status") != "approved") return z;
+  z.rep = report("a1");
+  z.w1 = worker("track", "tr1");
+  z.w2 = worker("track", "tr2");
+  for (const std::string& f : z.flights) client_->publish(nats::fixSubject("acme", f), json{{"start", {{"approval", "a1"}}}}.dump());
+  return z;
+}
+
 TEST_F(NatsWorkers, AZoneSetUpdateIsInForceForEveryFixPublishedAfterIt) {
   const std::string examples = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/";
   const auto put = [&](const std::string& file) { return putZurich(server_->url(), file); };
-  const std::uint64_t v1 = put(examples + "zones_ed269.json");
-  auto approver = worker("approve", "ap1");
-  ASSERT_EQ(approve("a1", zurichMission(dir_)).at("status"), "approved") << approver->log();
-  const json rep = report("a1");
-  auto w1 = worker("track", "tr1");
-  auto w2 = worker("track", "tr2");
-  const std::vector<std::string> flights = {"f1", "f2", "f3", "f4"};
-  for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), json{{"start", {{"approval", "a1"}}}}.dump());
+  ZurichFlights z = startZurichFlights();
+  ASSERT_FALSE(z.rep.is_null());
+  const std::uint64_t v1 = z.v1;
+  const json& rep = z.rep;
+  const auto& w1 = z.w1;
+  const auto& w2 = z.w2;
+  const std::vector<std::string>& flights = z.flights;
   for (int k = 0; k < 10; ++k) {
     for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), fixAt(rep, k).dump());
   }
   (void)waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= 40; });
   // Version 2: the same zones and a closure 120 m wide around the route 25 s after departure.
-  json zones = json::parse(std::ifstream(examples + "zones_ed269.json"));
-  json closure = zones["UASZoneList"][0];
-  const json at = fixAt(rep, 25);
-  const double lat = at["lat"], lon = at["lon"], dlat = 60.0 / 111'195.0, dlon = dlat / std::cos(lat * M_PI / 180.0);
-  closure["identifier"] = "EX-NEW-CLOSURE";
-  closure["name"] = "Closure put while flying (test)";
-  closure["geometry"][0]["horizontalProjection"]["coordinates"] =
-      json::array({json::array({{lon - dlon, lat - dlat}, {lon + dlon, lat - dlat}, {lon + dlon, lat + dlat}, {lon - dlon, lat + dlat}, {lon - dlon, lat - dlat}})});
-  zones["UASZoneList"].push_back(closure);
-  std::ofstream(dir_ + "/zones_v2.json") << zones.dump();
+  std::ofstream(dir_ + "/zones_v2.json") << test::withClosureAt(json::parse(std::ifstream(examples + "zones_ed269.json")), fixAt(rep, 25)).dump();
   const std::uint64_t v2 = put(dir_ + "/zones_v2.json");
   const auto t_put = std::chrono::steady_clock::now();
   for (int k = 10; k < 30; ++k) {
@@ -394,17 +401,12 @@ TEST_F(NatsWorkers, AZoneSetUpdateIsInForceForEveryFixPublishedAfterIt) {
 
 TEST_F(NatsWorkers, AZoneSetUpdateReachesQuietWorkersAndEachFlightIsToldWithoutAFix) {
   const std::string examples = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/";
-  (void)putZurich(server_->url(), examples + "zones_ed269.json");
-  auto approver = worker("approve", "ap1");
-  ASSERT_EQ(approve("a1", zurichMission(dir_)).at("status"), "approved") << approver->log();
-  const json rep = report("a1");
-  auto w1 = worker("track", "tr1");
-  auto w2 = worker("track", "tr2");
-  const std::vector<std::string> flights = {"f1", "f2", "f3", "f4"};
-  for (const std::string& f : flights) {
-    client_->publish(nats::fixSubject("acme", f), json{{"start", {{"approval", "a1"}}}}.dump());
-    client_->publish(nats::fixSubject("acme", f), fixAt(rep, 0).dump());
-  }
+  ZurichFlights z = startZurichFlights();
+  ASSERT_FALSE(z.rep.is_null());
+  const auto& w1 = z.w1;
+  const auto& w2 = z.w2;
+  const std::vector<std::string>& flights = z.flights;
+  for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), fixAt(z.rep, 0).dump());
   (void)waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= flights.size(); });
   // Both workers hold flights (the partitions are shared out), then no fix comes.
   std::this_thread::sleep_for(std::chrono::milliseconds(500));

@@ -7,6 +7,7 @@
 #include "maps/time.hpp"
 #include "tests/service/child_process.hpp"
 #include "tests/service/http_client.hpp"
+#include "tests/service/route_fix.hpp"
 #include "tests/service/service_process.hpp"
 #include "tests/test_util.hpp"
 
@@ -122,17 +123,7 @@ class ServeOnNats : public ::testing::Test {
     }
     return st;
   }
-  /// A fix k seconds after departure on the approved route, `off_m` north of it.
-  static json fixAt(const json& rep, int k, double off_m = 0.0) {
-    const json& pts = rep.at("route");
-    std::size_t i = 1;
-    while (i + 1 < pts.size() && k > pts[i].at("eta_s").get<double>()) ++i;
-    const json &a = pts[i - 1], &b = pts[i];
-    const double f = std::clamp((k - a.at("eta_s").get<double>()) / (b.at("eta_s").get<double>() - a.at("eta_s").get<double>()), 0.0, 1.0);
-    auto mix = [&](const char* key) { return a.at(key).get<double>() + f * (b.at(key).get<double>() - a.at(key).get<double>()); };
-    const std::string time = maps::formatRfc3339(maps::parseRfc3339(rep.at("departure").get<std::string>())->plus(k));
-    return {{"time", time}, {"lat", mix("lat") + off_m / 111'195.0}, {"lon", mix("lon")}, {"h_ell_m", mix("h_ell_m")}, {"hpl_m", 0.5}, {"vpl_m", 0.5}};
-  }
+  static json fixAt(const json& rep, int k, double off_m = 0.0) { return test::fixAlongRoute(rep, k, off_m); }
   /// `skylane track` on the approval's report (as the service serves it) and `body`'s fixes.
   std::vector<json> trackEvents(const std::string& flight, const std::string& body) {
     const std::string report = dir_ + "/report.json", fixes = dir_ + "/fixes.jsonl";
@@ -300,14 +291,7 @@ TEST_F(ServeOnNats, AZoneSetVersionUploadedToTheServiceIsInForceForTheFlightsOnT
   }
   // Version 2 through the service: the same zones and a closure 120 m wide around the route 25 s
   // after departure. The mission named the set without a version, so the flight follows it.
-  json zones = json::parse(readFile(std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/zones_ed269.json"));
-  json closure = zones["UASZoneList"][0];
-  const json at = fixAt(rep, 25);
-  const double lat = at["lat"], lon = at["lon"], dlat = 60.0 / 111'195.0, dlon = dlat / std::cos(lat * M_PI / 180.0);
-  closure["identifier"] = "EX-NEW-CLOSURE";
-  closure["geometry"][0]["horizontalProjection"]["coordinates"] =
-      json::array({json::array({{lon - dlon, lat - dlat}, {lon + dlon, lat - dlat}, {lon + dlon, lat + dlat}, {lon - dlon, lat + dlat}, {lon - dlon, lat - dlat}})});
-  zones["UASZoneList"].push_back(closure);
+  const json zones = test::withClosureAt(json::parse(readFile(std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/zones_ed269.json")), fixAt(rep, 25));
   const HttpReply v2 = call("PUT", "/v1/zonesets/" + zoneset_, TestTokens::kAuthority, zones.dump());
   ASSERT_EQ(v2.status, 200) << v2.body;
   // The quiet track worker takes it and tells the flight, with no fix sent.
