@@ -94,7 +94,7 @@ class Worker {
   void putFlightCheckpoints(Partition& p);
   bool putPartitionCheckpoint(Partition& p, std::uint64_t last_seq);
   void judge(Partition& p, const NatsMessage& m, std::vector<Outgoing>& out);
-  void judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, const json& body, std::vector<Outgoing>& out);
+  void judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, planner::TrackFix fix, std::vector<Outgoing>& out);
   void startFlight(Partition& p, FlightSlot& slot, const json& body);
   FlightSlot& slotOf(Partition& p, const std::string& op, const std::string& flight);
   void loadApproval(Partition& p, FlightSlot& slot, const std::string& id);
@@ -394,11 +394,10 @@ void Worker::reject(const NatsMessage& m, const std::string& subject, const std:
   ++c_.rejected;
 }
 
-void Worker::judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, const json& body, std::vector<Outgoing>& out) {
+void Worker::judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, planner::TrackFix fix, std::vector<Outgoing>& out) {
   if (slot.approval.empty()) {
     throw Rejected{"flight " + slot.flight + " of operator " + slot.op + " is not started: its first message is {\"start\": {\"approval\": ID}}"};
   }
-  planner::TrackFix fix = planner::parseTrackFixJson(body, m.subject);
   if (!fix.flight.empty() && fix.flight != slot.flight) throw Rejected{"the fix names flight \"" + fix.flight.substr(0, 64) + "\", not " + slot.flight};
   fix.flight = slot.op + "." + slot.flight;
   fix.line = 0;
@@ -432,13 +431,18 @@ void Worker::judge(Partition& p, const NatsMessage& m, std::vector<Outgoing>& ou
     }
     slot.covered_seq = m.stream_seq;
     slot.dirty = true;
+    // A plain fix line is read directly (planner/tracking/fix_line.cpp); anything else as a document.
+    if (std::optional<planner::TrackFix> plain = planner::parsePlainFixLine(m.data, m.subject)) {
+      judgeFix(p, slot, m, std::move(*plain), out);
+      return;
+    }
     const json body = maps::parseJsonLine(m.data, m.subject);
     if (body.is_object() && body.contains("start")) {
       startFlight(p, slot, body);
       out.push_back({subject, json{{"event", "flight_started"}, {"flight", slot.flight}, {"operator", slot.op}, {"approval", slot.approval},
                                    {"input_seq", m.stream_seq}}.dump(), "fix." + std::to_string(m.stream_seq) + ".0"});
     } else {
-      judgeFix(p, slot, m, body, out);
+      judgeFix(p, slot, m, planner::parseTrackFixJson(body, m.subject), out);
     }
   } catch (const Rejected& r) {
     reject(m, subject, r.why, out);
