@@ -20,16 +20,26 @@ using StateMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMa
 /// Q̃(x): the normal tail, 1 for negative arguments (conservative when PL < T + b).
 double modifiedTail(double x) { return x < 0.0 ? 1.0 : normalTail(x); }
 
+/// Largest leverage h_i = w_i g_iᵀ N⁻¹ g_i, as 1 − h_i, for which a single-satellite subset is
+/// taken from the rank-one down-date: N_k = N − w g gᵀ ⪰ (1 − h_i) N, so below this the
+/// down-dated solution would lose more than three digits to the all-in-view one's and the
+/// subset is solved from its own normal matrix instead (which also decides unmonitorable).
+constexpr double kMinDowndateRedundancy = 1e-3;
+
 struct AllInView {
   Eigen::MatrixXd A;  ///< Gᵀ W (m × n)
   StateMatrix N;      ///< Gᵀ W G
+  /// For the rank-one down-dates (AraimConfig::subset_downdate): P = N⁻¹ and S = P Gᵀ W with
+  /// every state's row (m × n); empty when not used.
+  StateMatrix P;
+  Eigen::MatrixXd S;
 };
 
-/// Columns 0..2 of N⁻¹ for the symmetric positive definite mk × mk matrix N (overwritten by
-/// its unit lower-triangular factor), by an unpivoted LDLᵀ factorisation and substitution —
+/// Columns 0..cols−1 of N⁻¹ for the symmetric positive definite mk × mk matrix N (overwritten
+/// by its unit lower-triangular factor), by an unpivoted LDLᵀ factorisation and substitution —
 /// a fixed-capacity loop for these ≤ 7 × 7 systems, no allocation. False when a pivot is not
 /// above kMinPivotRatio × the largest (the subset's states are not fixed: unmonitorable).
-bool firstThreeInverseColumns(StateMatrix& N, int mk, double (&X)[kMaxStates][3]) {
+bool ldltInverseColumns(StateMatrix& N, int mk, int cols, double (&X)[kMaxStates][kMaxStates]) {
   double d[kMaxStates];
   double d_max = 0.0;
   for (int j = 0; j < mk; ++j) {
@@ -47,7 +57,7 @@ bool firstThreeInverseColumns(StateMatrix& N, int mk, double (&X)[kMaxStates][3]
   for (int j = 0; j < mk; ++j) {
     if (!(d[j] > kMinPivotRatio * d_max)) return false;
   }
-  for (int q = 0; q < 3; ++q) {
+  for (int q = 0; q < cols; ++q) {
     double y[kMaxStates];
     for (int i = 0; i < mk; ++i) {  // L y = e_q
       double v = i == q ? 1.0 : 0.0;
@@ -94,8 +104,8 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
   for (int a = 0; a < mk; ++a) {
     for (int b = 0; b < mk; ++b) Nr(a, b) = Nk(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
   }
-  double X[kMaxStates][3];  // columns q of N_k⁻¹
-  if (!firstThreeInverseColumns(Nr, mk, X)) return false;
+  double X[kMaxStates][kMaxStates];  // columns q of N_k⁻¹
+  if (!ldltInverseColumns(Nr, mk, 3, X)) return false;
   out.S = Eigen::MatrixXd::Zero(3, n);
   for (int i = 0, r = 0; i < n; ++i) {
     if (r < static_cast<int>(removed.size()) && removed[static_cast<std::size_t>(r)] == i) {
@@ -109,6 +119,55 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
     }
   }
   for (int q = 0; q < 3; ++q) out.sigma[q] = std::sqrt(X[q][q]);
+  return std::isfinite(out.sigma[0]) && std::isfinite(out.sigma[2]);
+}
+
+/// The all-in-view covariance P = N⁻¹ and the projection S = P Gᵀ W with every state's row,
+/// for the rank-one down-dates. False (down-dates unused) when N is singular.
+bool setAllInViewCovariance(AllInView& aiv, int m, int n) {
+  StateMatrix L = aiv.N;
+  double X[kMaxStates][kMaxStates];
+  if (!ldltInverseColumns(L, m, m, X)) return false;
+  aiv.P.resize(m, m);
+  for (int a = 0; a < m; ++a) {
+    for (int b = 0; b < m; ++b) aiv.P(a, b) = X[a][b];
+  }
+  aiv.S.resize(m, n);
+  for (int i = 0; i < n; ++i) {
+    for (int a = 0; a < m; ++a) {
+      double v = 0.0;
+      for (int b = 0; b < m; ++b) v += aiv.P(a, b) * aiv.A(b, i);
+      aiv.S(a, i) = v;
+    }
+  }
+  return true;
+}
+
+/// The subset without satellite i from the all-in-view solution by a rank-one down-date
+/// (Sherman–Morrison on N_k = N − w_i g_i g_iᵀ): with H_ij = g_iᵀ S_·j (the hat matrix, h_i = H_ii),
+///   S^(k)_qj = S_qj + S_qi H_ij / (1 − h_i) for j ≠ i, 0 for j = i;
+///   σ_q^(k)2 = P_qq + S_qi² / (w_i (1 − h_i)).
+/// False when 1 − h_i < kMinDowndateRedundancy: the caller solves the subset from its own normal matrix.
+bool downdatedSubsetSolution(const Geometry& g, const AllInView& aiv, int i, SubsetSolution& out) {
+  const int n = g.numSats(), m = g.numStates();
+  double h = 0.0;
+  for (int a = 0; a < m; ++a) h += g.G(i, a) * aiv.S(a, i);
+  const double redundancy = 1.0 - h;
+  if (!(redundancy >= kMinDowndateRedundancy)) return false;
+  const double s0 = aiv.S(0, i), s1 = aiv.S(1, i), s2 = aiv.S(2, i);
+  out.S.resize(3, n);
+  for (int j = 0; j < n; ++j) {
+    double hij = 0.0;
+    for (int a = 0; a < m; ++a) hij += g.G(i, a) * aiv.S(a, j);
+    const double f = hij / redundancy;
+    out.S(0, j) = aiv.S(0, j) + s0 * f;
+    out.S(1, j) = aiv.S(1, j) + s1 * f;
+    out.S(2, j) = aiv.S(2, j) + s2 * f;
+  }
+  out.S.col(i).setZero();
+  const double c = g.sigma_int[i] * g.sigma_int[i] / redundancy;  // 1 / (w_i (1 − h_i))
+  out.sigma = {std::sqrt(aiv.P(0, 0) + s0 * s0 * c), std::sqrt(aiv.P(1, 1) + s1 * s1 * c),
+               std::sqrt(aiv.P(2, 2) + s2 * s2 * c)};
   return std::isfinite(out.sigma[0]) && std::isfinite(out.sigma[2]);
 }
 
@@ -188,7 +247,9 @@ void monitorFaultModes(AraimResult& out, const Geometry& g, const AllInView& aiv
     s.removed = std::move(mode.removed);
     s.prior = mode.prior;
     s.event_prior = mode.event_prior;
-    if (!subsetSolution(g, aiv, s.removed, s)) {
+    const bool downdated = s.removed.size() == 1 && aiv.S.size() > 0 && downdatedSubsetSolution(g, aiv, s.removed[0], s);
+    out.downdated_modes += downdated ? 1 : 0;
+    if (!downdated && !subsetSolution(g, aiv, s.removed, s)) {
       out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
       ++out.unmonitorable_modes;
       continue;
@@ -358,7 +419,8 @@ AraimResult araimLevelsOverModes(const Geometry& g, FaultModeSet modes, const Ar
     out.reason = *why;
     return out;
   }
-  const AllInView aiv = allInView(g);
+  AllInView aiv = allInView(g);
+  if (cfg.subset_downdate && !modes.modes.empty()) (void)setAllInViewCovariance(aiv, g.numStates(), g.numSats());
   SubsetSolution all;
   if (!subsetSolution(g, aiv, {}, all)) {
     out.reason = "singular geometry: the satellites do not fix position and clocks";
