@@ -344,7 +344,6 @@ void judgeAvailability(AraimResult& out, const AraimConfig& cfg) {
 }  // namespace
 
 RiskAndSlope integrityRiskAndSlope(const std::vector<RiskTerm>& terms, double pl) {
-  constexpr double kInvSqrt2Pi = 0.39894228040143267794;
   RiskAndSlope out;
   for (const RiskTerm& t : terms) {
     const double z = (pl - t.threshold - t.bias) / t.sigma;
@@ -352,8 +351,9 @@ RiskAndSlope integrityRiskAndSlope(const std::vector<RiskTerm>& terms, double pl
       out.risk += t.prior;  // Q̃ = 1, flat
       continue;
     }
-    out.risk += t.prior * normalTail(z);
-    out.slope -= t.prior * kInvSqrt2Pi * std::exp(-0.5 * z * z) / t.sigma;
+    const TailAndDensity q = normalTailAndDensity(z);  // one exponential for both
+    out.risk += t.prior * q.tail;
+    out.slope -= t.prior * q.density / t.sigma;
   }
   return out;
 }
