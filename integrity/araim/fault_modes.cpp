@@ -168,6 +168,21 @@ double selectUntilThreshold(std::vector<Combination>& combos, double p_any, cons
   return std::max(0.0, p_nm);
 }
 
+/// An upper bound on the prior of any combination of k events: p_nf times the k largest
+/// p_e/(1 − p_e), inflated by 1e-12 over the products' round-off.
+double largestPriorOf(const std::vector<Event>& events, int k, double p_nf) {
+  std::array<double, kMaxEnumeratedEvents> top{};  // descending
+  for (const Event& e : events) {
+    double u = e.p / (1.0 - e.p);
+    for (int i = 0; i < k; ++i) {
+      if (u > top[static_cast<std::size_t>(i)]) std::swap(u, top[static_cast<std::size_t>(i)]);
+    }
+  }
+  double bound = p_nf * (1.0 + 1e-12);
+  for (int i = 0; i < k; ++i) bound *= top[static_cast<std::size_t>(i)];
+  return bound;
+}
+
 /// The reference selection when the monitored-always combinations (prior > PHMI) alone leave
 /// P_nm ≤ P_THRES — the usual case with LPV-200 ISMs: then the loop adds nothing, and only those
 /// combinations are built. Returns false (and leaves `combos` empty) when more are needed.
@@ -176,6 +191,8 @@ bool selectLargeOnly(const std::vector<Event>& events, int depth, double p_any, 
   const double p_nf = noFault(events);
   double p = p_any;
   for (int k = 1; k <= depth; ++k) {
+    // No combination of k events can exceed PHMI: none to visit.
+    if (largestPriorOf(events, k, p_nf) <= o.phmi) continue;
     forEachCombination(events, k, p_nf, [&](const int* pick, int kk, double prior, double event_prior) {
       if (prior <= o.phmi) return;
       p -= prior;

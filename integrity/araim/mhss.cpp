@@ -33,6 +33,7 @@ struct AllInView {
   /// every state's row (m × n); empty when not used.
   StateMatrix P;
   Eigen::MatrixXd S;
+  Eigen::MatrixXd Ht;  ///< the hat matrix transposed, Ht(j, i) = H_ij = g_iᵀ S_·j (n × n): row i of H is column i
 };
 
 /// Columns 0..cols−1 of N⁻¹ for the symmetric positive definite mk × mk matrix N (overwritten
@@ -124,7 +125,8 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
 
 /// The all-in-view covariance P = N⁻¹ and the projection S = P Gᵀ W with every state's row,
 /// for the rank-one down-dates. False (down-dates unused) when N is singular.
-bool setAllInViewCovariance(AllInView& aiv, int m, int n) {
+bool setAllInViewCovariance(AllInView& aiv, const Geometry& g) {
+  const int m = g.numStates(), n = g.numSats();
   StateMatrix L = aiv.N;
   double X[kMaxStates][kMaxStates];
   if (!ldltInverseColumns(L, m, m, X)) return false;
@@ -140,34 +142,60 @@ bool setAllInViewCovariance(AllInView& aiv, int m, int n) {
       aiv.S(a, i) = v;
     }
   }
+  aiv.Ht.noalias() = aiv.S.transpose() * g.G.transpose();
   return true;
+}
+
+/// σ_ss,q, b_q and σ_acc,q of a subset from its projection S^(k) (rows 0..2) and S^(0) (ADD Eq. 21).
+void setSubsetErrors(SubsetSolution& s, const Eigen::MatrixXd& S0, const Geometry& g, const Eigen::VectorXd& c_acc) {
+  for (int q = 0; q < 3; ++q) {
+    double ss = 0.0, b = 0.0, acc = 0.0;
+    for (int i = 0; i < g.numSats(); ++i) {
+      const double sk = s.S(q, i), d = sk - S0(q, i);
+      ss += d * d * c_acc[i];  // ADD Eq. 21 (C_acc)
+      b += std::abs(sk) * g.bnom[i];
+      acc += sk * sk * c_acc[i];
+    }
+    s.sigma_ss[q] = std::sqrt(ss);
+    s.bias[q] = b;
+    s.sigma_acc[q] = std::sqrt(acc);
+  }
 }
 
 /// The subset without satellite i from the all-in-view solution by a rank-one down-date
 /// (Sherman–Morrison on N_k = N − w_i g_i g_iᵀ): with H_ij = g_iᵀ S_·j (the hat matrix, h_i = H_ii),
 ///   S^(k)_qj = S_qj + S_qi H_ij / (1 − h_i) for j ≠ i, 0 for j = i;
-///   σ_q^(k)2 = P_qq + S_qi² / (w_i (1 − h_i)).
-/// False when 1 − h_i < kMinDowndateRedundancy: the caller solves the subset from its own normal matrix.
-bool downdatedSubsetSolution(const Geometry& g, const AllInView& aiv, int i, SubsetSolution& out) {
+///   σ_q^(k)2 = P_qq + S_qi² / (w_i (1 − h_i));
+/// and, in the same pass, setSubsetErrors' sums. False when 1 − h_i < kMinDowndateRedundancy:
+/// the caller solves the subset from its own normal matrix.
+bool downdatedSubsetSolution(const Geometry& g, const AllInView& aiv, const Eigen::MatrixXd& S0,
+                             const Eigen::VectorXd& c_acc, int i, SubsetSolution& out) {
   const int n = g.numSats(), m = g.numStates();
   double h = 0.0;
-  for (int a = 0; a < m; ++a) h += g.G(i, a) * aiv.S(a, i);
+  for (int a = 0; a < m; ++a) h += g.G(i, a) * aiv.S(a, i);  // not Ht(i, i): the same sum as the fallback test
   const double redundancy = 1.0 - h;
   if (!(redundancy >= kMinDowndateRedundancy)) return false;
-  const double s0 = aiv.S(0, i), s1 = aiv.S(1, i), s2 = aiv.S(2, i);
+  const double si[3] = {aiv.S(0, i), aiv.S(1, i), aiv.S(2, i)};
+  double ss[3] = {0, 0, 0}, b[3] = {0, 0, 0}, acc[3] = {0, 0, 0};
   out.S.resize(3, n);
+  const double* h_i = aiv.Ht.col(i).data();  // row i of the hat matrix
   for (int j = 0; j < n; ++j) {
-    double hij = 0.0;
-    for (int a = 0; a < m; ++a) hij += g.G(i, a) * aiv.S(a, j);
-    const double f = hij / redundancy;
-    out.S(0, j) = aiv.S(0, j) + s0 * f;
-    out.S(1, j) = aiv.S(1, j) + s1 * f;
-    out.S(2, j) = aiv.S(2, j) + s2 * f;
+    const double f = j == i ? 0.0 : h_i[j] / redundancy;
+    for (int q = 0; q < 3; ++q) {
+      const double sk = j == i ? 0.0 : aiv.S(q, j) + si[q] * f, d = sk - S0(q, j);
+      out.S(q, j) = sk;
+      ss[q] += d * d * c_acc[j];
+      b[q] += std::abs(sk) * g.bnom[j];
+      acc[q] += sk * sk * c_acc[j];
+    }
   }
-  out.S.col(i).setZero();
   const double c = g.sigma_int[i] * g.sigma_int[i] / redundancy;  // 1 / (w_i (1 − h_i))
-  out.sigma = {std::sqrt(aiv.P(0, 0) + s0 * s0 * c), std::sqrt(aiv.P(1, 1) + s1 * s1 * c),
-               std::sqrt(aiv.P(2, 2) + s2 * s2 * c)};
+  for (int q = 0; q < 3; ++q) {
+    out.sigma[q] = std::sqrt(aiv.P(q, q) + si[q] * si[q] * c);
+    out.sigma_ss[q] = std::sqrt(ss[q]);
+    out.bias[q] = b[q];
+    out.sigma_acc[q] = std::sqrt(acc[q]);
+  }
   return std::isfinite(out.sigma[0]) && std::isfinite(out.sigma[2]);
 }
 
@@ -247,24 +275,16 @@ void monitorFaultModes(AraimResult& out, const Geometry& g, const AllInView& aiv
     s.removed = std::move(mode.removed);
     s.prior = mode.prior;
     s.event_prior = mode.event_prior;
-    const bool downdated = s.removed.size() == 1 && aiv.S.size() > 0 && downdatedSubsetSolution(g, aiv, s.removed[0], s);
+    const bool downdated = s.removed.size() == 1 && aiv.S.size() > 0 &&
+                           downdatedSubsetSolution(g, aiv, out.S0, c_acc, s.removed[0], s);
     out.downdated_modes += downdated ? 1 : 0;
-    if (!downdated && !subsetSolution(g, aiv, s.removed, s)) {
-      out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
-      ++out.unmonitorable_modes;
-      continue;
-    }
-    for (int q = 0; q < 3; ++q) {
-      double ss = 0.0, b = 0.0, acc = 0.0;
-      for (int i = 0; i < g.numSats(); ++i) {
-        const double sk = s.S(q, i), d = sk - out.S0(q, i);
-        ss += d * d * c_acc[i];  // ADD Eq. 21 (C_acc)
-        b += std::abs(sk) * g.bnom[i];
-        acc += sk * sk * c_acc[i];
+    if (!downdated) {
+      if (!subsetSolution(g, aiv, s.removed, s)) {
+        out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
+        ++out.unmonitorable_modes;
+        continue;
       }
-      s.sigma_ss[q] = std::sqrt(ss);
-      s.bias[q] = b;
-      s.sigma_acc[q] = std::sqrt(acc);
+      setSubsetErrors(s, out.S0, g, c_acc);
     }
     out.subsets.push_back(std::move(s));
   }
@@ -420,7 +440,7 @@ AraimResult araimLevelsOverModes(const Geometry& g, FaultModeSet modes, const Ar
     return out;
   }
   AllInView aiv = allInView(g);
-  if (cfg.subset_downdate && !modes.modes.empty()) (void)setAllInViewCovariance(aiv, g.numStates(), g.numSats());
+  if (cfg.subset_downdate && !modes.modes.empty()) (void)setAllInViewCovariance(aiv, g);
   SubsetSolution all;
   if (!subsetSolution(g, aiv, {}, all)) {
     out.reason = "singular geometry: the satellites do not fix position and clocks";
