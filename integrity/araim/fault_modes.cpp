@@ -97,8 +97,10 @@ Combination makeCombination(const std::vector<Event>& events, const int* pick, i
     c.events[static_cast<std::size_t>(c.n_events++)] = pick[i];
     c.removed.insert(c.removed.end(), e.removes.begin(), e.removes.end());
   }
-  std::sort(c.removed.begin(), c.removed.end());
-  c.removed.erase(std::unique(c.removed.begin(), c.removed.end()), c.removed.end());
+  if (k > 1) {  // one event's satellites are already ascending and distinct
+    std::sort(c.removed.begin(), c.removed.end());
+    c.removed.erase(std::unique(c.removed.begin(), c.removed.end()), c.removed.end());
+  }
   return c;
 }
 
@@ -190,6 +192,7 @@ bool selectLargeOnly(const std::vector<Event>& events, int depth, double p_any, 
                      std::vector<Combination>& combos, double& p_nm) {
   const double p_nf = noFault(events);
   double p = p_any;
+  combos.reserve(events.size());
   for (int k = 1; k <= depth; ++k) {
     // No combination of k events can exceed PHMI: none to visit.
     if (largestPriorOf(events, k, p_nf) <= o.phmi) continue;
@@ -242,16 +245,18 @@ Events buildEvents(const std::vector<Constellation>& sats, const std::vector<dou
     throw std::invalid_argument("determineFaultModes: one P_const per constellation");
   }
   Events ev;
+  ev.all.reserve(sats.size() + static_cast<std::size_t>(kNumConstellations));
   for (std::size_t i = 0; i < sats.size(); ++i) ev.all.push_back({{static_cast<int>(i)}, p_sat[i]});
   ev.first_const = static_cast<int>(ev.all.size());
   for (Constellation c : kAllConstellations) {
     Event e;
+    e.removes.reserve(sats.size());
     for (std::size_t i = 0; i < sats.size(); ++i) {
       if (sats[i] == c) e.removes.push_back(static_cast<int>(i));
     }
     if (e.removes.empty()) continue;
     e.p = p_const[static_cast<std::size_t>(c)];
-    ev.all.push_back(e);
+    ev.all.push_back(std::move(e));
   }
   for (const Event& e : ev.all) {
     if (!(e.p >= 0.0 && e.p < 1.0)) throw std::invalid_argument("determineFaultModes: a prior outside [0, 1)");

@@ -247,6 +247,8 @@ void setAllInViewErrors(AraimResult& out, const Geometry& g, const SubsetSolutio
 FaultModeSet araimFaultModes(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg) {
   std::vector<Constellation> cons;
   std::vector<double> p_sat;
+  cons.reserve(g.sats.size());
+  p_sat.reserve(g.sats.size());
   for (const SatId& s : g.sats) {
     cons.push_back(s.constellation);
     p_sat.push_back(model.of(s.constellation).psat);
