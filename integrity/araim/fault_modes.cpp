@@ -45,18 +45,15 @@ int nFaultMax(const std::vector<double>& p, double p_thres) {
   return r;
 }
 
-double noFault(const std::vector<Event>& events) {
+/// ln ∏(1 − p_e): P(no event) is its exponential, P(at least one event) −expm1 of it (without the
+/// cancellation of 1 − a number near 1).
+double logNoFault(const std::vector<Event>& events) {
   double log_nf = 0.0;
   for (const Event& e : events) log_nf += std::log1p(-e.p);
-  return std::exp(log_nf);
+  return log_nf;
 }
 
-/// P(at least one event) = 1 − ∏(1 − p_e), without the cancellation of 1 − (a number near 1).
-double anyFault(const std::vector<Event>& events) {
-  double log_nf = 0.0;
-  for (const Event& e : events) log_nf += std::log1p(-e.p);
-  return -std::expm1(log_nf);
-}
+double noFault(const std::vector<Event>& events) { return std::exp(logNoFault(events)); }
 
 /// Calls visit(indices, prior, event_prior) for every combination of exactly k events with
 /// nonzero probability, in lexicographic order of the event indices (MAAST's order); the
@@ -188,9 +185,8 @@ double largestPriorOf(const std::vector<Event>& events, int k, double p_nf) {
 /// The reference selection when the monitored-always combinations (prior > PHMI) alone leave
 /// P_nm ≤ P_THRES — the usual case with LPV-200 ISMs: then the loop adds nothing, and only those
 /// combinations are built. Returns false (and leaves `combos` empty) when more are needed.
-bool selectLargeOnly(const std::vector<Event>& events, int depth, double p_any, const FaultModeOptions& o,
+bool selectLargeOnly(const std::vector<Event>& events, int depth, double p_nf, double p_any, const FaultModeOptions& o,
                      std::vector<Combination>& combos, double& p_nm) {
-  const double p_nf = noFault(events);
   double p = p_any;
   combos.reserve(events.size());
   for (int k = 1; k <= depth; ++k) {
@@ -212,9 +208,11 @@ bool selectLargeOnly(const std::vector<Event>& events, int depth, double p_any, 
 
 /// Merges combinations by removed set; fewest removed satellites first, then lexicographic.
 std::vector<FaultMode> mergeByRemovedSet(std::vector<Combination>& combos) {
-  std::stable_sort(combos.begin(), combos.end(), [](const Combination& a, const Combination& b) {
+  const auto before = [](const Combination& a, const Combination& b) {
     return a.removed.size() != b.removed.size() ? a.removed.size() < b.removed.size() : a.removed < b.removed;
-  });
+  };
+  // The usual single events arrive in order already: a stable sort would leave them as they are.
+  if (!std::is_sorted(combos.begin(), combos.end(), before)) std::stable_sort(combos.begin(), combos.end(), before);
   std::vector<FaultMode> out;
   out.reserve(combos.size());
   for (Combination& c : combos) {
@@ -327,13 +325,14 @@ FaultModeSet determineFaultModes(const std::vector<Constellation>& sats, const s
                          : out.n_fault_max;
   std::vector<Combination> combos;
   // Consolidation can lift a constellation mode above PHMI, so the shortcut needs it off.
-  if (adds && !(o.fc_thres > 0.0) && selectLargeOnly(ev.all, depth, anyFault(ev.all), o, combos, out.p_not_monitored)) {
+  const double log_nf = logNoFault(ev.all), p_nf = std::exp(log_nf), p_any = -std::expm1(log_nf);
+  if (adds && !(o.fc_thres > 0.0) && selectLargeOnly(ev.all, depth, p_nf, p_any, o, combos, out.p_not_monitored)) {
     out.modes = mergeByRemovedSet(combos);
     return out;
   }
-  combos = combinationsUpTo(ev.all, depth, noFault(ev.all));
+  combos = combinationsUpTo(ev.all, depth, p_nf);
   consolidateIntoConstellations(combos, ev.first_const, o.fc_thres);
-  out.p_not_monitored = adds ? selectUntilThreshold(combos, anyFault(ev.all), o)
+  out.p_not_monitored = adds ? selectUntilThreshold(combos, p_any, o)
                              : probabilityOfAtLeast(p, out.n_fault_max + 1);
   out.modes = mergeByRemovedSet(combos);
   return out;
