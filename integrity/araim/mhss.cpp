@@ -28,7 +28,7 @@ constexpr double kMinDowndateRedundancy = 1e-3;
 
 struct AllInView {
   Eigen::MatrixXd A;  ///< Gᵀ W (m × n)
-  StateMatrix N;      ///< Gᵀ W G
+  StateMatrix N;      ///< Gᵀ W G, lower triangle only (all the LDLᵀ reads); the upper is zero
   /// For the rank-one down-dates (AraimConfig::subset_downdate): P = N⁻¹ and S = P Gᵀ W with
   /// every state's row (m × n); empty when not used.
   StateMatrix P;
@@ -36,8 +36,8 @@ struct AllInView {
   Eigen::MatrixXd Ht;  ///< the hat matrix transposed, Ht(j, i) = H_ij = g_iᵀ S_·j (n × n): row i of H is column i
 };
 
-/// Columns 0..cols−1 of N⁻¹ for the symmetric positive definite mk × mk matrix N (overwritten
-/// by its unit lower-triangular factor), by an unpivoted LDLᵀ factorisation and substitution —
+/// Columns 0..cols−1 of N⁻¹ for the symmetric positive definite mk × mk matrix N (only its lower
+/// triangle is read; overwritten by its unit lower-triangular factor), by an unpivoted LDLᵀ factorisation and substitution —
 /// a fixed-capacity loop for these ≤ 7 × 7 systems, no allocation. False when a pivot is not
 /// above kMinPivotRatio × the largest (the subset's states are not fixed: unmonitorable).
 bool ldltInverseColumns(StateMatrix& N, int mk, int cols, double (&X)[kMaxStates][kMaxStates]) {
@@ -98,7 +98,7 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
   for (int i : removed) {
     const double w = 1.0 / (g.sigma_int[i] * g.sigma_int[i]);
     for (int a = 0; a < m; ++a) {  // rank-one down-date N_k = N − w g gᵀ
-      for (int b = 0; b < m; ++b) Nk(a, b) -= w * g.G(i, a) * g.G(i, b);
+      for (int b = 0; b <= a; ++b) Nk(a, b) -= w * g.G(i, a) * g.G(i, b);
     }
   }
   StateMatrix Nr(mk, mk);
@@ -225,7 +225,7 @@ AllInView allInView(const Geometry& g) {
   aiv.N = StateMatrix::Zero(m, m);
   for (int i = 0; i < g.numSats(); ++i) {  // N = Σ w_i g_i g_iᵀ, without Eigen's general product kernel
     for (int a = 0; a < m; ++a) {
-      for (int b = 0; b < m; ++b) aiv.N(a, b) += aiv.A(a, i) * g.G(i, b);
+      for (int b = 0; b <= a; ++b) aiv.N(a, b) += aiv.A(a, i) * g.G(i, b);
     }
   }
   return aiv;
