@@ -19,7 +19,8 @@ constexpr int kMinEnumeratedEvents = 2;
 constexpr int kMaxEvents = 256;
 
 struct Event {
-  std::vector<int> removes;  ///< satellite indices, ascending
+  int satellite = -1;        ///< a satellite fault: its index (no list to allocate)
+  std::vector<int> removes;  ///< a constellation fault: its satellites' indices, ascending
   double p = 0.0;
 };
 
@@ -89,10 +90,20 @@ Combination makeCombination(const std::vector<Event>& events, const int* pick, i
   Combination c;
   c.prior = prior;
   c.event_prior = event_prior;
+  std::size_t count = 0;
+  for (int i = 0; i < k; ++i) {
+    const Event& e = events[static_cast<std::size_t>(pick[i])];
+    count += e.satellite >= 0 ? 1 : e.removes.size();
+  }
+  c.removed.reserve(count);
   for (int i = 0; i < k; ++i) {
     const Event& e = events[static_cast<std::size_t>(pick[i])];
     c.events[static_cast<std::size_t>(c.n_events++)] = pick[i];
-    c.removed.insert(c.removed.end(), e.removes.begin(), e.removes.end());
+    if (e.satellite >= 0) {
+      c.removed.push_back(e.satellite);
+    } else {
+      c.removed.insert(c.removed.end(), e.removes.begin(), e.removes.end());
+    }
   }
   if (k > 1) {  // one event's satellites are already ascending and distinct
     std::sort(c.removed.begin(), c.removed.end());
@@ -244,7 +255,7 @@ Events buildEvents(const std::vector<Constellation>& sats, const std::vector<dou
   }
   Events ev;
   ev.all.reserve(sats.size() + static_cast<std::size_t>(kNumConstellations));
-  for (std::size_t i = 0; i < sats.size(); ++i) ev.all.push_back({{static_cast<int>(i)}, p_sat[i]});
+  for (std::size_t i = 0; i < sats.size(); ++i) ev.all.push_back({static_cast<int>(i), {}, p_sat[i]});
   ev.first_const = static_cast<int>(ev.all.size());
   for (Constellation c : kAllConstellations) {
     Event e;
