@@ -219,9 +219,12 @@ std::optional<std::string> geometryShortfall(const Geometry& g) {
 
 AllInView allInView(const Geometry& g) {
   AllInView aiv;
-  const Eigen::VectorXd w = g.sigma_int.array().square().inverse();
-  aiv.A = g.G.transpose() * w.asDiagonal();
   const int m = g.numStates();
+  aiv.A.resize(m, g.numSats());
+  for (int i = 0; i < g.numSats(); ++i) {
+    const double w = 1.0 / (g.sigma_int[i] * g.sigma_int[i]);
+    for (int a = 0; a < m; ++a) aiv.A(a, i) = g.G(i, a) * w;
+  }
   aiv.N = StateMatrix::Zero(m, m);
   for (int i = 0; i < g.numSats(); ++i) {  // N = Σ w_i g_i g_iᵀ, without Eigen's general product kernel
     for (int a = 0; a < m; ++a) {
@@ -232,8 +235,8 @@ AllInView allInView(const Geometry& g) {
 }
 
 /// The all-in-view projection, sigmas, nominal biases and vertical accuracy sigma.
-void setAllInViewErrors(AraimResult& out, const Geometry& g, const SubsetSolution& all, const Eigen::VectorXd& c_acc) {
-  out.S0 = all.S;
+void setAllInViewErrors(AraimResult& out, const Geometry& g, SubsetSolution&& all, const Eigen::VectorXd& c_acc) {
+  out.S0 = std::move(all.S);
   for (int q = 0; q < 3; ++q) {
     out.sigma0[q] = all.sigma[q];
     out.bias0[q] = out.S0.row(q).cwiseAbs().dot(g.bnom);  // b_q^(0) = Σ|S_q,i| b_nom,i
@@ -449,7 +452,7 @@ AraimResult araimLevelsOverModes(const Geometry& g, FaultModeSet modes, const Ar
     return out;
   }
   const Eigen::VectorXd c_acc = g.sigma_acc.array().square();
-  setAllInViewErrors(out, g, all, c_acc);
+  setAllInViewErrors(out, g, std::move(all), c_acc);
   monitorFaultModes(out, g, aiv, std::move(modes), c_acc);
   setThresholds(out, cfg.requirements);
   setEffectiveMonitorThreshold(out, cfg);
