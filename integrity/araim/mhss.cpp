@@ -445,9 +445,11 @@ AraimResult araimLevelsOverModes(const Geometry& g, FaultModeSet modes, const Ar
     return out;
   }
   AllInView aiv = allInView(g);
-  if (cfg.subset_downdate && !modes.modes.empty()) (void)setAllInViewCovariance(aiv, g);
   SubsetSolution all;
-  if (!subsetSolution(g, aiv, {}, all)) {
+  if (cfg.subset_downdate && !modes.modes.empty() && setAllInViewCovariance(aiv, g)) {
+    all.S = aiv.S.topRows(3);  // the all-in-view solution is the covariance's first three rows
+    for (int q = 0; q < 3; ++q) all.sigma[q] = std::sqrt(aiv.P(q, q));
+  } else if (!subsetSolution(g, aiv, {}, all)) {
     out.reason = "singular geometry: the satellites do not fix position and clocks";
     return out;
   }
