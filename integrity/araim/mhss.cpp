@@ -33,12 +33,14 @@ struct AllInView {
   /// every state's row (m × n); empty when not used.
   StateMatrix P;
   Eigen::MatrixXd S;
-  Eigen::MatrixXd Ht;  ///< the hat matrix transposed, Ht(j, i) = H_ij = g_iᵀ S_·j (n × n): row i of H is column i
+  /// The hat matrix transposed, Ht(j, i) = H_ij = g_iᵀ S_·j (n × n): row i of H is column i.
+  Eigen::MatrixXd Ht;
 };
 
-/// Columns 0..cols−1 of N⁻¹ for the symmetric positive definite mk × mk matrix N (only its lower
-/// triangle is read; overwritten by its unit lower-triangular factor), by an unpivoted LDLᵀ factorisation and substitution —
-/// a fixed-capacity loop for these ≤ 7 × 7 systems, no allocation. False when a pivot is not
+/// Columns 0..cols−1 of N⁻¹ for the symmetric positive definite mk × mk matrix N (only its
+/// lower triangle is read; overwritten by its unit lower-triangular factor), by an unpivoted
+/// LDLᵀ factorisation and substitution — a fixed-capacity loop for these ≤ 7 × 7 systems, no
+/// allocation. False when a pivot is not
 /// above kMinPivotRatio × the largest (the subset's states are not fixed: unmonitorable).
 bool ldltInverseColumns(StateMatrix& N, int mk, int cols, double (&X)[kMaxStates][kMaxStates]) {
   double d[kMaxStates];
@@ -172,7 +174,7 @@ bool downdatedSubsetSolution(const Geometry& g, const AllInView& aiv, const Eige
                              const Eigen::VectorXd& c_acc, int i, SubsetSolution& out) {
   const int n = g.numSats(), m = g.numStates();
   double h = 0.0;
-  for (int a = 0; a < m; ++a) h += g.G(i, a) * aiv.S(a, i);  // not Ht(i, i): the same sum as the fallback test
+  for (int a = 0; a < m; ++a) h += g.G(i, a) * aiv.S(a, i);  // h_i = g_iᵀ S_·i, the leverage
   const double redundancy = 1.0 - h;
   if (!(redundancy >= kMinDowndateRedundancy)) return false;
   const double si[3] = {aiv.S(0, i), aiv.S(1, i), aiv.S(2, i)};
