@@ -33,6 +33,57 @@ double normalTail(double x) { return 0.5 * std::erfc(x / std::sqrt(2.0)); }
 
 namespace {
 
+/// Horner evaluation of c[0] + c[1] r + … + c[N−1] r^(N−1).
+template <std::size_t N>
+double horner(const double (&c)[N], double r) {
+  double v = c[N - 1];
+  for (std::size_t i = N - 1; i-- > 0;) v = v * r + c[i];
+  return v;
+}
+
+/// Cody (1969) on x = z/√2 ≥ 0: erf(x)/x for x ≤ 0.46875, else e^{x²}erfc(x) — coefficients
+/// of his three near-minimax rational approximations, lowest degree first.
+double codyErfOverX(double x2) {
+  static constexpr double a[5] = {3.20937758913846947e3, 3.77485237685302021e2, 1.13864154151050156e2,
+                                  3.16112374387056560e0, 1.85777706184603153e-1};
+  static constexpr double b[5] = {2.84423683343917062e3, 1.28261652607737228e3, 2.44024637934444173e2,
+                                  2.36012909523441209e1, 1.0};
+  return horner(a, x2) / horner(b, x2);
+}
+
+double codyScaledErfc(double x) {
+  static constexpr double c[9] = {1.23033935479799725e3, 2.05107837782607147e3, 1.71204761263407058e3,
+                                  8.81952221241769090e2, 2.98635138197400131e2, 6.61191906371416295e1,
+                                  8.88314979438837594e0, 5.64188496988670089e-1, 2.15311535474403846e-8};
+  static constexpr double d[9] = {1.23033935480374942e3, 3.43936767414372164e3, 4.36261909014324716e3,
+                                  3.29079923573345963e3, 1.62138957456669019e3, 5.37181101862009858e2,
+                                  1.17693950891312499e2, 1.57449261107098347e1, 1.0};
+  static constexpr double p[6] = {6.58749161529837803e-4, 1.60837851487422766e-2, 1.25781726111229246e-1,
+                                  3.60344899949804439e-1, 3.05326634961232344e-1, 1.63153871373020978e-2};
+  static constexpr double q[6] = {2.33520497626869185e-3, 6.05183413124413191e-2, 5.27905102951428412e-1,
+                                  1.87295284992346047e0,  2.56852019228982242e0,  1.0};
+  constexpr double kInvSqrtPi = 0.56418958354775628695;
+  if (x <= 4.0) return horner(c, x) / horner(d, x);
+  const double y = 1.0 / (x * x);
+  return (kInvSqrtPi - y * horner(p, y) / horner(q, y)) / x;
+}
+
+}  // namespace
+
+TailAndDensity normalTailAndDensity(double z) {
+  constexpr double kInvSqrt2Pi = 0.39894228040143267794, kHalfSqrt2Pi = 1.25331413731550025121;
+  constexpr double kInvSqrt2 = 0.70710678118654752440;
+  const double zz = z * z, zz_err = std::fma(z, z, -zz);  // z² = zz + zz_err exactly
+  const double e = std::exp(-0.5 * zz) * (1.0 - 0.5 * zz_err);
+  const double x = z * kInvSqrt2;
+  TailAndDensity out;
+  out.density = kInvSqrt2Pi * e;
+  out.tail = x <= 0.46875 ? 0.5 - 0.5 * x * codyErfOverX(x * x) : kHalfSqrt2Pi * out.density * codyScaledErfc(x);
+  return out;
+}
+
+namespace {
+
 /// Horner evaluation of c[0] + c[1] r + … + c[7] r⁷.
 double poly7(const double (&c)[8], double r) {
   double v = c[7];

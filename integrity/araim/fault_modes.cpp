@@ -19,7 +19,8 @@ constexpr int kMinEnumeratedEvents = 2;
 constexpr int kMaxEvents = 256;
 
 struct Event {
-  std::vector<int> removes;  ///< satellite indices, ascending
+  int satellite = -1;        ///< a satellite fault: its index (no list to allocate)
+  std::vector<int> removes;  ///< a constellation fault: its satellites' indices, ascending
   double p = 0.0;
 };
 
@@ -45,18 +46,15 @@ int nFaultMax(const std::vector<double>& p, double p_thres) {
   return r;
 }
 
-double noFault(const std::vector<Event>& events) {
+/// ln ∏(1 − p_e): P(no event) is its exponential, P(at least one event) −expm1 of it (without the
+/// cancellation of 1 − a number near 1).
+double logNoFault(const std::vector<Event>& events) {
   double log_nf = 0.0;
   for (const Event& e : events) log_nf += std::log1p(-e.p);
-  return std::exp(log_nf);
+  return log_nf;
 }
 
-/// P(at least one event) = 1 − ∏(1 − p_e), without the cancellation of 1 − (a number near 1).
-double anyFault(const std::vector<Event>& events) {
-  double log_nf = 0.0;
-  for (const Event& e : events) log_nf += std::log1p(-e.p);
-  return -std::expm1(log_nf);
-}
+double noFault(const std::vector<Event>& events) { return std::exp(logNoFault(events)); }
 
 /// Calls visit(indices, prior, event_prior) for every combination of exactly k events with
 /// nonzero probability, in lexicographic order of the event indices (MAAST's order); the
@@ -92,13 +90,25 @@ Combination makeCombination(const std::vector<Event>& events, const int* pick, i
   Combination c;
   c.prior = prior;
   c.event_prior = event_prior;
+  std::size_t count = 0;
+  for (int i = 0; i < k; ++i) {
+    const Event& e = events[static_cast<std::size_t>(pick[i])];
+    count += e.satellite >= 0 ? 1 : e.removes.size();
+  }
+  c.removed.reserve(count);
   for (int i = 0; i < k; ++i) {
     const Event& e = events[static_cast<std::size_t>(pick[i])];
     c.events[static_cast<std::size_t>(c.n_events++)] = pick[i];
-    c.removed.insert(c.removed.end(), e.removes.begin(), e.removes.end());
+    if (e.satellite >= 0) {
+      c.removed.push_back(e.satellite);
+    } else {
+      c.removed.insert(c.removed.end(), e.removes.begin(), e.removes.end());
+    }
   }
-  std::sort(c.removed.begin(), c.removed.end());
-  c.removed.erase(std::unique(c.removed.begin(), c.removed.end()), c.removed.end());
+  if (k > 1) {  // one event's satellites are already ascending and distinct
+    std::sort(c.removed.begin(), c.removed.end());
+    c.removed.erase(std::unique(c.removed.begin(), c.removed.end()), c.removed.end());
+  }
   return c;
 }
 
@@ -168,14 +178,31 @@ double selectUntilThreshold(std::vector<Combination>& combos, double p_any, cons
   return std::max(0.0, p_nm);
 }
 
+/// An upper bound on the prior of any combination of k events: p_nf times the k largest
+/// p_e/(1 − p_e), inflated by 1e-12 over the products' round-off.
+double largestPriorOf(const std::vector<Event>& events, int k, double p_nf) {
+  std::array<double, kMaxEnumeratedEvents> top{};  // descending
+  for (const Event& e : events) {
+    double u = e.p / (1.0 - e.p);
+    for (int i = 0; i < k; ++i) {
+      if (u > top[static_cast<std::size_t>(i)]) std::swap(u, top[static_cast<std::size_t>(i)]);
+    }
+  }
+  double bound = p_nf * (1.0 + 1e-12);
+  for (int i = 0; i < k; ++i) bound *= top[static_cast<std::size_t>(i)];
+  return bound;
+}
+
 /// The reference selection when the monitored-always combinations (prior > PHMI) alone leave
 /// P_nm ≤ P_THRES — the usual case with LPV-200 ISMs: then the loop adds nothing, and only those
 /// combinations are built. Returns false (and leaves `combos` empty) when more are needed.
-bool selectLargeOnly(const std::vector<Event>& events, int depth, double p_any, const FaultModeOptions& o,
+bool selectLargeOnly(const std::vector<Event>& events, int depth, double p_nf, double p_any, const FaultModeOptions& o,
                      std::vector<Combination>& combos, double& p_nm) {
-  const double p_nf = noFault(events);
   double p = p_any;
+  combos.reserve(events.size());
   for (int k = 1; k <= depth; ++k) {
+    // No combination of k events can exceed PHMI: none to visit.
+    if (largestPriorOf(events, k, p_nf) <= o.phmi) continue;
     forEachCombination(events, k, p_nf, [&](const int* pick, int kk, double prior, double event_prior) {
       if (prior <= o.phmi) return;
       p -= prior;
@@ -192,9 +219,11 @@ bool selectLargeOnly(const std::vector<Event>& events, int depth, double p_any, 
 
 /// Merges combinations by removed set; fewest removed satellites first, then lexicographic.
 std::vector<FaultMode> mergeByRemovedSet(std::vector<Combination>& combos) {
-  std::stable_sort(combos.begin(), combos.end(), [](const Combination& a, const Combination& b) {
+  const auto before = [](const Combination& a, const Combination& b) {
     return a.removed.size() != b.removed.size() ? a.removed.size() < b.removed.size() : a.removed < b.removed;
-  });
+  };
+  // The usual single events arrive in order already: a stable sort would leave them as they are.
+  if (!std::is_sorted(combos.begin(), combos.end(), before)) std::stable_sort(combos.begin(), combos.end(), before);
   std::vector<FaultMode> out;
   out.reserve(combos.size());
   for (Combination& c : combos) {
@@ -225,16 +254,18 @@ Events buildEvents(const std::vector<Constellation>& sats, const std::vector<dou
     throw std::invalid_argument("determineFaultModes: one P_const per constellation");
   }
   Events ev;
-  for (std::size_t i = 0; i < sats.size(); ++i) ev.all.push_back({{static_cast<int>(i)}, p_sat[i]});
+  ev.all.reserve(sats.size() + static_cast<std::size_t>(kNumConstellations));
+  for (std::size_t i = 0; i < sats.size(); ++i) ev.all.push_back({static_cast<int>(i), {}, p_sat[i]});
   ev.first_const = static_cast<int>(ev.all.size());
   for (Constellation c : kAllConstellations) {
     Event e;
+    e.removes.reserve(sats.size());
     for (std::size_t i = 0; i < sats.size(); ++i) {
       if (sats[i] == c) e.removes.push_back(static_cast<int>(i));
     }
     if (e.removes.empty()) continue;
     e.p = p_const[static_cast<std::size_t>(c)];
-    ev.all.push_back(e);
+    ev.all.push_back(std::move(e));
   }
   for (const Event& e : ev.all) {
     if (!(e.p >= 0.0 && e.p < 1.0)) throw std::invalid_argument("determineFaultModes: a prior outside [0, 1)");
@@ -305,13 +336,14 @@ FaultModeSet determineFaultModes(const std::vector<Constellation>& sats, const s
                          : out.n_fault_max;
   std::vector<Combination> combos;
   // Consolidation can lift a constellation mode above PHMI, so the shortcut needs it off.
-  if (adds && !(o.fc_thres > 0.0) && selectLargeOnly(ev.all, depth, anyFault(ev.all), o, combos, out.p_not_monitored)) {
+  const double log_nf = logNoFault(ev.all), p_nf = std::exp(log_nf), p_any = -std::expm1(log_nf);
+  if (adds && !(o.fc_thres > 0.0) && selectLargeOnly(ev.all, depth, p_nf, p_any, o, combos, out.p_not_monitored)) {
     out.modes = mergeByRemovedSet(combos);
     return out;
   }
-  combos = combinationsUpTo(ev.all, depth, noFault(ev.all));
+  combos = combinationsUpTo(ev.all, depth, p_nf);
   consolidateIntoConstellations(combos, ev.first_const, o.fc_thres);
-  out.p_not_monitored = adds ? selectUntilThreshold(combos, anyFault(ev.all), o)
+  out.p_not_monitored = adds ? selectUntilThreshold(combos, p_any, o)
                              : probabilityOfAtLeast(p, out.n_fault_max + 1);
   out.modes = mergeByRemovedSet(combos);
   return out;

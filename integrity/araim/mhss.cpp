@@ -20,16 +20,29 @@ using StateMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMa
 /// Q̃(x): the normal tail, 1 for negative arguments (conservative when PL < T + b).
 double modifiedTail(double x) { return x < 0.0 ? 1.0 : normalTail(x); }
 
+/// Largest leverage h_i = w_i g_iᵀ N⁻¹ g_i, as 1 − h_i, for which a single-satellite subset is
+/// taken from the rank-one down-date: N_k = N − w g gᵀ ⪰ (1 − h_i) N, so below this the
+/// down-dated solution would lose more than three digits to the all-in-view one's and the
+/// subset is solved from its own normal matrix instead (which also decides unmonitorable).
+constexpr double kMinDowndateRedundancy = 1e-3;
+
 struct AllInView {
   Eigen::MatrixXd A;  ///< Gᵀ W (m × n)
-  StateMatrix N;      ///< Gᵀ W G
+  StateMatrix N;      ///< Gᵀ W G, lower triangle only (all the LDLᵀ reads); the upper is zero
+  /// For the rank-one down-dates (AraimConfig::subset_downdate): P = N⁻¹ and S = P Gᵀ W with
+  /// every state's row (m × n); empty when not used.
+  StateMatrix P;
+  Eigen::MatrixXd S;
+  /// The hat matrix transposed, Ht(j, i) = H_ij = g_iᵀ S_·j (n × n): row i of H is column i.
+  Eigen::MatrixXd Ht;
 };
 
-/// Columns 0..2 of N⁻¹ for the symmetric positive definite mk × mk matrix N (overwritten by
-/// its unit lower-triangular factor), by an unpivoted LDLᵀ factorisation and substitution —
-/// a fixed-capacity loop for these ≤ 7 × 7 systems, no allocation. False when a pivot is not
+/// Columns 0..cols−1 of N⁻¹ for the symmetric positive definite mk × mk matrix N (only its
+/// lower triangle is read; overwritten by its unit lower-triangular factor), by an unpivoted
+/// LDLᵀ factorisation and substitution — a fixed-capacity loop for these ≤ 7 × 7 systems, no
+/// allocation. False when a pivot is not
 /// above kMinPivotRatio × the largest (the subset's states are not fixed: unmonitorable).
-bool firstThreeInverseColumns(StateMatrix& N, int mk, double (&X)[kMaxStates][3]) {
+bool ldltInverseColumns(StateMatrix& N, int mk, int cols, double (&X)[kMaxStates][kMaxStates]) {
   double d[kMaxStates];
   double d_max = 0.0;
   for (int j = 0; j < mk; ++j) {
@@ -47,7 +60,7 @@ bool firstThreeInverseColumns(StateMatrix& N, int mk, double (&X)[kMaxStates][3]
   for (int j = 0; j < mk; ++j) {
     if (!(d[j] > kMinPivotRatio * d_max)) return false;
   }
-  for (int q = 0; q < 3; ++q) {
+  for (int q = 0; q < cols; ++q) {
     double y[kMaxStates];
     for (int i = 0; i < mk; ++i) {  // L y = e_q
       double v = i == q ? 1.0 : 0.0;
@@ -87,15 +100,15 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
   for (int i : removed) {
     const double w = 1.0 / (g.sigma_int[i] * g.sigma_int[i]);
     for (int a = 0; a < m; ++a) {  // rank-one down-date N_k = N − w g gᵀ
-      for (int b = 0; b < m; ++b) Nk(a, b) -= w * g.G(i, a) * g.G(i, b);
+      for (int b = 0; b <= a; ++b) Nk(a, b) -= w * g.G(i, a) * g.G(i, b);
     }
   }
   StateMatrix Nr(mk, mk);
   for (int a = 0; a < mk; ++a) {
     for (int b = 0; b < mk; ++b) Nr(a, b) = Nk(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
   }
-  double X[kMaxStates][3];  // columns q of N_k⁻¹
-  if (!firstThreeInverseColumns(Nr, mk, X)) return false;
+  double X[kMaxStates][kMaxStates];  // columns q of N_k⁻¹
+  if (!ldltInverseColumns(Nr, mk, 3, X)) return false;
   out.S = Eigen::MatrixXd::Zero(3, n);
   for (int i = 0, r = 0; i < n; ++i) {
     if (r < static_cast<int>(removed.size()) && removed[static_cast<std::size_t>(r)] == i) {
@@ -109,6 +122,82 @@ bool subsetSolution(const Geometry& g, const AllInView& aiv, const std::vector<i
     }
   }
   for (int q = 0; q < 3; ++q) out.sigma[q] = std::sqrt(X[q][q]);
+  return std::isfinite(out.sigma[0]) && std::isfinite(out.sigma[2]);
+}
+
+/// The all-in-view covariance P = N⁻¹ and the projection S = P Gᵀ W with every state's row,
+/// for the rank-one down-dates. False (down-dates unused) when N is singular.
+bool setAllInViewCovariance(AllInView& aiv, const Geometry& g) {
+  const int m = g.numStates(), n = g.numSats();
+  StateMatrix L = aiv.N;
+  double X[kMaxStates][kMaxStates];
+  if (!ldltInverseColumns(L, m, m, X)) return false;
+  aiv.P.resize(m, m);
+  for (int a = 0; a < m; ++a) {
+    for (int b = 0; b < m; ++b) aiv.P(a, b) = X[a][b];
+  }
+  aiv.S.resize(m, n);
+  for (int i = 0; i < n; ++i) {
+    for (int a = 0; a < m; ++a) {
+      double v = 0.0;
+      for (int b = 0; b < m; ++b) v += aiv.P(a, b) * aiv.A(b, i);
+      aiv.S(a, i) = v;
+    }
+  }
+  aiv.Ht.noalias() = aiv.S.transpose() * g.G.transpose();
+  return true;
+}
+
+/// σ_ss,q, b_q and σ_acc,q of a subset from its projection S^(k) (rows 0..2) and S^(0) (ADD Eq. 21).
+void setSubsetErrors(SubsetSolution& s, const Eigen::MatrixXd& S0, const Geometry& g, const Eigen::VectorXd& c_acc) {
+  for (int q = 0; q < 3; ++q) {
+    double ss = 0.0, b = 0.0, acc = 0.0;
+    for (int i = 0; i < g.numSats(); ++i) {
+      const double sk = s.S(q, i), d = sk - S0(q, i);
+      ss += d * d * c_acc[i];  // ADD Eq. 21 (C_acc)
+      b += std::abs(sk) * g.bnom[i];
+      acc += sk * sk * c_acc[i];
+    }
+    s.sigma_ss[q] = std::sqrt(ss);
+    s.bias[q] = b;
+    s.sigma_acc[q] = std::sqrt(acc);
+  }
+}
+
+/// The subset without satellite i from the all-in-view solution by a rank-one down-date
+/// (Sherman–Morrison on N_k = N − w_i g_i g_iᵀ): with H_ij = g_iᵀ S_·j (the hat matrix, h_i = H_ii),
+///   S^(k)_qj = S_qj + S_qi H_ij / (1 − h_i) for j ≠ i, 0 for j = i;
+///   σ_q^(k)2 = P_qq + S_qi² / (w_i (1 − h_i));
+/// and, in the same pass, setSubsetErrors' sums. False when 1 − h_i < kMinDowndateRedundancy:
+/// the caller solves the subset from its own normal matrix.
+bool downdatedSubsetSolution(const Geometry& g, const AllInView& aiv, const Eigen::MatrixXd& S0,
+                             const Eigen::VectorXd& c_acc, int i, SubsetSolution& out) {
+  const int n = g.numSats(), m = g.numStates();
+  double h = 0.0;
+  for (int a = 0; a < m; ++a) h += g.G(i, a) * aiv.S(a, i);  // h_i = g_iᵀ S_·i, the leverage
+  const double redundancy = 1.0 - h;
+  if (!(redundancy >= kMinDowndateRedundancy)) return false;
+  const double si[3] = {aiv.S(0, i), aiv.S(1, i), aiv.S(2, i)};
+  double ss[3] = {0, 0, 0}, b[3] = {0, 0, 0}, acc[3] = {0, 0, 0};
+  out.S.resize(3, n);
+  const double* h_i = aiv.Ht.col(i).data();  // row i of the hat matrix
+  for (int j = 0; j < n; ++j) {
+    const double f = j == i ? 0.0 : h_i[j] / redundancy;
+    for (int q = 0; q < 3; ++q) {
+      const double sk = j == i ? 0.0 : aiv.S(q, j) + si[q] * f, d = sk - S0(q, j);
+      out.S(q, j) = sk;
+      ss[q] += d * d * c_acc[j];
+      b[q] += std::abs(sk) * g.bnom[j];
+      acc[q] += sk * sk * c_acc[j];
+    }
+  }
+  const double c = g.sigma_int[i] * g.sigma_int[i] / redundancy;  // 1 / (w_i (1 − h_i))
+  for (int q = 0; q < 3; ++q) {
+    out.sigma[q] = std::sqrt(aiv.P(q, q) + si[q] * si[q] * c);
+    out.sigma_ss[q] = std::sqrt(ss[q]);
+    out.bias[q] = b[q];
+    out.sigma_acc[q] = std::sqrt(acc[q]);
+  }
   return std::isfinite(out.sigma[0]) && std::isfinite(out.sigma[2]);
 }
 
@@ -132,21 +221,24 @@ std::optional<std::string> geometryShortfall(const Geometry& g) {
 
 AllInView allInView(const Geometry& g) {
   AllInView aiv;
-  const Eigen::VectorXd w = g.sigma_int.array().square().inverse();
-  aiv.A = g.G.transpose() * w.asDiagonal();
   const int m = g.numStates();
+  aiv.A.resize(m, g.numSats());
+  for (int i = 0; i < g.numSats(); ++i) {
+    const double w = 1.0 / (g.sigma_int[i] * g.sigma_int[i]);
+    for (int a = 0; a < m; ++a) aiv.A(a, i) = g.G(i, a) * w;
+  }
   aiv.N = StateMatrix::Zero(m, m);
   for (int i = 0; i < g.numSats(); ++i) {  // N = Σ w_i g_i g_iᵀ, without Eigen's general product kernel
     for (int a = 0; a < m; ++a) {
-      for (int b = 0; b < m; ++b) aiv.N(a, b) += aiv.A(a, i) * g.G(i, b);
+      for (int b = 0; b <= a; ++b) aiv.N(a, b) += aiv.A(a, i) * g.G(i, b);
     }
   }
   return aiv;
 }
 
 /// The all-in-view projection, sigmas, nominal biases and vertical accuracy sigma.
-void setAllInViewErrors(AraimResult& out, const Geometry& g, const SubsetSolution& all, const Eigen::VectorXd& c_acc) {
-  out.S0 = all.S;
+void setAllInViewErrors(AraimResult& out, const Geometry& g, SubsetSolution&& all, const Eigen::VectorXd& c_acc) {
+  out.S0 = std::move(all.S);
   for (int q = 0; q < 3; ++q) {
     out.sigma0[q] = all.sigma[q];
     out.bias0[q] = out.S0.row(q).cwiseAbs().dot(g.bnom);  // b_q^(0) = Σ|S_q,i| b_nom,i
@@ -160,6 +252,8 @@ void setAllInViewErrors(AraimResult& out, const Geometry& g, const SubsetSolutio
 FaultModeSet araimFaultModes(const Geometry& g, const ErrorModel& model, const AraimConfig& cfg) {
   std::vector<Constellation> cons;
   std::vector<double> p_sat;
+  cons.reserve(g.sats.size());
+  p_sat.reserve(g.sats.size());
   for (const SatId& s : g.sats) {
     cons.push_back(s.constellation);
     p_sat.push_back(model.of(s.constellation).psat);
@@ -188,22 +282,16 @@ void monitorFaultModes(AraimResult& out, const Geometry& g, const AllInView& aiv
     s.removed = std::move(mode.removed);
     s.prior = mode.prior;
     s.event_prior = mode.event_prior;
-    if (!subsetSolution(g, aiv, s.removed, s)) {
-      out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
-      ++out.unmonitorable_modes;
-      continue;
-    }
-    for (int q = 0; q < 3; ++q) {
-      double ss = 0.0, b = 0.0, acc = 0.0;
-      for (int i = 0; i < g.numSats(); ++i) {
-        const double sk = s.S(q, i), d = sk - out.S0(q, i);
-        ss += d * d * c_acc[i];  // ADD Eq. 21 (C_acc)
-        b += std::abs(sk) * g.bnom[i];
-        acc += sk * sk * c_acc[i];
+    const bool downdated = s.removed.size() == 1 && aiv.S.size() > 0 &&
+                           downdatedSubsetSolution(g, aiv, out.S0, c_acc, s.removed[0], s);
+    out.downdated_modes += downdated ? 1 : 0;
+    if (!downdated) {
+      if (!subsetSolution(g, aiv, s.removed, s)) {
+        out.p_not_monitored += mode.prior;  // unmonitorable: its whole prior is integrity risk
+        ++out.unmonitorable_modes;
+        continue;
       }
-      s.sigma_ss[q] = std::sqrt(ss);
-      s.bias[q] = b;
-      s.sigma_acc[q] = std::sqrt(acc);
+      setSubsetErrors(s, out.S0, g, c_acc);
     }
     out.subsets.push_back(std::move(s));
   }
@@ -283,7 +371,6 @@ void judgeAvailability(AraimResult& out, const AraimConfig& cfg) {
 }  // namespace
 
 RiskAndSlope integrityRiskAndSlope(const std::vector<RiskTerm>& terms, double pl) {
-  constexpr double kInvSqrt2Pi = 0.39894228040143267794;
   RiskAndSlope out;
   for (const RiskTerm& t : terms) {
     const double z = (pl - t.threshold - t.bias) / t.sigma;
@@ -291,8 +378,9 @@ RiskAndSlope integrityRiskAndSlope(const std::vector<RiskTerm>& terms, double pl
       out.risk += t.prior;  // Q̃ = 1, flat
       continue;
     }
-    out.risk += t.prior * normalTail(z);
-    out.slope -= t.prior * kInvSqrt2Pi * std::exp(-0.5 * z * z) / t.sigma;
+    const TailAndDensity q = normalTailAndDensity(z);  // one exponential for both
+    out.risk += t.prior * q.tail;
+    out.slope -= t.prior * q.density / t.sigma;
   }
   return out;
 }
@@ -358,14 +446,17 @@ AraimResult araimLevelsOverModes(const Geometry& g, FaultModeSet modes, const Ar
     out.reason = *why;
     return out;
   }
-  const AllInView aiv = allInView(g);
+  AllInView aiv = allInView(g);
   SubsetSolution all;
-  if (!subsetSolution(g, aiv, {}, all)) {
+  if (cfg.subset_downdate && !modes.modes.empty() && setAllInViewCovariance(aiv, g)) {
+    all.S = aiv.S.topRows(3);  // the all-in-view solution is the covariance's first three rows
+    for (int q = 0; q < 3; ++q) all.sigma[q] = std::sqrt(aiv.P(q, q));
+  } else if (!subsetSolution(g, aiv, {}, all)) {
     out.reason = "singular geometry: the satellites do not fix position and clocks";
     return out;
   }
   const Eigen::VectorXd c_acc = g.sigma_acc.array().square();
-  setAllInViewErrors(out, g, all, c_acc);
+  setAllInViewErrors(out, g, std::move(all), c_acc);
   monitorFaultModes(out, g, aiv, std::move(modes), c_acc);
   setThresholds(out, cfg.requirements);
   setEffectiveMonitorThreshold(out, cfg);

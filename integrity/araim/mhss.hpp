@@ -45,6 +45,11 @@ struct AraimConfig {
   /// off by default: with two constellations, the other one's fault cannot be monitored after
   /// one is excluded, so that outcome has no PL unless P_const is within P_THRES).
   bool exclude_constellations = false;
+  /// Single-satellite subsets from the all-in-view solution by a rank-one down-date
+  /// (Sherman–Morrison, docs/method.md §4.2), falling back to the subset's own normal matrix
+  /// when the satellite's redundancy 1 − h_i is below 1e-3. false: every subset from its own
+  /// normal matrix (the reference the down-date is tested against).
+  bool subset_downdate = true;
 };
 
 /// \brief One monitored fault mode with its subset solution.
@@ -80,6 +85,7 @@ struct AraimResult {
   double sigma_acc_v_m = 0;  ///< √(S⁰ C_acc S⁰ᵀ)_UU
   int fault_modes = 0;       ///< monitored (and monitorable) fault modes, fault-free excluded
   int unmonitorable_modes = 0;  ///< selected modes whose subset is singular (prior added to P_not_monitored)
+  int downdated_modes = 0;  ///< monitored modes solved by the rank-one down-date (AraimConfig::subset_downdate)
   int n_fault_max = 0;
   double p_not_monitored = 0;
   /// Share ρ of the integrity budget this outcome was solved with: 1 for detection only,

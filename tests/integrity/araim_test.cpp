@@ -274,6 +274,97 @@ TEST(AraimPl, SolvedLevelSatisfiesTheRiskEquationAndBeatsEqualAllocation) {
   EXPECT_GE(computed, 55);
 }
 
+/// |a − b| ≤ rel·max(|a|, |b|, 1e-3 m): relative, with a floor for values near zero.
+void expectRelNear(double a, double b, double rel, const std::string& what) {
+  EXPECT_LE(std::abs(a - b), rel * std::max({std::abs(a), std::abs(b), 1e-3})) << what << ": " << a << " vs " << b;
+}
+
+/// Everything the fast path feeds the PL: per-mode σ, σ_ss, bias, thresholds and the levels.
+void expectSameLevels(const AraimResult& fast, const AraimResult& full, const std::string& tag) {
+  ASSERT_EQ(fast.pl_computed, full.pl_computed) << tag;
+  ASSERT_EQ(fast.fault_modes, full.fault_modes) << tag;
+  ASSERT_EQ(fast.unmonitorable_modes, full.unmonitorable_modes) << tag;
+  for (std::size_t k = 0; k < fast.subsets.size(); ++k) {
+    const SubsetSolution &a = fast.subsets[k], &b = full.subsets[k];
+    ASSERT_EQ(a.removed, b.removed) << tag;
+    for (int q = 0; q < 3; ++q) {
+      expectRelNear(a.sigma[q], b.sigma[q], 1e-11, tag + " sigma");
+      expectRelNear(a.sigma_ss[q], b.sigma_ss[q], 1e-10, tag + " sigma_ss");
+      expectRelNear(a.bias[q], b.bias[q], 1e-11, tag + " bias");
+      expectRelNear(a.sigma_acc[q], b.sigma_acc[q], 1e-11, tag + " sigma_acc");
+    }
+    EXPECT_LE((a.S - b.S).cwiseAbs().maxCoeff(), 1e-11 * b.S.cwiseAbs().maxCoeff()) << tag;
+  }
+  if (!full.pl_computed) return;
+  expectRelNear(fast.hpl_m, full.hpl_m, 1e-9, tag + " HPL");
+  expectRelNear(fast.vpl_m, full.vpl_m, 1e-9, tag + " VPL");
+  expectRelNear(fast.emt_m, full.emt_m, 1e-9, tag + " EMT");
+}
+
+TEST(AraimPl, RankOneDowndatesMatchTheSubsetsOwnNormalMatricesOnRandomGeometries) {
+  // GIVEN random GPS + Galileo skies, each also thinned at random down to m + 2 satellites (weak
+  // geometries, high leverages), under the default rule and joint_events
+  std::mt19937 rng(41);
+  int downdated = 0, compared = 0, fallbacks = 0;
+  for (const Geometry& sky : randomAlmanacGeometries(150, 17)) {
+    Geometry g = sky;
+    for (int thin = 0; thin < 3; ++thin) {
+      for (const FaultModeRule rule : {FaultModeRule::kAddsUntilThreshold, FaultModeRule::kJointEvents}) {
+        AraimConfig fast_cfg, full_cfg;
+        fast_cfg.rule = full_cfg.rule = rule;
+        full_cfg.subset_downdate = false;
+        // WHEN the subsets come from the down-date and from their own normal matrices
+        const AraimResult fast = araimProtectionLevels(g, ErrorModel{}, fast_cfg);
+        const AraimResult full = araimProtectionLevels(g, ErrorModel{}, full_cfg);
+        // THEN every input of the PL and the PLs agree to round-off
+        expectSameLevels(fast, full, "sats " + std::to_string(g.numSats()) + " thin " + std::to_string(thin));
+        EXPECT_EQ(full.downdated_modes, 0);
+        downdated += fast.downdated_modes;
+        for (const SubsetSolution& s : fast.subsets) fallbacks += s.removed.size() == 1 ? 1 : 0;
+        ++compared;
+      }
+      for (int k = 0; k < 4 && g.numSats() > g.numStates() + 2; ++k) {
+        g = g.without(std::uniform_int_distribution<int>(0, g.numSats() - 1)(rng));
+      }
+    }
+  }
+  fallbacks -= downdated;
+  std::printf("%d results compared, %d modes down-dated, %d single-satellite modes solved in full\n", compared,
+              downdated, fallbacks);
+  EXPECT_GT(downdated, 10000);
+}
+
+TEST(AraimPl, AHighLeverageSatelliteFallsBackToTheFullSubsetSolve) {
+  // GIVEN the ADD example with every up component equal (then the up column is half the sum of
+  // the two clock columns) except satellite 0's, plus a perturbation eps of the others: removing
+  // satellite 0 leaves the vertical fixed only by eps, its leverage h_0 → 1 as eps → 0
+  for (const double eps : {0.0, 1e-9, 1e-6, 1e-4, 1e-3, 1e-2, 0.1}) {
+    Geometry g = addExampleGeometry();
+    for (int i = 1; i < g.numSats(); ++i) g.G(i, 2) = -0.5 + eps * std::sin(3.0 * i);
+    g.G(0, 2) = -0.9;
+    AraimConfig fast_cfg, full_cfg;
+    full_cfg.subset_downdate = false;
+    // WHEN solved with and without the down-dates
+    const AraimResult fast = araimProtectionLevels(g, ismWith(1e-4, 1e-8), fast_cfg);
+    const AraimResult full = araimProtectionLevels(g, ismWith(1e-4, 1e-8), full_cfg);
+    // THEN both agree, and satellite 0's mode is down-dated only while 1 − h_0 ≥ 1e-3
+    expectSameLevels(fast, full, "eps " + std::to_string(eps));
+    const bool sat0_monitored = std::any_of(full.subsets.begin(), full.subsets.end(),
+                                            [](const SubsetSolution& s) { return s.removed == std::vector<int>{0}; });
+    const int singles = static_cast<int>(std::count_if(fast.subsets.begin(), fast.subsets.end(),
+                                                       [](const SubsetSolution& s) { return s.removed.size() == 1; }));
+    std::printf("eps %g: satellite 0's mode %s, %d of %d single-satellite modes down-dated\n", eps,
+                sat0_monitored ? "monitored" : "unmonitorable", fast.downdated_modes, singles);
+    const int solved_in_full = singles - fast.downdated_modes;
+    if (eps <= 1e-6 && sat0_monitored) {
+      EXPECT_GE(solved_in_full, 1);
+    }
+    if (eps >= 1e-2) {
+      EXPECT_EQ(solved_in_full, 0);
+    }
+  }
+}
+
 TEST(AraimPl, RemovingASatelliteNeverShrinksTheFaultFreeSigma) {
   for (const Geometry& g : randomAlmanacGeometries(10, 5)) {
     const AraimResult all = araimProtectionLevels(g, ErrorModel{}, AraimConfig{});
