@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// \brief The map frame's inverse projection tabulated over a planning box, and the ground
-/// height under a map point through it (docs/method.md §4.1, "Ground height in the map frame").
+/// height under a map point through it (docs/method.md §7.1, "Ground height in the map frame").
 ///
 /// PlaneFrame::toLatLon solves a geodesic direct problem per call (GeographicLib's azimuthal
 /// equidistant projection, Karney 2013): microseconds, called for every planner state to find
