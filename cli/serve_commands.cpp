@@ -124,6 +124,9 @@ void addServeCommands(CLI::App& app) {
                 "each udp:// input's socket receive buffer in bytes (default: the system's; capped by net.core.rmem_max, "
                 "the granted size said when smaller); kernel drops are input_dropped events and a metric")
       ->check(CLI::Range(planner::kMinReceiveBufferBytes, planner::kMaxReceiveBufferBytes));
+  c->add_option("--nats", o->nats_url,
+                "NATS server(s) set up by `skylane nats setup`: approvals go to the approve workers' queue, fixes to the track "
+                "workers, events come back from the event stream (docs/nats.md); without it everything runs in this process");
   c->add_flag("--quiet", *quiet, "no log lines on stderr");
   c->callback([o, quiet, timeout_s, inputs, udp_buffer] {
     o->limits.request_timeout = std::chrono::seconds(*timeout_s);

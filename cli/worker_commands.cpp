@@ -5,6 +5,7 @@
 #include "cli/zones_commands.hpp"
 #include "maps/parse_error.hpp"
 #include "maps/text_file.hpp"
+#include "planner/mission.hpp"
 #include "service/approval_bundle.hpp"
 #include "service/approve_worker.hpp"
 #include "service/nats_layout.hpp"
@@ -128,10 +129,19 @@ void runSetup(const NatsCli& n) {
             << nats::serverMappings(n.partitions);
 }
 
+/// The mission as `skylane approve` will read it (its `zonesets`, resolved by the approve
+/// worker, left out): a bad one is the client's error at once, not an invalid approval later.
+void checkMission(const std::string& path) {
+  nlohmann::json doc = maps::readJsonFile(path);
+  if (doc.is_object()) doc.erase("zonesets");
+  (void)planner::parseMission(doc, path, std::filesystem::path(path).parent_path().string());
+}
+
 /// Publishes an approval request; with --wait, its outcome (exit 0 approved, 1 rejected or failed, 2 invalid).
 void runApprove(const NatsCli& n) {
   requireId(n.op, "--operator");
   requireId(n.id, "--id");
+  checkMission(n.file);
   const service::ApprovalBundle b = service::packMission(n.file);
   auto c = connect(n.url, "skylane-approve");
   (void)c->publish(nats::approvalSubject(n.op, n.id), service::bundleText(b), "request." + n.op + "." + n.id);

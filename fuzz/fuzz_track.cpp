@@ -6,7 +6,8 @@
 /// - as an NMEA 0183 sentence (`parseNmeaSentence`) fed to one `NmeaEpochAssembler` with a
 ///   default date; every epoch it releases goes through `trackFixFromNmea`.
 /// Each must return or throw ParseError naming its source ("fuzz.jsonl:<line>",
-/// "fuzz.nmea:<line>", "fuzz.nmea epoch <n>").
+/// "fuzz.nmea:<line>", "fuzz.nmea epoch <n>"). The direct reading of plain lines
+/// (`parsePlainFixLine`) gives a fix only where the general one does, and the same fix.
 ///
 /// Every fix that parses: finite latitude and longitude within ±90° and ±180° (in radians), a
 /// finite height and time, its own source, both PLs or neither and each ≥ 0, every pseudorange
@@ -85,6 +86,19 @@ void checkNmeaFix(const planner::TrackFix& f, const std::string& source) {
 
 }  // namespace
 
+/// The direct reading of a plain line gives a fix only where the general one does, the same.
+void checkDirectReading(const std::string& line, const std::string& source, const std::optional<planner::TrackFix>& general) {
+  const std::optional<planner::TrackFix> direct = planner::parsePlainFixLine(line, source);
+  if (!direct) return;
+  SKYLANE_FUZZ_CHECK(general.has_value(), source + ": the direct reading gave a fix the general reading refuses");
+  const planner::TrackFix &a = *direct, &b = *general;
+  const bool same = a.flight == b.flight && a.time.week == b.time.week && a.time.sow == b.time.sow && a.lat_rad == b.lat_rad &&
+                    a.lon_rad == b.lon_rad && a.h_ell_m == b.h_ell_m && a.hpl_m == b.hpl_m && a.vpl_m == b.vpl_m &&
+                    a.baro_h_m == b.baro_h_m && a.mag_heading_rad == b.mag_heading_rad && a.pl_source == b.pl_source &&
+                    a.ranges.empty() && b.ranges.empty() && !b.ins && !b.imu;
+  SKYLANE_FUZZ_CHECK(same, source + ": the direct and the general reading give different fixes");
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   integrity::NmeaEpochAssembler assembler(integrity::NmeaDate{{0.0}, 2026, 11, 23});
@@ -101,11 +115,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   while (std::getline(in, line)) {
     ++n;
     const json doc = json::parse(line, nullptr, /*allow_exceptions=*/false);
+    const std::string json_source = "fuzz.jsonl:" + std::to_string(n);
+    std::optional<planner::TrackFix> general;
     if (!doc.is_discarded()) {
-      const std::string json_source = "fuzz.jsonl:" + std::to_string(n);
       fuzz::parseThenUse(json_source, [&] { return planner::parseTrackFixJson(doc, json_source); },
-                         [&](const planner::TrackFix& f) { checkJsonFix(f, json_source); });
+                         [&](const planner::TrackFix& f) {
+                           checkJsonFix(f, json_source);
+                           general = f;
+                         });
     }
+    checkDirectReading(line, json_source, general);
     const std::string nmea_source = "fuzz.nmea:" + std::to_string(n);
     fuzz::parseThenUse(nmea_source, [&] { return integrity::parseNmeaSentence(line, nmea_source); },
                        [&](const integrity::NmeaSentence& s) { fromEpoch(assembler.add(s)); });

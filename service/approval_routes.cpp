@@ -42,7 +42,7 @@ const std::map<std::string, std::string>& approvalFiles() {
 
 }  // namespace
 
-json ServiceImpl::resolveMission(const json& body, const Principal& who) {
+json ServiceImpl::resolveMission(const json& body, const Principal& who, std::vector<std::string>* follow) {
   if (!body.is_object()) throw BadRequest{"the request body: expected a mission (a JSON object)"};
   if (body.contains("zones")) throw BadRequest{"$.zones: the service reads no files a request names; give zone sets by id in \"zonesets\""};
   if (body.contains("terrain")) throw BadRequest{"$.terrain: the service reads no files a request names; give ground_amsl_m"};
@@ -68,6 +68,7 @@ json ServiceImpl::resolveMission(const json& body, const Principal& who) {
       version = std::stoi(v);
     }
     zones.push_back((files / z->set.versions[static_cast<std::size_t>(version - 1)].file).string());
+    if (follow) follow->push_back(ref.find('@') == std::string::npos ? natsZoneSetKey(z->set) : std::string());
   }
   m.erase("zonesets");
   m["zones"] = zones;
@@ -122,11 +123,13 @@ HttpResponse ServiceImpl::submitApproval(const HttpRequest& r, const Principal& 
   std::string name;
   try {
     const json body = maps::parseJsonText(r.body, "the request body");
-    const json mission = resolveMission(body, who);
+    std::vector<std::string> follow;
+    const json mission = resolveMission(body, who, &follow);
     name = mission.value("name", json()).is_string() ? mission["name"].get<std::string>() : std::string();
     fs::create_directories(dir);
     writeFileAtomically(dir / "mission.json", mission.dump(1) + "\n");
     (void)planner::loadMission((dir / "mission.json").string());  // what approve will read, checked now
+    if (nats) natsWriteMission(dir, mission, follow);
   } catch (const BadRequest& e) {
     return errorResponse(400, e.message);
   } catch (const std::exception& e) {
@@ -137,7 +140,15 @@ HttpResponse ServiceImpl::submitApproval(const HttpRequest& r, const Principal& 
   ApprovalState a;
   a.row = {id, who.owner(), name, "queued", nowUtc(), "approvals/" + id, "", ""};
   a.submitted = std::chrono::steady_clock::now();
-  if (!pool->submit({id, (dir / "mission.json").string(), dir.string()})) {
+  if (nats) {
+    try {
+      nats->requestApproval(who.owner(), id, (dir / "nats_mission.json").string());
+    } catch (const std::exception& e) {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+      return errorResponse(503, withoutFolder(std::string("NATS: ") + e.what(), files, "the service folder"));
+    }
+  } else if (!pool->submit({id, (dir / "mission.json").string(), dir.string()})) {
     ++metrics.approvals_refused_queue_full;
     std::error_code ec;
     fs::remove_all(dir, ec);
@@ -156,7 +167,17 @@ HttpResponse ServiceImpl::submitApproval(const HttpRequest& r, const Principal& 
 void ServiceImpl::queueApproval(ApprovalState& a) {
   const fs::path dir = files / a.row.dir;
   a.row.status = "queued";
-  if (!pool->submit({a.row.id, (dir / "mission.json").string(), dir.string()})) {
+  if (nats) {
+    // The workers may have finished it while the service was down; else it is asked again (a
+    // repeat within the queue's duplicate window is dropped, a worker never redoes a final one).
+    if (natsTakeOutcome(a)) return;
+    try {
+      nats->requestApproval(a.row.owner, a.row.id, (dir / (fs::exists(dir / "nats_mission.json") ? "nats_mission.json" : "mission.json")).string());
+    } catch (const std::exception& e) {
+      a.row.status = "failed";
+      a.row.error = withoutFolder(std::string("NATS: ") + e.what(), files, "the service folder");
+    }
+  } else if (!pool->submit({a.row.id, (dir / "mission.json").string(), dir.string()})) {
     a.row.status = "failed";
     a.row.error = "the approval queue was full when the service restarted";
   }

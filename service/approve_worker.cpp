@@ -37,8 +37,21 @@ std::string statusWord(int exit_code, bool has_report) {
   return "failed";
 }
 
+/// The approval's other outputs (what `skylane serve --nats` serves), each as `<key>.out.<name>`;
+/// one larger than a message may be is left out and said.
+void keepOutputs(const ApproveWorkerOptions& o, NatsClient& nats, const std::string& key, const fs::path& out) {
+  for (const std::string name : {"operational_intent.json", "mission.plan", "map.svg", "pl.svg"}) {
+    if (!fs::exists(out / name)) continue;
+    try {
+      nats.put(nats::kApprovalBucket, key + ".out." + name, maps::readTextFile((out / name).string()));
+    } catch (const NatsError& e) {
+      if (o.log) o.log(key + ": " + name + " not kept: " + e.what());
+    }
+  }
+}
+
 /// Puts the outcome (bundle and route first, the status last) and publishes the event.
-void keepOutcome(NatsClient& nats, const std::string& op, const std::string& id, ApprovalBundle& bundle, const fs::path& dir,
+void keepOutcome(const ApproveWorkerOptions& o, NatsClient& nats, const std::string& op, const std::string& id, ApprovalBundle& bundle, const fs::path& dir,
                  const ApprovalOutcome& out) {
   const std::string key = op + "." + id;
   const bool has_report = fs::exists(dir / "out" / "report.json");
@@ -46,6 +59,7 @@ void keepOutcome(NatsClient& nats, const std::string& op, const std::string& id,
     bundle.report = maps::readTextFile((dir / "out" / "report.json").string());
     nats.put(nats::kApprovalBucket, key + ".bundle", bundleText(bundle));
     if (fs::exists(dir / "out" / "route.geojson")) nats.put(nats::kApprovalBucket, key + ".route", maps::readTextFile((dir / "out" / "route.geojson").string()));
+    keepOutputs(o, nats, key, dir / "out");
   }
   const std::string status = statusWord(out.exit_code, has_report);
   json st = {{"status", status}, {"operator", op}, {"id", id}};
@@ -126,7 +140,7 @@ void handleRequest(const ApproveWorkerOptions& o, NatsClient& nats, const NatsMe
   }
   o.log(op + "/" + id + ": approving");
   const ApprovalOutcome out = runApproval(o, m, dir);
-  keepOutcome(nats, op, id, bundle, dir, out);
+  keepOutcome(o, nats, op, id, bundle, dir, out);
   const std::string word = statusWord(out.exit_code, fs::exists(dir / "out" / "report.json"));
   o.log(op + "/" + id + ": " + word + (out.message.empty() ? "" : " — " + out.message));
   (word == "approved" ? c.approved : word == "rejected" ? c.rejected : word == "invalid" ? c.invalid : c.failed)++;

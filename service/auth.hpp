@@ -12,7 +12,9 @@
 #include <cstddef>
 #include <map>
 #include <optional>
+#include <algorithm>
 #include <string>
+#include <vector>
 #include <unordered_map>
 
 namespace skylane::service {
@@ -35,6 +37,14 @@ class TokenTable {
   /// \brief The caller of an `Authorization` header value ("Bearer <token>"), if known.
   [[nodiscard]] std::optional<Principal> find(const std::string& authorization) const;
   [[nodiscard]] std::size_t size() const { return by_digest_.size(); }
+  /// \brief The operators the tokens stand for (each once).
+  [[nodiscard]] std::vector<std::string> operators() const {
+    std::vector<std::string> out;
+    for (const auto& [digest, p] : by_digest_) {
+      if (!p.authority && std::find(out.begin(), out.end(), p.operator_id) == out.end()) out.push_back(p.operator_id);
+    }
+    return out;
+  }
   /// \brief Adds one (tests).
   void add(const std::string& sha256_hex, Principal p) { by_digest_[sha256_hex] = std::move(p); }
 

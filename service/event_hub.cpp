@@ -15,33 +15,39 @@ void EventHub::write(const planner::TrackEvent& event, const std::string& json_l
 
 void EventHub::deliver(std::vector<Subscriber>& list, const HubEvent& e, const std::string& text) {
   list.erase(std::remove_if(list.begin(), list.end(),
-                            [&](Subscriber& s) { return s.stream->closed() || ((!s.wants || s.wants(e.flight)) && !s.stream->push(text)); }),
+                            [&](Subscriber& s) {
+                              if (s.stream->closed()) return true;
+                              const bool had = e.seq > 0 && e.seq <= s.after;  // in the stream's backlog already
+                              return !had && (!s.wants || s.wants(e.flight)) && !s.stream->push(text);
+                            }),
              list.end());
 }
 
 void EventHub::flush() {
   std::vector<HubEvent> batch = std::move(pending_);
   pending_.clear();
-  for (const HubEvent& e : batch) {
-    for (const auto& observe : observers) observe(e);
-    const auto it = by_flight_.find(e.flight);
-    if (it == by_flight_.end() && filtered_.empty()) continue;
-    const std::string text = sseMessage(e);
-    if (it != by_flight_.end()) {
-      deliver(it->second, e, text);
-      if (it->second.empty()) by_flight_.erase(it);
-    }
-    deliver(filtered_, e, text);
-  }
+  for (const HubEvent& e : batch) publish(e);
 }
 
-void EventHub::subscribe(std::shared_ptr<EventStream> stream, const std::string& flight, Filter wants) {
+void EventHub::publish(const HubEvent& e) {
+  for (const auto& observe : observers) observe(e);
+  const auto it = by_flight_.find(e.flight);
+  if (it == by_flight_.end() && filtered_.empty()) return;
+  const std::string text = sseMessage(e);
+  if (it != by_flight_.end()) {
+    deliver(it->second, e, text);
+    if (it->second.empty()) by_flight_.erase(it);
+  }
+  deliver(filtered_, e, text);
+}
+
+void EventHub::subscribe(std::shared_ptr<EventStream> stream, const std::string& flight, Filter wants, std::int64_t after) {
   // A closed stream is dropped at the next event or keep-alive (not from its close callback, which
   // may run inside the loops here).
   if (flight.empty()) {
-    filtered_.push_back({std::move(stream), std::move(wants)});
+    filtered_.push_back({std::move(stream), std::move(wants), after});
   } else {
-    by_flight_[flight].push_back({std::move(stream), nullptr});
+    by_flight_[flight].push_back({std::move(stream), nullptr, after});
   }
 }
 

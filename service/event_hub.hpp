@@ -36,11 +36,16 @@ class EventHub final : public planner::EventSink {
   void write(const planner::TrackEvent& event, const std::string& json_line) override;
   /// \brief The batch is committed: its events go to the subscribers and the observers.
   void flush() override;
+  /// \brief An event committed elsewhere (the NATS event stream, its sequence the stream's) goes
+  /// to the subscribers and the observers.
+  void publish(const HubEvent& e);
 
   /// \brief A stream gets the events of one flight (`flight`), or, with `flight` empty, those
   /// whose flight `wants` accepts (all of an operator's flights).
   using Filter = std::function<bool(const std::string& flight)>;
-  void subscribe(std::shared_ptr<EventStream> stream, const std::string& flight, Filter wants);
+  /// `after`: the last sequence the stream has had already (its backlog); events up to it are
+  /// not sent again.
+  void subscribe(std::shared_ptr<EventStream> stream, const std::string& flight, Filter wants, std::int64_t after = 0);
   /// \brief Sends a comment line to every stream (keeps proxies and readers from timing out, and
   /// finds streams whose reader has gone).
   void keepAlive();
@@ -52,6 +57,7 @@ class EventHub final : public planner::EventSink {
   struct Subscriber {
     std::shared_ptr<EventStream> stream;
     Filter wants;
+    std::int64_t after = 0;
   };
   const planner::TrackStore& store_;
   std::vector<HubEvent> pending_;

@@ -38,6 +38,7 @@ HttpResponse ServiceImpl::flightsRoute(const HttpRequest& r, const Principal& wh
   if (part.empty()) return flightJson(f);
   if (part == "events") return eventStream(r, who, f.id);
   if (part == "route") {
+    if (nats) return natsRoute(f);
     HttpResponse res = jsonBody(200, session->tracker().routeGeoJson(f.id));
     res.content_type = "application/geo+json";
     return res;
@@ -63,7 +64,13 @@ HttpResponse ServiceImpl::startFlight(const HttpRequest& r, const Principal& who
   if (it->second.row.status != "approved") return errorResponse(409, "approval " + ap + " is " + it->second.row.status + ", not approved");
   const std::string id = newId("fl-");
   try {
-    session->addApprovalFile((files / it->second.row.dir / "report.json").string(), id);
+    if (nats) {
+      nats->startFlight(who.owner(), id, ap);
+    } else {
+      session->addApprovalFile((files / it->second.row.dir / "report.json").string(), id);
+    }
+  } catch (const NatsError& e) {
+    return errorResponse(503, std::string("NATS: ") + e.what());
   } catch (const std::exception& e) {
     return errorResponse(409, std::string("approval ") + ap + " cannot be tracked: " + e.what());
   }
@@ -78,8 +85,8 @@ HttpResponse ServiceImpl::startFlight(const HttpRequest& r, const Principal& who
 }
 
 nlohmann::json ServiceImpl::flightObject(const FlightRow& f) const {
-  const planner::FlightState& st = session->tracker().state(f.id);
-  nlohmann::json j = {{"id", f.id}, {"approval", f.approval}, {"created", f.created}, {"state", planner::flightStateJson(st)}};
+  nlohmann::json j = {{"id", f.id}, {"approval", f.approval}, {"created", f.created}};
+  j["state"] = nats ? natsFlightState(f) : planner::flightStateJson(session->tracker().state(f.id));
   if (const auto it = last_fix.find(f.id); it != last_fix.end()) j["last_fix"] = nlohmann::json::parse(it->second);
   return j;
 }
@@ -99,6 +106,7 @@ HttpResponse ServiceImpl::postFixes(const HttpRequest& r, const FlightRow& f) {
     return errorResponse(413, "a request of " + std::to_string(lines.size()) + " lines; at most " +
                                   std::to_string(options.max_fixes_per_request) + " fixes per request");
   }
+  if (nats) return natsPostFixes(f, std::move(lines));
   std::vector<HubEvent> mine;
   hub->observers.push_back([&mine](const HubEvent& e) { mine.push_back(e); });
   struct Unobserve {
@@ -148,8 +156,12 @@ HttpResponse ServiceImpl::eventStream(const HttpRequest& r, const Principal& who
   res.content_type = "text/event-stream";
   res.stream = std::make_shared<EventStream>();
   res.body = "retry: 1000\n\n";
-  // What the reader missed comes first, from the database; then the live events.
-  if (after >= 0) {
+  // What the reader missed comes first, from the database (or the NATS event stream); then the
+  // live events, none of them twice.
+  std::int64_t sent = std::max<std::int64_t>(after, 0);
+  if (after >= 0 && nats) {
+    if (auto bad = natsBacklog(who, flight, after, wants, res.body, sent)) return *bad;
+  } else if (after >= 0) {
     for (std::int64_t from = after;;) {
       const auto batch = session->store()->eventsAfter(from, 1000);
       for (const auto& e : batch) {
@@ -160,7 +172,7 @@ HttpResponse ServiceImpl::eventStream(const HttpRequest& r, const Principal& who
       if (res.body.size() > (64u << 20)) return errorResponse(413, "more than 64 MiB of events after " + last + "; resume from a later id");
     }
   }
-  hub->subscribe(res.stream, flight, wants);
+  hub->subscribe(res.stream, flight, wants, sent);
   return res;
 }
 

@@ -199,6 +199,23 @@ std::optional<NatsEntry> NatsClient::get(const std::string& bucket, const std::s
   return out;
 }
 
+std::vector<NatsEntry> NatsClient::history(const std::string& bucket, const std::string& key) {
+  kvEntryList list{};
+  const natsStatus s = kvStore_History(&list, impl_->bucket(bucket), key.c_str(), nullptr);
+  if (s == NATS_NOT_FOUND) return {};
+  check("history of " + bucket + "/" + key, s);
+  std::vector<NatsEntry> out;
+  for (int i = 0; i < list.Count; ++i) {
+    kvEntry* e = list.Entries[i];
+    if (kvEntry_Operation(e) != kvOp_Put) continue;
+    const void* value = kvEntry_Value(e);
+    out.push_back({value == nullptr ? std::string() : std::string(static_cast<const char*>(value), static_cast<std::size_t>(kvEntry_ValueLen(e))),
+                   kvEntry_Revision(e)});
+  }
+  kvEntryList_Destroy(&list);
+  return out;
+}
+
 std::uint64_t NatsClient::put(const std::string& bucket, const std::string& key, const std::string& value) {
   std::uint64_t rev = 0;
   check("put " + bucket + "/" + key, kvStore_Put(&rev, impl_->bucket(bucket), key.c_str(), value.data(), static_cast<int>(value.size())));
@@ -270,11 +287,15 @@ void addConsumer(jsCtx* js, const std::string& stream, jsConsumerConfig& cc) {
 
 }  // namespace
 
-std::unique_ptr<NatsPull> NatsClient::pullFrom(const std::string& stream, const std::string& durable, const std::string& filter,
-                                               std::uint64_t start_seq) {
+void NatsClient::deleteConsumer(const std::string& stream, const std::string& durable) {
   jsErrCode jerr = static_cast<jsErrCode>(0);
   const natsStatus s = js_DeleteConsumer(impl_->js, stream.c_str(), durable.c_str(), nullptr, &jerr);
   if (s != NATS_OK && s != NATS_NOT_FOUND && jerr != kConsumerNotFound) fail("deleting consumer " + durable, s, jerr);
+}
+
+std::unique_ptr<NatsPull> NatsClient::pullFrom(const std::string& stream, const std::string& durable, const std::string& filter,
+                                               std::uint64_t start_seq, std::chrono::seconds inactive) {
+  deleteConsumer(stream, durable);
   jsConsumerConfig cc;
   jsConsumerConfig_Init(&cc);
   cc.Durable = durable.c_str();
@@ -282,6 +303,7 @@ std::unique_ptr<NatsPull> NatsClient::pullFrom(const std::string& stream, const 
   cc.OptStartSeq = std::max<std::uint64_t>(start_seq, 1);
   cc.AckPolicy = js_AckNone;
   cc.FilterSubject = filter.c_str();
+  cc.InactiveThreshold = inactive.count() * kNsPerS;
   addConsumer(impl_->js, stream, cc);
   return bindPull(impl_->js, stream, durable, filter);
 }

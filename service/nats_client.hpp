@@ -90,6 +90,8 @@ class NatsClient {
 
   /// \brief A bucket's entry; none when the key is absent or deleted.
   [[nodiscard]] std::optional<NatsEntry> get(const std::string& bucket, const std::string& key);
+  /// \brief Every value a bucket keeps for a key (its history), oldest first; deletions left out.
+  [[nodiscard]] std::vector<NatsEntry> history(const std::string& bucket, const std::string& key);
   /// \brief Puts a value; returns its revision.
   std::uint64_t put(const std::string& bucket, const std::string& key, const std::string& value);
   /// \brief Puts a value without waiting (a publish to the bucket's subject; completed by
@@ -109,8 +111,12 @@ class NatsClient {
   /// message is the one at `start_seq` (1: the stream's first). An existing consumer of that name
   /// is deleted first: its deliveries pending are forgotten, the caller's checkpoint says where
   /// to go on from. No acknowledgements: the caller's checkpoint is the consumer's position.
+  /// `inactive` > 0: the server deletes the consumer after that long with no one fetching (a
+  /// reader that died leaves nothing behind).
   [[nodiscard]] std::unique_ptr<NatsPull> pullFrom(const std::string& stream, const std::string& durable, const std::string& filter,
-                                                   std::uint64_t start_seq);
+                                                   std::uint64_t start_seq, std::chrono::seconds inactive = std::chrono::seconds(0));
+  /// \brief Deletes a consumer (a no-op when absent).
+  void deleteConsumer(const std::string& stream, const std::string& durable);
   /// \brief A durable pull consumer shared by every worker that names it (a work queue):
   /// made when absent, joined when present.
   [[nodiscard]] std::unique_ptr<NatsPull> pullShared(const std::string& stream, const std::string& durable, const std::string& filter,

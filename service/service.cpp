@@ -135,6 +135,7 @@ ServiceImpl::ServiceImpl(ServeOptions o, Service::Log l)
         });
       },
       [this](const std::string& id, const ApprovalOutcome& outcome) { server->post([this, id, outcome] { approvalDone(id, outcome); }); });
+  if (!options.nats_url.empty()) startNats();
   restore();
   addGauges();
   server->every(std::chrono::seconds(15), [this] { hub->keepAlive(); });
@@ -142,6 +143,7 @@ ServiceImpl::ServiceImpl(ServeOptions o, Service::Log l)
 
 ServiceImpl::~ServiceImpl() {
   stopping = true;
+  nats.reset();  // its reader posts to the server
   for (auto& in : inputs) {
     if (in->thread.joinable()) in->thread.join();
   }
@@ -212,8 +214,9 @@ void ServiceImpl::restore() {
 void ServiceImpl::addGauges() {
   metrics.gauges["skylane_approval_queue_depth"] = {"Approvals waiting for a worker.", [this] { return double(pool->waiting()); }};
   metrics.gauges["skylane_approvals_running"] = {"Approvals being computed.", [this] { return double(pool->running()); }};
-  metrics.gauges["skylane_flights_tracked"] = {"Flights the tracking engine holds.",
-                                               [this] { return double(session->tracker().flights().size()); }};
+  metrics.gauges["skylane_flights_tracked"] = {"Flights the tracking engine holds (with --nats: the flights started here).", [this] {
+    return double(nats ? flights.size() : session->tracker().flights().size());
+  }};
   metrics.gauges["skylane_event_streams"] = {"Open event streams.", [this] { return double(hub->streams()); }};
   metrics.gauges["skylane_http_connections"] = {"Open HTTP connections.", [this] { return double(server->connections()); }};
 }
@@ -326,6 +329,9 @@ Service::Service(ServeOptions options, Log log) : impl_(std::make_unique<Service
 Service::~Service() = default;
 unsigned short Service::port() const { return impl_->server->port(); }
 void Service::addInput(std::unique_ptr<planner::FixSource> source, const std::string& flight) {
+  if (impl_->nats) {
+    throw std::invalid_argument("--input " + source->name() + ": with --nats, fixes go to the workers: publish them to skylane.fix.<operator>.<flight> (skylane nats publish)");
+  }
   impl_->inputs.push_back(std::make_unique<ServiceImpl::Input>(ServiceImpl::Input{std::move(source), flight, {}}));
 }
 void Service::run() {

@@ -35,6 +35,9 @@ struct ServeOptions {
   double rate_burst = 400.0;
   std::size_t max_fixes_per_request = 20000;
   HttpLimits limits;
+  /// NATS server(s) (nats://host:port, comma-separated): approvals and tracking go to the
+  /// JetStream workers (docs/nats.md); empty: everything runs in this process.
+  std::string nats_url;
 };
 
 class ServiceImpl;

@@ -12,6 +12,7 @@
 #include "service/auth.hpp"
 #include "service/event_hub.hpp"
 #include "service/metrics.hpp"
+#include "service/nats_front.hpp"
 #include "service/service.hpp"
 #include "service/service_store.hpp"
 
@@ -75,6 +76,28 @@ class ServiceImpl {
   void startInput(Input& in);
   void takeRecord(const planner::SourceRecord& r, const std::string& input_flight);
   std::unique_ptr<HttpServer> server;
+  std::unique_ptr<NatsFront> nats;  ///< with --nats: the workers do the engine's work
+
+  // nats_routes.cpp (with --nats)
+  void startNats();
+  void natsEvent(const StreamEvent& e);
+  /// The zone set's NATS key: `authority.<id>` or `<operator>.<id>`.
+  [[nodiscard]] static std::string natsZoneSetKey(const ZoneSet& z);
+  /// Puts the set's latest version into the NATS zone set bucket (when it differs from the one there).
+  void natsPutZoneSet(const ZoneSet& z);
+  /// The mission the approve worker gets: the zone sets named without a version by their NATS keys
+  /// (resolved to their current versions by the worker, and followed by the track workers).
+  void natsWriteMission(const std::filesystem::path& dir, nlohmann::json mission, const std::vector<std::string>& follow);
+  /// The approval's outcome when the workers have it; false while it is still to come.
+  bool natsTakeOutcome(ApprovalState& a);
+  HttpResponse natsPostFixes(const FlightRow& f, std::vector<std::string> lines);
+  [[nodiscard]] nlohmann::json natsFlightState(const FlightRow& f) const;
+  HttpResponse natsRoute(const FlightRow& f) const;
+  /// The events on NATS after `after` that `wants` accepts, as Server-Sent Events text; `sent`:
+  /// the last sequence of the operator's events read (so a live one up to it is not sent again).
+  std::optional<HttpResponse> natsBacklog(const Principal& who, const std::string& flight, std::int64_t after,
+                                          const std::function<bool(const std::string&)>& wants, std::string& body,
+                                          std::int64_t& sent) const;
 
   // service.cpp
   HttpResponse handle(const HttpRequest& r);
@@ -100,7 +123,10 @@ class ServiceImpl {
   HttpResponse approvalStatus(const ApprovalState& a) const;
   HttpResponse approvalFile(const ApprovalState& a, const std::string& name) const;
   /// The mission as `skylane approve` reads it: zone set ids → their files; orbits → the orbits folder.
-  nlohmann::json resolveMission(const nlohmann::json& body, const Principal& who);
+  /// `follow` (when given): for each of the mission's zone files, the NATS zone set key it stands
+  /// for when the mission named its set without a version (the set's later versions are followed),
+  /// else "".
+  nlohmann::json resolveMission(const nlohmann::json& body, const Principal& who, std::vector<std::string>* follow = nullptr);
   void queueApproval(ApprovalState& a);
   void approvalDone(const std::string& id, const ApprovalOutcome& outcome);
 

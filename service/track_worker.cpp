@@ -94,12 +94,16 @@ class Worker {
   void putFlightCheckpoints(Partition& p);
   bool putPartitionCheckpoint(Partition& p, std::uint64_t last_seq);
   void judge(Partition& p, const NatsMessage& m, std::vector<Outgoing>& out);
-  void judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, const json& body, std::vector<Outgoing>& out);
+  void judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, planner::TrackFix fix, std::vector<Outgoing>& out);
   void startFlight(Partition& p, FlightSlot& slot, const json& body);
   FlightSlot& slotOf(Partition& p, const std::string& op, const std::string& flight);
   void loadApproval(Partition& p, FlightSlot& slot, const std::string& id);
   void checkZoneSets();
   void followZoneSets(Partition& p, const std::string& dir, ApprovalZones& a);
+  bool tryZoneSetVersion(Partition& p, const std::string& dir, ApprovalZones& a, const std::string& name, const NatsEntry& e,
+                         std::string& why);
+  void announceZoneSet(const Partition& p, const std::string& dir, const std::string& name, std::uint64_t version);
+  void checkZoneSetsWhileIdle();
   void sweepStale(Partition& p, std::uint64_t last_seq, std::vector<Outgoing>& out);
   void commit(std::vector<Taken>& taken, const std::vector<Outgoing>& out);
   void checkpointAll();
@@ -112,6 +116,7 @@ class Worker {
   std::vector<Partition> parts_;
   int partition_count_ = 0;
   std::uint64_t zone_seq_ = 0;  ///< the zone set bucket's last sequence when last looked at
+  Clock::time_point last_zone_check_{};
   Clock::time_point last_checkpoint_{};
 };
 
@@ -120,6 +125,8 @@ std::string leaseKey(int k) { return "p" + std::to_string(k); }
 /// How often the flights' and partitions' checkpoints are written (one key-value put per flight
 /// judged since: at 1 Hz fixes, a put per flight every period instead of per fix).
 constexpr std::chrono::seconds kCheckpointPeriod{2};
+/// How often a worker with no fixes coming looks for new zone set versions (one request).
+constexpr std::chrono::milliseconds kIdleZoneCheck{250};
 
 void Worker::choosePartitions() {
   const int count = nats::partitionCount(nats_);
@@ -294,28 +301,72 @@ void Worker::checkZoneSets() {
   }
 }
 
+/// Puts the zone set's version `e` in force for the approval unpacked in `dir`; false (the file
+/// as it was, `why` said) when the fence cannot use it.
+bool Worker::tryZoneSetVersion(Partition& p, const std::string& dir, ApprovalZones& a, const std::string& name, const NatsEntry& e,
+                               std::string& why) {
+  ApprovalBundle::ZoneSetFile& f = a.zonesets.at(name);
+  const std::string path = (fs::path(dir) / f.file).string();
+  const std::string before = maps::readTextFile(path);
+  maps::writeFileAtomically(path, e.value, "zone set file");
+  try {
+    p.tracker->reloadZones(a.flight);
+  } catch (const std::exception& ex) {
+    maps::writeFileAtomically(path, before, "zone set file");
+    why = ex.what();
+    return false;
+  }
+  log("partition " + std::to_string(p.index) + ": zone set " + name + " version " + std::to_string(e.revision) + " in force");
+  f.version = e.revision;
+  announceZoneSet(p, dir, name, f.version);
+  return true;
+}
+
 void Worker::followZoneSets(Partition& p, const std::string& dir, ApprovalZones& a) {
   for (auto& [name, f] : a.zonesets) {
     const auto e = nats_.get(nats::kZoneSetBucket, name);
     if (!e || e->revision == f.version) continue;
-    const std::string path = (fs::path(dir) / f.file).string();
-    const std::string before = maps::readTextFile(path);
-    maps::writeFileAtomically(path, e->value, "zone set file");
-    try {
-      p.tracker->reloadZones(a.flight);
-      log("partition " + std::to_string(p.index) + ": zone set " + name + " version " + std::to_string(e->revision) + " in force");
-      f.version = e->revision;
-    } catch (const std::exception& ex) {  // a version the fence cannot use: the one before stays
-      maps::writeFileAtomically(path, before, "zone set file");
-      log("zone set " + name + " version " + std::to_string(e->revision) + " not taken: " + ex.what());
-      const std::string subject = "$KV." + nats::kZoneSetBucket + "." + name;
-      json r = planner::rejectedInputEvent(subject, 0, std::string("version ") + std::to_string(e->revision) + " not taken, version " +
-                                                             std::to_string(f.version) + " stays in force: " + ex.what()).toJson();
-      r["subject"] = subject;
-      nats_.publishAsync(nats::kRejectedSubject, r.dump(), "zoneset." + name + "." + std::to_string(e->revision));
+    std::string why;
+    if (tryZoneSetVersion(p, dir, a, name, *e, why)) continue;
+    // A version the fence cannot use: the newest usable one before it (newer than the one in force
+    // here) is what every worker that followed the set has in force, so one that loads the
+    // approval only now goes there too.
+    const std::vector<NatsEntry> history = nats_.history(nats::kZoneSetBucket, name);
+    std::string ignored;
+    for (auto it = history.rbegin(); it != history.rend(); ++it) {
+      if (it->revision < e->revision && it->revision > f.version && tryZoneSetVersion(p, dir, a, name, *it, ignored)) break;
     }
+    log("zone set " + name + " version " + std::to_string(e->revision) + " not taken: " + why);
+    const std::string subject = "$KV." + nats::kZoneSetBucket + "." + name;
+    json r = planner::rejectedInputEvent(subject, 0, std::string("version ") + std::to_string(e->revision) + " not taken, version " +
+                                                         std::to_string(f.version) + " stays in force: " + why).toJson();
+    r["subject"] = subject;
+    nats_.publishAsync(nats::kRejectedSubject, r.dump(), "zoneset." + name + "." + std::to_string(e->revision));
   }
   maps::writeFileAtomically((fs::path(dir) / "zonesets.json").string(), zoneSetsText(a.zonesets) + "\n", "zone sets");
+}
+
+/// Each flight of the approval unpacked in `dir` is told by an event that a zone set's version
+/// is in force for it (its next fixes are judged against it).
+void Worker::announceZoneSet(const Partition& p, const std::string& dir, const std::string& name, std::uint64_t version) {
+  for (const auto& [id, slot] : p.flights) {
+    if (slot.approval_dir != dir) continue;
+    const json e = {{"event", "zoneset_in_force"}, {"flight", slot.flight}, {"zoneset", name}, {"version", version}};
+    nats_.publishAsync(nats::eventSubject(slot.op, slot.flight), e.dump(), "zoneset." + id + "." + name + "." + std::to_string(version));
+  }
+}
+
+/// A quiet worker looks at the zone sets too (every kIdleZoneCheck), so a new version is in
+/// force, and said, before the next fix comes.
+void Worker::checkZoneSetsWhileIdle() {
+  if (Clock::now() - last_zone_check_ < kIdleZoneCheck) return;
+  last_zone_check_ = Clock::now();
+  try {
+    checkZoneSets();
+    nats_.publishesComplete();
+  } catch (const std::exception& e) {
+    log(std::string("zone sets not looked at: ") + e.what());
+  }
 }
 
 void Worker::startFlight(Partition& p, FlightSlot& slot, const json& body) {
@@ -343,11 +394,10 @@ void Worker::reject(const NatsMessage& m, const std::string& subject, const std:
   ++c_.rejected;
 }
 
-void Worker::judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, const json& body, std::vector<Outgoing>& out) {
+void Worker::judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, planner::TrackFix fix, std::vector<Outgoing>& out) {
   if (slot.approval.empty()) {
     throw Rejected{"flight " + slot.flight + " of operator " + slot.op + " is not started: its first message is {\"start\": {\"approval\": ID}}"};
   }
-  planner::TrackFix fix = planner::parseTrackFixJson(body, m.subject);
   if (!fix.flight.empty() && fix.flight != slot.flight) throw Rejected{"the fix names flight \"" + fix.flight.substr(0, 64) + "\", not " + slot.flight};
   fix.flight = slot.op + "." + slot.flight;
   fix.line = 0;
@@ -381,13 +431,18 @@ void Worker::judge(Partition& p, const NatsMessage& m, std::vector<Outgoing>& ou
     }
     slot.covered_seq = m.stream_seq;
     slot.dirty = true;
+    // A plain fix line is read directly (planner/tracking/fix_line.cpp); anything else as a document.
+    if (std::optional<planner::TrackFix> plain = planner::parsePlainFixLine(m.data, m.subject)) {
+      judgeFix(p, slot, m, std::move(*plain), out);
+      return;
+    }
     const json body = maps::parseJsonLine(m.data, m.subject);
     if (body.is_object() && body.contains("start")) {
       startFlight(p, slot, body);
       out.push_back({subject, json{{"event", "flight_started"}, {"flight", slot.flight}, {"operator", slot.op}, {"approval", slot.approval},
                                    {"input_seq", m.stream_seq}}.dump(), "fix." + std::to_string(m.stream_seq) + ".0"});
     } else {
-      judgeFix(p, slot, m, body, out);
+      judgeFix(p, slot, m, planner::parseTrackFixJson(body, m.subject), out);
     }
   } catch (const Rejected& r) {
     reject(m, subject, r.why, out);
@@ -420,6 +475,7 @@ void Worker::putFlightCheckpoints(Partition& p) {
       cp["state"] = planner::flightStateJson(st);
       if (st.route_version != slot.checkpointed_route) {
         nats_.putAsync(nats::kFlightBucket, id + ".route", p.tracker->routeJson(id).dump());
+        nats_.putAsync(nats::kFlightBucket, id + ".geojson", p.tracker->routeGeoJson(id).dump());
         slot.checkpointed_route = st.route_version;
       }
     } else {
@@ -528,7 +584,7 @@ void Worker::run(const std::atomic<bool>& stop) {
     // A fetch waits for a full batch or this long: short, so that a quiet partition does not
     // hold up the others, long enough that a batch gathers the fixes of several milliseconds.
     const auto wait = std::chrono::milliseconds(held > 0 ? std::max(5, 40 / held) : 0);
-    if (held > 0) (void)runRound(wait);
+    if (held > 0 && !runRound(wait)) checkZoneSetsWhileIdle();
     if (held > 0 && Clock::now() - last_checkpoint_ >= kCheckpointPeriod) {
       try {
         checkpointAll();  // a quiet worker's last fixes get their checkpoints too

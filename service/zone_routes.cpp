@@ -164,6 +164,13 @@ HttpResponse ServiceImpl::uploadZoneSet(const HttpRequest& r, const Principal& w
     zonesets[set_id] = {z, {}};
   }
   zonesets[set_id].zones[version] = airspace::loadZones((files / rel).string());
+  if (nats) {
+    try {
+      natsPutZoneSet(zonesets[set_id].set);
+    } catch (const NatsError& e) {  // kept here; put into NATS at the next start
+      log("zone set " + set_id + " version " + std::to_string(version) + " not yet in NATS: " + e.what());
+    }
+  }
   log("zone set " + set_id + " version " + std::to_string(version) + " (" + std::to_string(zones.size()) + " zones) by " +
       (who.authority ? "the authority" : who.owner()));
   return jsonBody(existing ? 200 : 201, zoneSetJson(zonesets[set_id].set));

@@ -67,7 +67,7 @@ SourceRecord JsonLinesFixSource::next(int timeout_ms) {
     if (blank(text)) continue;
     const std::string source = name() + ":" + std::to_string(line_);
     try {
-      TrackFix f = parseTrackFixJson(maps::parseJsonLine(text, source), source);
+      TrackFix f = parseTrackFixLine(text, source);
       f.line = line_;
       return fixRecord(std::move(f));
     } catch (const std::exception& e) {

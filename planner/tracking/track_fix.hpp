@@ -39,6 +39,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace skylane::planner {
@@ -98,6 +99,14 @@ struct TrackFix {
 /// \brief Parses one JSON-lines fix (the file comment's schema).
 /// \throws maps::ParseError naming `source`, the field, the value and what was expected.
 [[nodiscard]] TrackFix parseTrackFixJson(const nlohmann::json& doc, const std::string& source);
+/// \brief One JSON-lines fix from its text: a plain line (one flat object of flight or vehicle,
+/// time, position, onboard PLs, baro_h_m, mag_heading_deg; ASCII strings without escapes) is
+/// read directly, anything else through maps::parseJsonLine and parseTrackFixJson — the same fix
+/// and the same errors either way (fix_line.cpp). \throws maps::ParseError as parseTrackFixJson.
+[[nodiscard]] TrackFix parseTrackFixLine(const std::string& text, const std::string& source);
+/// \brief The direct way alone: the fix of a plain line whose values parseTrackFixJson accepts,
+/// else none (never an error of its own).
+[[nodiscard]] std::optional<TrackFix> parsePlainFixLine(std::string_view text, const std::string& source);
 
 /// \brief A fix as one JSON-lines object (the file comment's schema; parseTrackFixJson reads
 /// it back: positions to 1e-9°, heights and ranges to 0.1 mm, increments with full precision).

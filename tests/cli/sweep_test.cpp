@@ -169,6 +169,14 @@ class Sweep : public ::testing::Test {
         {"fly_faults", "fly " + r + " --out {OUT}/f.jsonl --imu tactical --faults {F}", given() + "/faults.json", Format::kJson,
          {"f.jsonl"}},
         {"serve_tokens", "serve --db {OUT}/s.sqlite --tokens {F} --port 0 --web none", given() + "/tokens.json", Format::kJson, {}},
+        // The NATS clients check what they send before they connect (no server at this address).
+        {"nats_approve_mission", "nats approve {F} --nats nats://127.0.0.1:9 --operator acme --id a1", ex + "/approve/mission.json",
+         Format::kJson, {}},
+        {"nats_zones_file", "nats zones {F} --nats nats://127.0.0.1:9 --owner authority --set zurich", ex + "/approve/zones_ed269.json",
+         Format::kJson, {}},
+        {"nats_publish_fixes", "nats publish {F} --nats nats://127.0.0.1:9 --operator acme --flight f1", fixes, Format::kStream, {}},
+        {"serve_nats_tokens", "serve --db {OUT}/s.sqlite --tokens {F} --port 0 --web none --nats nats://127.0.0.1:9",
+         given() + "/tokens.json", Format::kJson, {}},
     };
   }
 

@@ -4,6 +4,7 @@
 #include "maps/time.hpp"
 #include "planner/tracking/track_store.hpp"
 #include "tests/planner/track_events.hpp"
+#include "tests/service/child_process.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -526,9 +527,11 @@ std::string waitForUdpPort(int port) {
 TEST_F(TrackCli, UdpInputAndAStaleFlightOnAQuietLink) {
   const std::string events = *dir_ + "/udp_events.jsonl";
   std::string send;
-  for (int k = 0; k < 5; ++k) send += "echo \x27" + goodFix(k).dump() + "\x27 > /dev/udp/127.0.0.1/47811; sleep 0.05; ";
-  const RunResult r = sh(kBin + " track --approval " + approval() + " --input udp://127.0.0.1:47811 --stale-after 1 --no-replan > " +
-                         events + " 2>/dev/null & pid=$!; " + waitForUdpPort(47811) + send +
+  const int port = test::freeUdpPort();
+  const std::string udp = "127.0.0.1/" + std::to_string(port);
+  for (int k = 0; k < 5; ++k) send += "echo \x27" + goodFix(k).dump() + "\x27 > /dev/udp/" + udp + "; sleep 0.05; ";
+  const RunResult r = sh(kBin + " track --approval " + approval() + " --input udp://127.0.0.1:" + std::to_string(port) +
+                         " --stale-after 1 --no-replan > " + events + " 2>/dev/null & pid=$!; " + waitForUdpPort(port) + send +
                          " sleep 2.5; kill -TERM $pid; wait $pid; echo status=$?");
   EXPECT_NE(r.out.find("status=0"), std::string::npos) << r.out;
   const auto ev = readEvents(events);

@@ -5,6 +5,7 @@
 #include "maps/parse_error.hpp"
 #include "planner/tracking/datagram_socket.hpp"
 #include "planner/tracking/line_input.hpp"
+#include "tests/service/child_process.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -22,18 +23,7 @@
 namespace skylane::planner {
 namespace {
 
-/// A free loopback UDP port (bound and released: the kernel does not hand it out again at once).
-int freeUdpPort() {
-  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  EXPECT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
-  socklen_t len = sizeof a;
-  getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  close(fd);
-  return ntohs(a.sin_port);
-}
+using test::freeUdpPort;
 
 /// Sends `n` datagrams of one line each ("datagram k" padded to `bytes`) to 127.0.0.1:port,
 /// pausing `pause` after every `every` datagrams (every 0: flat out).

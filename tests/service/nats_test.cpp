@@ -9,12 +9,14 @@
 #include "service/nats_client.hpp"
 #include "service/nats_layout.hpp"
 #include "tests/service/child_process.hpp"
+#include "tests/service/route_fix.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <csignal>
 #include <cmath>
 #include <atomic>
 #include <map>
@@ -31,6 +33,15 @@ using test::NatsServer;
 namespace nats = service::nats;
 
 constexpr int kPartitions = 4;
+
+/// The example zones put as authority.zurich, the example mission made from it approved as a1
+/// (its report), two track workers, and four flights of it started.
+struct ZurichFlights {
+  std::uint64_t v1 = 0;
+  json rep;
+  std::unique_ptr<ChildProcess> w1, w2;
+  std::vector<std::string> flights = {"f1", "f2", "f3", "f4"};
+};
 
 class NatsWorkers : public ::testing::Test {
  protected:
@@ -60,17 +71,7 @@ class NatsWorkers : public ::testing::Test {
     const auto b = client_->get(nats::kApprovalBucket, "acme." + id + ".bundle");
     return b ? json::parse(service::parseBundle(b->value, "bundle").report) : json();
   }
-  /// A fix k seconds after departure on the route, `off_m` north of it, with PLs `pl_m`.
-  static json fixAt(const json& rep, int k, double off_m = 0.0, double pl_m = 0.5) {
-    const json& pts = rep.at("route");
-    std::size_t i = 1;
-    while (i + 1 < pts.size() && k > pts[i].at("eta_s").get<double>()) ++i;
-    const json &a = pts[i - 1], &b = pts[i];
-    const double f = std::clamp((k - a.at("eta_s").get<double>()) / (b.at("eta_s").get<double>() - a.at("eta_s").get<double>()), 0.0, 1.0);
-    auto mix = [&](const char* key) { return a.at(key).get<double>() + f * (b.at(key).get<double>() - a.at(key).get<double>()); };
-    const std::string time = maps::formatRfc3339(maps::parseRfc3339(rep.at("departure").get<std::string>())->plus(k));
-    return {{"time", time}, {"lat", mix("lat") + off_m / 111'195.0}, {"lon", mix("lon")}, {"h_ell_m", mix("h_ell_m")}, {"hpl_m", pl_m}, {"vpl_m", pl_m}};
-  }
+  static json fixAt(const json& rep, int k, double off_m = 0.0, double pl_m = 0.5) { return test::fixAlongRoute(rep, k, off_m, pl_m); }
   /// Every event in the stream, each with its subject.
   std::vector<json> events() {
     std::vector<json> out;
@@ -124,6 +125,8 @@ class NatsWorkers : public ::testing::Test {
     if (e.at("event") == "rejected_input") e.erase("flight");
     return e;
   }
+  /// See ZurichFlights; its report is null when the approval failed.
+  ZurichFlights startZurichFlights();
   std::string dir_;
   std::unique_ptr<NatsServer> server_;
   std::unique_ptr<NatsClient> client_;
@@ -280,43 +283,57 @@ TEST_F(NatsWorkers, DuplicateAndOutOfOrderFixesAreRejectedAndARepeatedMessageIdI
 /// A zone set's new version, put while two workers track four flights made from it: every fix
 /// published after the put is judged against it (its events name the version), a closure it adds
 /// on the route ahead gives a zone violation naming it, and the fixes before name the old version.
-TEST_F(NatsWorkers, AZoneSetUpdateIsInForceForEveryFixPublishedAfterIt) {
+/// Puts a zone set file as the authority's set "zurich" (`skylane nats zones`); its version.
+std::uint64_t putZurich(const std::string& url, const std::string& file) {
+  const test::CommandResult r = test::runCommand(std::string(SKYLANE_BINARY) + " nats zones " + file + " --nats " + url +
+                                                 " --owner authority --set zurich");
+  EXPECT_EQ(r.status, 0) << r.out;
+  return r.status == 0 ? json::parse(r.out).at("version").get<std::uint64_t>() : 0;
+}
+
+/// The example mission with its zones from the zone set authority.zurich, as a file in `dir`.
+std::string zurichMission(const std::string& dir) {
   const std::string examples = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/";
-  const auto put = [&](const std::string& file) {
-    const test::CommandResult r = test::runCommand(std::string(SKYLANE_BINARY) + " nats zones " + file + " --nats " + server_->url() +
-                                                   " --owner authority --set zurich");
-    EXPECT_EQ(r.status, 0) << r.out;
-    return json::parse(r.out).at("version").get<std::uint64_t>();
-  };
-  const std::uint64_t v1 = put(examples + "zones_ed269.json");
   json mission = json::parse(std::ifstream(examples + "mission.json"));
   mission.erase("zones");
   mission["zonesets"] = {"authority.zurich"};
   for (auto& o : mission["orbits"]) o = examples + o.get<std::string>();
   mission["buildings"] = examples + mission["buildings"].get<std::string>();
-  std::ofstream(dir_ + "/mission.json") << mission.dump();
+  std::ofstream(dir + "/mission.json") << mission.dump();
+  return dir + "/mission.json";
+}
+
+
+ZurichFlights NatsWorkers::startZurichFlights() {
+  ZurichFlights z;
+  z.v1 = putZurich(server_->url(), std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/zones_ed269.json");
   auto approver = worker("approve", "ap1");
-  ASSERT_EQ(approve("a1", dir_ + "/mission.json").at("status"), "approved") << approver->log();
-  const json rep = report("a1");
-  auto w1 = worker("track", "tr1");
-  auto w2 = worker("track", "tr2");
-  const std::vector<std::string> flights = {"f1", "f2", "f3", "f4"};
-  for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), json{{"start", {{"approval", "a1"}}}}.dump());
+  const json st = approve("a1", zurichMission(dir_));
+  EXPECT_EQ(st.at("status"), "approved") << approver->log();
+  if (st.at("status") != "approved") return z;
+  z.rep = report("a1");
+  z.w1 = worker("track", "tr1");
+  z.w2 = worker("track", "tr2");
+  for (const std::string& f : z.flights) client_->publish(nats::fixSubject("acme", f), json{{"start", {{"approval", "a1"}}}}.dump());
+  return z;
+}
+
+TEST_F(NatsWorkers, AZoneSetUpdateIsInForceForEveryFixPublishedAfterIt) {
+  const std::string examples = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/";
+  const auto put = [&](const std::string& file) { return putZurich(server_->url(), file); };
+  ZurichFlights z = startZurichFlights();
+  ASSERT_FALSE(z.rep.is_null());
+  const std::uint64_t v1 = z.v1;
+  const json& rep = z.rep;
+  const auto& w1 = z.w1;
+  const auto& w2 = z.w2;
+  const std::vector<std::string>& flights = z.flights;
   for (int k = 0; k < 10; ++k) {
     for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), fixAt(rep, k).dump());
   }
   (void)waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= 40; });
   // Version 2: the same zones and a closure 120 m wide around the route 25 s after departure.
-  json zones = json::parse(std::ifstream(examples + "zones_ed269.json"));
-  json closure = zones["UASZoneList"][0];
-  const json at = fixAt(rep, 25);
-  const double lat = at["lat"], lon = at["lon"], dlat = 60.0 / 111'195.0, dlon = dlat / std::cos(lat * M_PI / 180.0);
-  closure["identifier"] = "EX-NEW-CLOSURE";
-  closure["name"] = "Closure put while flying (test)";
-  closure["geometry"][0]["horizontalProjection"]["coordinates"] =
-      json::array({json::array({{lon - dlon, lat - dlat}, {lon + dlon, lat - dlat}, {lon + dlon, lat + dlat}, {lon - dlon, lat + dlat}, {lon - dlon, lat - dlat}})});
-  zones["UASZoneList"].push_back(closure);
-  std::ofstream(dir_ + "/zones_v2.json") << zones.dump();
+  std::ofstream(dir_ + "/zones_v2.json") << test::withClosureAt(json::parse(std::ifstream(examples + "zones_ed269.json")), fixAt(rep, 25)).dump();
   const std::uint64_t v2 = put(dir_ + "/zones_v2.json");
   const auto t_put = std::chrono::steady_clock::now();
   for (int k = 10; k < 30; ++k) {
@@ -366,6 +383,46 @@ TEST_F(NatsWorkers, AZoneSetUpdateIsInForceForEveryFixPublishedAfterIt) {
   }
   EXPECT_EQ(judged_after, flights.size());
   EXPECT_NE((w1->log() + w2->log()).find("zone set authority.zurich version " + std::to_string(v2) + " in force"), std::string::npos);
+  // Both workers stop; a new one (an empty cache: the approval's bundle names version 1) takes
+  // every partition. The newest version is still unusable: it goes back to version 2, the newest
+  // usable one, as the others had — not to the bundle's version 1.
+  EXPECT_EQ(w1->kill(SIGTERM), 0);
+  EXPECT_EQ(w2->kill(SIGTERM), 0);
+  auto w3 = worker("track", "tr3");
+  for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), fixAt(rep, 31).dump());
+  const std::vector<json> late = waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= 128; });
+  ASSERT_EQ(count(late, "fix"), 128u) << w3->log();
+  for (const json& e : late) {
+    if (e.at("event") == "fix" && *maps::parseRfc3339(e.at("time").get<std::string>()) - departure > 30.5) {
+      EXPECT_EQ(e.at("zonesets").at("authority.zurich"), v2) << w3->log();
+    }
+  }
+}
+
+TEST_F(NatsWorkers, AZoneSetUpdateReachesQuietWorkersAndEachFlightIsToldWithoutAFix) {
+  const std::string examples = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/";
+  ZurichFlights z = startZurichFlights();
+  ASSERT_FALSE(z.rep.is_null());
+  const auto& w1 = z.w1;
+  const auto& w2 = z.w2;
+  const std::vector<std::string>& flights = z.flights;
+  for (const std::string& f : flights) client_->publish(nats::fixSubject("acme", f), fixAt(z.rep, 0).dump());
+  (void)waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= flights.size(); });
+  // Both workers hold flights (the partitions are shared out), then no fix comes.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto t_put = std::chrono::steady_clock::now();
+  const std::uint64_t v2 = putZurich(server_->url(), examples + "zones_ed269.json");
+  const std::vector<json> ev = waitFor([&](const std::vector<json>& e) { return count(e, "zoneset_in_force") >= flights.size(); }, 30);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_put).count();
+  ASSERT_EQ(count(ev, "zoneset_in_force"), flights.size()) << w1->log() << w2->log();
+  for (const json& e : ev) {
+    if (e.at("event") != "zoneset_in_force") continue;
+    EXPECT_EQ(e.at("zoneset"), "authority.zurich");
+    EXPECT_EQ(e.at("version"), v2);
+  }
+  EXPECT_EQ(count(ev, "fix"), flights.size());  // no fix was needed for it
+  std::printf("zone set version in force at every quiet worker after %.3f s (the workers look every 0.25 s)\n", seconds);
+  EXPECT_LT(seconds, 10.0);  // 1 s on a quiet machine; the margin is for a loaded test run
 }
 
 TEST_F(NatsWorkers, TwoApproveWorkersDoEachRequestOnceAndABadRequestIsInvalidByName) {
@@ -386,7 +443,19 @@ TEST_F(NatsWorkers, TwoApproveWorkersDoEachRequestOnceAndABadRequestIsInvalidByN
   for (auto& o : bad["orbits"]) o = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/" + o.get<std::string>();
   bad["buildings"] = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/" + bad["buildings"].get<std::string>();
   std::ofstream(dir_ + "/bad.json") << bad.dump();
-  const json invalid = approve("bad", dir_ + "/bad.json");
+  // `skylane nats approve` checks the mission before it sends it: exit 2 naming the field.
+  const test::CommandResult refused = test::runCommand(std::string(SKYLANE_BINARY) + " nats approve " + dir_ + "/bad.json --nats " +
+                                                       server_->url() + " --operator acme --id bad 2>&1");
+  EXPECT_EQ(refused.status, 2) << refused.out;
+  EXPECT_NE(refused.out.find("$.vehicle"), std::string::npos) << refused.out;
+  // Sent anyway (another client): the approve worker finds it invalid, by name.
+  client_->publish(nats::approvalSubject("acme", "bad"), service::bundleText(service::packMission(dir_ + "/bad.json")));
+  json invalid;
+  for (int i = 0; i < 600 && (invalid.is_null() || invalid.at("status") == "running"); ++i) {
+    if (const auto e = client_->get(nats::kApprovalBucket, "acme.bad")) invalid = json::parse(e->value);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_FALSE(invalid.is_null());
   EXPECT_EQ(invalid.at("status"), "invalid");
   EXPECT_NE(invalid.value("message", "").find("vehicle"), std::string::npos) << invalid.dump();
   const std::vector<json> ev = events();

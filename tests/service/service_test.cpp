@@ -6,6 +6,7 @@
 
 #include "maps/time.hpp"
 #include "tests/service/http_client.hpp"
+#include "tests/service/route_fix.hpp"
 #include "tests/service/service_process.hpp"
 #include "tests/test_util.hpp"
 
@@ -26,6 +27,7 @@ using test::HttpClient;
 using test::HttpReply;
 using test::ServiceProcess;
 using test::TestTokens;
+using test::freeUdpPort;
 
 std::string auth(const char* token) { return std::string("Authorization: ") + token; }
 const std::string kJson = "Content-Type: application/json";
@@ -91,15 +93,7 @@ class Service : public ::testing::Test {
       const json f = json::parse(call("GET", "/v1/flights/" + flight, TestTokens::kAcme).body);
       route_ = json::parse(call("GET", "/v1/approvals/" + f.at("approval").get<std::string>() + "/report.json", TestTokens::kAcme).body);
     }
-    const json& pts = route_.at("route");
-    std::size_t i = 1;
-    while (i + 1 < pts.size() && k > pts[i].at("eta_s").get<double>()) ++i;
-    const json &a = pts[i - 1], &b = pts[i];
-    const double f = std::clamp((k - a.at("eta_s").get<double>()) / (b.at("eta_s").get<double>() - a.at("eta_s").get<double>()), 0.0, 1.0);
-    auto mix = [&](const char* key) { return a.at(key).get<double>() + f * (b.at(key).get<double>() - a.at(key).get<double>()); };
-    const std::string time = maps::formatRfc3339(maps::parseRfc3339(route_.at("departure").get<std::string>())->plus(k));
-    return {{"time", time}, {"lat", mix("lat") + off_m / 111'195.0}, {"lon", mix("lon")}, {"h_ell_m", mix("h_ell_m")},
-            {"hpl_m", pl_m}, {"vpl_m", pl_m}};
+    return test::fixAlongRoute(route_, k, off_m, pl_m);
   }
   std::string dir_;
   std::unique_ptr<ServiceProcess> server_;
@@ -466,18 +460,6 @@ namespace skylane {
 namespace {
 
 /// A free UDP port on the loopback (bound and released; the service binds it next).
-int freeUdpPort() {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t n = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
-
 void sendUdp(int port, const std::string& datagram) {
   const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
   sockaddr_in a{};
