@@ -10,6 +10,8 @@
 #include "geofence/fix.hpp"
 #include "geofence/obstruction_files.hpp"
 #include "geofence/verdict_json.hpp"
+#include "geofence/fix_line.hpp"
+#include "geofence/verdict_writer.hpp"
 #include "maps/geoid.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
@@ -47,10 +49,12 @@ json checkFix(const geofence::Fix& f, const geofence::Fence& fence, const maps::
   if (!f.id.is_null()) out["id"] = f.id;
   out["time"] = maps::formatRfc3339(f.t0, 3);
   if (f.t1 - f.t0 > 0) out["until"] = maps::formatRfc3339(f.t1, 3);
-  json verdict = fenceVerdictJson(fence.check(v), fence);
+  json verdict = geofence::fenceVerdictJson(fence.check(v), fence);
   out.update(verdict);
   return out;
 }
+
+void checkStream(const FenceCheckOptions& o, const geofence::Fence& fence, const maps::PlaneFrame& frame);
 
 void runFenceCheck(const FenceCheckOptions& o) {
   if (o.fix.empty() == o.fixes.empty()) throw ParseError("--fix", 0, "--fix|--fixes", "", "exactly one of --fix JSON and --fixes FILE");
@@ -83,6 +87,39 @@ void runFenceCheck(const FenceCheckOptions& o) {
     std::cout << out.dump(2) << "\n";
     return;
   }
+  checkStream(o, fence, boxes.frame);
+}
+
+/// Where the verdicts go: a buffer written to stdout in blocks (and before any message on stderr,
+/// so the two keep their order).
+struct VerdictOut {
+  static constexpr std::size_t kFlushBytes = 1 << 16;
+  std::string buffer;
+  void flush() {
+    std::cout.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    buffer.clear();
+  }
+};
+
+/// One line of the stream: the plain form through the fast reader and writer (no allocation
+/// per fix, geofence/fix_line.hpp), anything else through parseFix and nlohmann, which word the
+/// errors. Throws what parseFix or the fence throws.
+void checkLine(const std::string& text, std::size_t line, const std::string& fixes, const geofence::Fence& fence,
+               const maps::PlaneFrame& frame, const geofence::VerdictLineWriter& writer, VerdictOut& out) {
+  geofence::PlainFix f;
+  if (geofence::readPlainFixLine(text, f)) {
+    const Eigen::Vector2d p = frame.toPlane(f.lat_rad, f.lon_rad);
+    const geofence::TimedVolume v{f.t0, f.t1, {Eigen::Vector3d(p.x(), p.y(), f.h_ell_m), f.hpl_m, f.vpl_m}};
+    if (writer.append(out.buffer, f.id_json, f.t0, f.t1, line, fence.check(v))) return;
+  }
+  const std::string source = fixes + ":" + std::to_string(line);
+  json j = checkFix(geofence::parseFix(maps::parseJsonLine(text, source), source), fence, frame);
+  j["line"] = line;
+  out.buffer += j.dump();
+  out.buffer += '\n';
+}
+
+void checkStream(const FenceCheckOptions& o, const geofence::Fence& fence, const maps::PlaneFrame& frame) {
   // A stream: one verdict line per fix; a bad line is reported (stdout and stderr), skipped,
   // and the stream goes on.
   std::ifstream file;
@@ -92,46 +129,33 @@ void runFenceCheck(const FenceCheckOptions& o) {
     if (!file) throw ParseError(o.fixes, 0, "--fixes", o.fixes, "a readable JSON-lines file");
   }
   std::istream& in = o.fixes == "-" ? std::cin : file;
+  const geofence::VerdictLineWriter writer(fence);
+  VerdictOut out;
+  out.buffer.reserve(2 * VerdictOut::kFlushBytes);
   std::string text;
   std::size_t line = 0, checked = 0, rejected = 0;
   while (std::getline(in, text)) {
     ++line;
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-    const std::string source = o.fixes + ":" + std::to_string(line);
     try {
-      json out = checkFix(geofence::parseFix(maps::parseJsonLine(text, source), source), fence, boxes.frame);
-      out["line"] = line;
-      std::cout << out.dump() << "\n";
+      checkLine(text, line, o.fixes, fence, frame, writer, out);
       ++checked;
     } catch (const std::exception& e) {  // ParseError, or a fix the checker refuses
       ++rejected;
       // The message quotes the line, which may hold bytes that are not UTF-8: replaced, not fatal.
-      std::cout << json{{"event", "rejected_input"}, {"line", line}, {"error", e.what()}}.dump(-1, ' ', false, json::error_handler_t::replace)
-                << "\n";
+      out.buffer += json{{"event", "rejected_input"}, {"line", line}, {"error", e.what()}}.dump(-1, ' ', false, json::error_handler_t::replace);
+      out.buffer += '\n';
+      out.flush();
       std::cerr << "skylane: skipped: " << e.what() << "\n";
     }
+    if (out.buffer.size() >= VerdictOut::kFlushBytes) out.flush();
   }
+  out.flush();
   std::cerr << "skylane: fence check: " << checked << " fix" << (checked == 1 ? "" : "es") << " checked, " << rejected
             << " rejected\n";
 }
 
 }  // namespace
-
-json fenceVerdictJson(const geofence::FenceVerdict& v, const geofence::Fence& fence) {
-  json out = v;  // the one form (geofence/verdict_json.hpp), with what the fence knows of each check
-  for (std::size_t i = 0; i < v.checks.size(); ++i) {
-    const geofence::Check& c = v.checks[i];
-    json& j = out["checks"][i];
-    if (geofence::isBoxLevel(c)) {
-      const geofence::AlertLimits& l = (c.level == geofence::Level::kCorridor ? fence.level1() : fence.level2()).limits();
-      j["hal_m"] = metresOrNull(l.hal_m);
-      j["val_m"] = metresOrNull(l.val_m);
-    } else if (c.level == geofence::Level::kZone || c.level == geofence::Level::kKeepIn) {
-      j["file"] = fence.zones()[c.index].source;
-    }
-  }
-  return out;
-}
 
 void addFenceCommands(CLI::App& app) {
   CLI::App* fence = app.add_subcommand("fence", "Protection-volume checks against corridor, airspace boxes, zones and obstacles");

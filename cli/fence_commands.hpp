@@ -10,10 +10,6 @@
 
 namespace skylane::cli {
 
-/// \brief A fence verdict as JSON (also for the reports of later commands): overall verdict,
-/// violated level, and every check with its margins in metres (null for ±∞).
-[[nodiscard]] nlohmann::json fenceVerdictJson(const geofence::FenceVerdict& v, const geofence::Fence& fence);
-
 /// \brief Registers `fence` on `app`.
 void addFenceCommands(CLI::App& app);
 

@@ -116,6 +116,22 @@ void from_json(const json& j, FenceVerdict& v) {
   if (v.violated && !v.deciding) root.at("violated").fail("a level with a check of the verdict's outcome");
 }
 
+json fenceVerdictJson(const FenceVerdict& v, const Fence& fence) {
+  json out = v;  // the one form, with what the fence knows of each check
+  for (std::size_t i = 0; i < v.checks.size(); ++i) {
+    const Check& c = v.checks[i];
+    json& j = out["checks"][i];
+    if (isBoxLevel(c)) {
+      const AlertLimits& l = (c.level == Level::kCorridor ? fence.level1() : fence.level2()).limits();
+      j["hal_m"] = maps::metresOrNull(l.hal_m);
+      j["val_m"] = maps::metresOrNull(l.val_m);
+    } else if (c.level == Level::kZone || c.level == Level::kKeepIn) {
+      j["file"] = fence.zones()[c.index].source;
+    }
+  }
+  return out;
+}
+
 json pickMembers(const json& object, std::initializer_list<const char*> keys) {
   json out = json::object();
   for (const char* k : keys) {

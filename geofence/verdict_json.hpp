@@ -31,6 +31,10 @@ void from_json(const nlohmann::json& j, Check& c);
 /// is the verdict's.
 void from_json(const nlohmann::json& j, FenceVerdict& v);
 
+/// \brief A fence verdict as `fence check` writes it: the one form, and in each check what the
+/// fence knows of it — the box levels' "hal_m" and "val_m", the zones' and keep-in's "file".
+[[nodiscard]] nlohmann::json fenceVerdictJson(const FenceVerdict& v, const Fence& fence);
+
 /// \brief Whether a check is of a box level (corridor or airspace) rather than a zone or obstacle.
 [[nodiscard]] inline bool isBoxLevel(const Check& c) { return c.level == Level::kCorridor || c.level == Level::kAirspace; }
 

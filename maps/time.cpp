@@ -126,7 +126,7 @@ CalendarTime utcFromGps(const GpsTime& t) {
   return calendarFromSeconds(t.totalSeconds() - leapSecondsAtGps(t));
 }
 
-std::optional<GpsTime> parseRfc3339(const std::string& text) {
+std::optional<GpsTime> parseRfc3339(std::string_view text) {
   // YYYY-MM-DDTHH:MM:SS[.frac](Z|±HH:MM), every digit where RFC 3339 §5.6 puts it.
   const auto digits = [&](std::size_t pos, std::size_t n, int& out) {
     if (pos + n > text.size()) return false;
@@ -159,7 +159,7 @@ std::optional<GpsTime> parseRfc3339(const std::string& text) {
       h > 23 || mi > 59 || si > 59) {
     return std::nullopt;  // 23:59:60 is not accepted: skylane cannot tell a real leap second apart
   }
-  const std::string zone = text.substr(pos);
+  const std::string_view zone = text.substr(pos);
   int offset_min = 0;
   if (zone == "Z" || zone == "z") {
     offset_min = 0;
@@ -200,9 +200,15 @@ std::string formatRfc3339Printf(const GpsTime& t, int fraction_digits) {
 }  // namespace
 
 std::string formatRfc3339(const GpsTime& t, int fraction_digits) {
+  char buf[kRfc3339MaxChars];
+  const char* end = formatRfc3339To(buf, t, fraction_digits);
+  return end != nullptr ? std::string(static_cast<const char*>(buf), end) : formatRfc3339Printf(t, fraction_digits);
+}
+
+char* formatRfc3339To(char* out, const GpsTime& t, int fraction_digits) {
   // 0–6 digits for years 1–9998 by hand (the common case: snprintf's "%0*.*f" was a third of a
   // tracker fix event's time); anything else in the general form.
-  if (fraction_digits < 0 || fraction_digits > 6) return formatRfc3339Printf(t, fraction_digits);
+  if (fraction_digits < 0 || fraction_digits > 6) return nullptr;
   const int digits = fraction_digits;
   long long unit = 1;
   for (int i = 0; i < digits; ++i) unit *= 10;
@@ -210,12 +216,11 @@ std::string formatRfc3339(const GpsTime& t, int fraction_digits) {
   // Round once in seconds so that 59.9996 does not print as 60.000.
   const double utc_s = std::round((t.totalSeconds() - leapSecondsAtGps(t)) * scale) / scale;
   const CalendarTime c = calendarFromSeconds(utc_s);
-  if (c.year < 1 || c.year > 9998) return formatRfc3339Printf(t, fraction_digits);
+  if (c.year < 1 || c.year > 9998) return nullptr;
   const long long units = std::llround(c.second * scale);
   const long long whole = (units / unit) % 60;
   long long frac = units % unit;
-  char buf[40];
-  char* p = buf;
+  char* p = out;
   auto put = [&p](long long v, int width) {
     for (int i = width - 1; i >= 0; --i, v /= 10) p[i] = static_cast<char>('0' + v % 10);
     p += width;
@@ -236,7 +241,7 @@ std::string formatRfc3339(const GpsTime& t, int fraction_digits) {
     put(frac, digits);
   }
   *p++ = 'Z';
-  return std::string(buf, p);
+  return p;
 }
 
 std::optional<double> parseDuration(const std::string& text) {

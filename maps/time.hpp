@@ -9,6 +9,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace skylane::maps {
 
@@ -63,9 +64,15 @@ struct GpsTime {
 
 /// \brief Parses an RFC 3339 date-time ("2026-11-23T14:00:00Z", "…+01:00", fractional
 /// seconds allowed) as UTC and returns GPS time. nullopt when the text is not RFC 3339.
-[[nodiscard]] std::optional<GpsTime> parseRfc3339(const std::string& text);
+[[nodiscard]] std::optional<GpsTime> parseRfc3339(std::string_view text);
 /// \brief GPS time → RFC 3339 UTC string with the given number of fractional digits.
 [[nodiscard]] std::string formatRfc3339(const GpsTime& t, int fraction_digits = 0);
+/// \brief formatRfc3339 into `out` without allocating (0–6 fractional digits, years 1–9998):
+/// the end of the text written (at most kRfc3339MaxChars), or nullptr for any other case, which
+/// formatRfc3339 then writes.
+[[nodiscard]] char* formatRfc3339To(char* out, const GpsTime& t, int fraction_digits);
+/// \brief Longest text formatRfc3339To writes.
+inline constexpr int kRfc3339MaxChars = 32;
 
 /// \brief Parses a duration such as "24h", "10m", "30s", "1h30m", "90" (seconds).
 /// nullopt when the text is not a positive duration.

@@ -143,6 +143,7 @@ Approver::Impl::Impl(Mission mission)
   if (!std::isfinite(g_lo)) throw maps::ParseError(m.source, 0, "$.terrain", m.terrain_file, "terrain covering the mission area");
   lower << lo, g_lo + m.min_agl_m - 1.0;
   upper << hi, g_hi + m.max_agl_m + 1.0;
+  ground_grid.emplace(frame, terrain, lo, hi);
 }
 
 std::optional<double> Approver::Impl::ground(const Eigen::Vector2d& xy) const {
@@ -157,13 +158,14 @@ maps::Geodetic Approver::Impl::geodetic(const Eigen::Vector3d& p) const {
 
 bool Approver::Impl::valid(const Eigen::Vector3d& p, const maps::GpsTime& t0, const maps::GpsTime& t1,
                            const std::vector<approval_steps::Penalty>& penalties) const {
-  const auto g = ground(p.head<2>());
+  // The state's (lat, lon) from the map-frame grid (within its bound), for the ground and the geoid.
+  const Eigen::Vector2d ll = ground_grid ? ground_grid->toLatLon(p.head<2>()) : frame.toLatLon(p.head<2>());
+  const auto g = terrain.heightEllipsoid_m(ll.x(), ll.y());
   if (!g) return false;
   const double agl = p.z() - *g;
   if (agl < m.min_agl_m || agl > m.max_agl_m) return false;
-  if (m.max_amsl_m) {
-    const maps::Geodetic q = geodetic(p);
-    if (maps::Geoid::egm96().amslFromEllipsoidal_m(q.lat_rad, q.lon_rad, p.z()) > *m.max_amsl_m) return false;
+  if (m.max_amsl_m && maps::Geoid::egm96().amslFromEllipsoidal_m(ll.x(), ll.y(), p.z()) > *m.max_amsl_m) {
+    return false;
   }
   for (const auto& [c, r] : penalties) {
     if ((p - c).norm() < r) return false;

@@ -15,6 +15,7 @@
 #include "maps/buildings.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/sky_mask.hpp"
+#include "maps/map_ground_grid.hpp"
 #include "maps/terrain.hpp"
 #include "maps/time.hpp"
 
@@ -132,6 +133,9 @@ struct Approver::Impl {
   MissionRecord record;  ///< the mission's names and its inputs' digests when they were read
   maps::PlaneFrame frame;
   maps::Terrain terrain;
+  /// The map frame's inverse projection over the search box, built once (maps/map_ground_grid.hpp):
+  /// the ground and (lat, lon) of a state without a geodesic per state. Empty until the box is known.
+  std::optional<maps::MapGroundGrid> ground_grid;
   geofence::LevelLimits limits;
   std::unique_ptr<geofence::Obstructions> obstructions;
   std::unique_ptr<maps::BuildingIndex> index;
