@@ -1,6 +1,7 @@
 #include "geofence/fix_line.hpp"
 
 #include "maps/geodesy.hpp"
+#include "maps/plain_json.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -15,65 +16,7 @@ constexpr std::uint32_t kRequired = kTime | kLat | kLon | kH | kHpl | kVpl;
 /// Longest integer id echoed as written (nlohmann reads up to 19 digits as an integer).
 constexpr std::size_t kMaxIdDigits = 18;
 
-/// A cursor over the line; every read returns false on anything outside the plain form.
-struct Cursor {
-  const char* p;
-  const char* end;
-
-  void skipSpace() {
-    while (p != end && (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r')) ++p;
-  }
-  bool take(char c) {
-    skipSpace();
-    if (p == end || *p != c) return false;
-    ++p;
-    return true;
-  }
-  /// A string of printable ASCII without escapes: its characters (quotes excluded).
-  bool plainString(std::string_view& out) {
-    if (!take('"')) return false;
-    const char* start = p;
-    while (p != end && *p != '"') {
-      const auto c = static_cast<unsigned char>(*p);
-      if (c < 0x20 || c >= 0x7f || c == '\\') return false;
-      ++p;
-    }
-    if (p == end) return false;
-    out = std::string_view(start, static_cast<std::size_t>(p - start));
-    ++p;
-    return true;
-  }
-  /// A JSON number (RFC 8259 §6 grammar), read as the nearest double; `integer` tells whether
-  /// it had neither fraction nor exponent.
-  bool number(double& out, bool& integer) {
-    skipSpace();
-    const char* start = p;
-    if (p != end && *p == '-') ++p;
-    if (p == end || *p < '0' || *p > '9') return false;
-    if (*p == '0') {
-      ++p;
-    } else {
-      while (p != end && *p >= '0' && *p <= '9') ++p;
-    }
-    integer = true;
-    if (p != end && *p == '.') {
-      integer = false;
-      const char* digits = ++p;
-      while (p != end && *p >= '0' && *p <= '9') ++p;
-      if (p == digits) return false;
-    }
-    if (p != end && (*p == 'e' || *p == 'E')) {
-      integer = false;
-      ++p;
-      if (p != end && (*p == '+' || *p == '-')) ++p;
-      const char* digits = p;
-      while (p != end && *p >= '0' && *p <= '9') ++p;
-      if (p == digits) return false;
-    }
-    const auto [at, ec] = std::from_chars(start, p, out);
-    return ec == std::errc() && at == p && std::isfinite(out);
-  }
-};
+using Cursor = maps::PlainJsonCursor;
 
 bool readTime(Cursor& c, maps::GpsTime& out) {
   std::string_view text;
@@ -128,16 +71,14 @@ bool readMember(Cursor& c, PlainFix& out, std::uint32_t& seen) {
 }  // namespace
 
 bool readPlainFixLine(std::string_view text, PlainFix& out) {
-  Cursor c{text.data(), text.data() + text.size()};
+  Cursor c(text);
   out = PlainFix{};
   std::uint32_t seen = 0;
   if (!c.take('{')) return false;
   do {
     if (!readMember(c, out, seen)) return false;
   } while (c.take(','));
-  if (!c.take('}')) return false;
-  c.skipSpace();
-  if (c.p != c.end || (seen & kRequired) != kRequired) return false;
+  if (!c.take('}') || !c.atEnd() || (seen & kRequired) != kRequired) return false;
   if (!(seen & kUntil)) out.t1 = out.t0;
   return out.t1 - out.t0 >= 0;
 }

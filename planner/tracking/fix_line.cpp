@@ -9,10 +9,10 @@
 /// example and on generated lines, and fuzz_track on every input it makes).
 
 #include "maps/json_node.hpp"
+#include "maps/plain_json.hpp"
 #include "planner/tracking/track_fix.hpp"
 
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <optional>
 #include <string_view>
@@ -33,95 +33,24 @@ struct PlainLine {
   std::string_view flight, vehicle, time;
 };
 
-/// A cursor over the line; every step false when the line is not plain.
-class Cursor {
- public:
-  explicit Cursor(std::string_view s) : s_(s) {}
-  void space() {
-    while (i_ < s_.size() && (s_[i_] == ' ' || s_[i_] == '\t' || s_[i_] == '\r' || s_[i_] == '\n')) ++i_;
-  }
-  bool take(char c) {
-    space();
-    if (i_ >= s_.size() || s_[i_] != c) return false;
-    ++i_;
-    return true;
-  }
-  [[nodiscard]] bool atEnd() {
-    space();
-    return i_ == s_.size();
-  }
-  [[nodiscard]] char peek() {
-    space();
-    return i_ < s_.size() ? s_[i_] : '\0';
-  }
-  /// A string of printable ASCII without escapes.
-  bool string(std::string_view& out) {
-    if (!take('"')) return false;
-    const std::size_t start = i_;
-    while (i_ < s_.size() && s_[i_] != '"') {
-      const auto c = static_cast<unsigned char>(s_[i_]);
-      if (c < 0x20 || c > 0x7e || c == '\\') return false;
-      ++i_;
-    }
-    if (i_ >= s_.size()) return false;
-    out = s_.substr(start, i_ - start);
-    ++i_;
-    return true;
-  }
-  /// A number in JSON's grammar (-?(0|[1-9][0-9]*)(.[0-9]+)?([eE][+-]?[0-9]+)?), at most 15
-  /// digits when it is an integer (so its double is the one strtod gives as well).
-  bool number(double& out) {
-    space();
-    const std::size_t start = i_;
-    if (i_ < s_.size() && s_[i_] == '-') ++i_;
-    const std::size_t int_start = i_;
-    if (!digits()) return false;
-    if (s_[int_start] == '0' && i_ - int_start > 1) return false;
-    bool integer = true;
-    if (i_ < s_.size() && s_[i_] == '.') {
-      ++i_;
-      integer = false;
-      if (!digits()) return false;
-    }
-    if (i_ < s_.size() && (s_[i_] == 'e' || s_[i_] == 'E')) {
-      ++i_;
-      integer = false;
-      if (i_ < s_.size() && (s_[i_] == '+' || s_[i_] == '-')) ++i_;
-      if (!digits()) return false;
-    }
-    if (integer && i_ - int_start > 15) return false;
-    const auto r = std::from_chars(s_.data() + start, s_.data() + i_, out);
-    return r.ec == std::errc() && r.ptr == s_.data() + i_ && std::isfinite(out);
-  }
-
- private:
-  bool digits() {
-    const std::size_t start = i_;
-    while (i_ < s_.size() && s_[i_] >= '0' && s_[i_] <= '9') ++i_;
-    return i_ > start;
-  }
-  std::string_view s_;
-  std::size_t i_ = 0;
-};
-
 /// One "key": value pair into `p`; false when it is not a plain field or not plain.
-bool readPair(Cursor& c, PlainLine& p) {
+bool readPair(maps::PlainJsonCursor& c, PlainLine& p) {
   std::string_view key;
-  if (!c.string(key) || !c.take(':')) return false;
+  if (!c.plainString(key) || !c.take(':')) return false;
   std::size_t k = 0;
   while (k < kFieldCount && kFieldNames[k] != key) ++k;
   if (k == kFieldCount || p.seen[k]) return false;
   p.seen[k] = true;
-  if (k == kFlight) return c.string(p.flight);
-  if (k == kVehicle) return c.string(p.vehicle);
-  if (k == kTime) return c.string(p.time);
-  return c.number(p.number[k]);
+  if (k == kFlight) return c.plainString(p.flight);
+  if (k == kVehicle) return c.plainString(p.vehicle);
+  if (k == kTime) return c.plainString(p.time);
+  bool integer = false;
+  return c.number(p.number[k], integer);
 }
 
 bool readPlainLine(std::string_view text, PlainLine& p) {
-  Cursor c(text);
+  maps::PlainJsonCursor c(text);
   if (!c.take('{')) return false;
-  if (c.peek() == '}') return false;  // {} is the general way's error
   do {
     if (!readPair(c, p)) return false;
   } while (c.take(','));

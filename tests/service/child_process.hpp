@@ -23,9 +23,10 @@ namespace skylane::test {
 
 // (Shared by the service and NATS tests and the load generator bench/nats_load.cpp.)
 
-/// A free TCP port on 127.0.0.1 (bound and released: the kernel does not hand it out again at once).
-inline int freeTcpPort() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+/// A port of `type` (SOCK_STREAM, SOCK_DGRAM) free on 127.0.0.1 now (bound and released: the
+/// kernel does not hand it out again at once).
+inline int freePort(int type) {
+  const int fd = ::socket(AF_INET, type, 0);
   sockaddr_in a{};
   a.sin_family = AF_INET;
   a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
@@ -35,19 +36,8 @@ inline int freeTcpPort() {
   ::close(fd);
   return ntohs(a.sin_port);
 }
-
-/// A UDP port free on the loopback interface now (the kernel's choice).
-inline int freeUdpPort() {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t n = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
+inline int freeTcpPort() { return freePort(SOCK_STREAM); }
+inline int freeUdpPort() { return freePort(SOCK_DGRAM); }
 
 inline bool tcpAccepts(int port) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
