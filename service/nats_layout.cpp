@@ -1,5 +1,6 @@
 #include "service/nats_layout.hpp"
 
+#include <cstdint>
 #include <stdexcept>
 
 namespace skylane::service::nats {
@@ -17,6 +18,14 @@ std::string fixSubject(const std::string& op, const std::string& flight) { retur
 std::string partitionFilter(int partition) { return "skylane.fixp." + std::to_string(partition) + ".*.*"; }
 std::string eventSubject(const std::string& op, const std::string& flight) { return "skylane.event." + op + "." + flight; }
 std::string approvalSubject(const std::string& op, const std::string& id) { return "skylane.approve." + op + "." + id; }
+
+int partitionOf(std::string_view op, std::string_view flight, int partitions) {
+  std::uint32_t h = 2166136261u;  // FNV-1a offset basis and prime
+  for (std::string_view token : {op, flight}) {
+    for (unsigned char c : token) h = (h ^ c) * 16777619u;
+  }
+  return static_cast<int>(h % static_cast<std::uint32_t>(partitions));
+}
 
 std::string serverMappings(int partitions) {
   return "mappings = {\n  \"skylane.fix.*.*\": \"skylane.fixp.{{partition(" + std::to_string(partitions) +

@@ -44,6 +44,10 @@ inline constexpr int kLeaseTtl_s = 5;  ///< a partition whose worker stopped ref
 [[nodiscard]] std::string partitionFilter(int partition);
 [[nodiscard]] std::string eventSubject(const std::string& op, const std::string& flight);
 [[nodiscard]] std::string approvalSubject(const std::string& op, const std::string& id);
+/// \brief The partition the server's mapping (serverMappings) sends `flight`'s fixes to: its
+/// `partition(n,1,2)` transform, FNV-1a (32 bits) of the operator and flight tokens one after
+/// the other, modulo `partitions` (tested against nats-server).
+[[nodiscard]] int partitionOf(std::string_view op, std::string_view flight, int partitions);
 /// \brief The server configuration's `mappings` block that spreads fixes over `partitions`.
 [[nodiscard]] std::string serverMappings(int partitions);
 /// \brief Makes (or checks) every stream and bucket; records the partition count, or checks it

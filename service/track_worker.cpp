@@ -97,12 +97,17 @@ class Worker {
   void judgeFix(Partition& p, FlightSlot& slot, const NatsMessage& m, planner::TrackFix fix, std::vector<Outgoing>& out);
   void startFlight(Partition& p, FlightSlot& slot, const json& body);
   FlightSlot& slotOf(Partition& p, const std::string& op, const std::string& flight);
+  FlightSlot& restoreFlight(Partition& p, const std::string& op, const std::string& flight, const json& cp);
+  void loadFlightsOf(Partition& p);
+  void tellZoneSetsSinceCheckpoint(Partition& p, FlightSlot& slot, const json& cp);
+  void tellZoneSet(const std::string& id, FlightSlot& slot, const std::string& name, std::uint64_t version);
+  void handOver(Partition& p);
   void loadApproval(Partition& p, FlightSlot& slot, const std::string& id);
   void checkZoneSets();
   void followZoneSets(Partition& p, const std::string& dir, ApprovalZones& a);
   bool tryZoneSetVersion(Partition& p, const std::string& dir, ApprovalZones& a, const std::string& name, const NatsEntry& e,
                          std::string& why);
-  void announceZoneSet(const Partition& p, const std::string& dir, const std::string& name, std::uint64_t version);
+  void announceZoneSet(Partition& p, const std::string& dir, const std::string& name, std::uint64_t version);
   void checkZoneSetsWhileIdle();
   void sweepStale(Partition& p, std::uint64_t last_seq, std::vector<Outgoing>& out);
   void commit(std::vector<Taken>& taken, const std::vector<Outgoing>& out);
@@ -163,6 +168,7 @@ bool Worker::acquire(Partition& p) {
   p.known = std::set<std::string>(keys.begin(), keys.end());
   p.deliveries = 0;
   p.judged_seq = p.covered_seq;
+  loadFlightsOf(p);
   p.pull = nats_.pullFrom(nats::kFixStream, "track-" + leaseKey(p.index), nats::partitionFilter(p.index), p.covered_seq + 1);
   p.held = true;
   ++c_.partitions_held;
@@ -208,6 +214,7 @@ void Worker::refreshLeases() {
       if (!p.held) {
         if (held < share && acquire(p)) ++held;
       } else if (held >= share && !released) {  // more than its share: one goes back each second
+        handOver(p);
         drop(p, "another worker takes its share");
         nats_.erase(nats::kLeaseBucket, leaseKey(p.index));
         p.lease_rev = 0;
@@ -228,16 +235,26 @@ void Worker::refreshLeases() {
 FlightSlot& Worker::slotOf(Partition& p, const std::string& op, const std::string& flight) {
   const std::string id = op + "." + flight;
   if (const auto it = p.flights.find(id); it != p.flights.end()) return it->second;
+  const auto cp = p.known.count(id) > 0 ? nats_.get(nats::kFlightBucket, id) : std::nullopt;
+  if (cp) return restoreFlight(p, op, flight, json::parse(cp->value));
   FlightSlot slot;
   slot.op = op;
   slot.flight = flight;
-  const auto cp = p.known.count(id) > 0 ? nats_.get(nats::kFlightBucket, id) : std::nullopt;
-  if (cp) {
-    const json j = json::parse(cp->value);
-    slot.approval = j.at("approval").get<std::string>();
-    slot.covered_seq = j.at("seq").get<std::uint64_t>();
+  return p.flights.emplace(id, std::move(slot)).first->second;
+}
+
+/// A flight as its checkpoint `cp` left it: its approval loaded (when it was started), the
+/// tracker's state and route restored, and told of zone set versions put in force since.
+FlightSlot& Worker::restoreFlight(Partition& p, const std::string& op, const std::string& flight, const json& cp) {
+  const std::string id = op + "." + flight;
+  FlightSlot slot;
+  slot.op = op;
+  slot.flight = flight;
+  slot.approval = cp.at("approval").get<std::string>();
+  slot.covered_seq = cp.at("seq").get<std::uint64_t>();
+  if (!slot.approval.empty()) {  // a flight whose messages were all refused has no approval yet
     loadApproval(p, slot, id);
-    const planner::FlightState st = planner::parseFlightState(j.at("state"), "NATS checkpoint of flight " + id);
+    const planner::FlightState st = planner::parseFlightState(cp.at("state"), "NATS checkpoint of flight " + id);
     json route;
     if (st.route_version > 0) {
       const auto r = nats_.get(nats::kFlightBucket, id + ".route");
@@ -246,7 +263,41 @@ FlightSlot& Worker::slotOf(Partition& p, const std::string& op, const std::strin
     p.tracker->restore(id, st, route);
     slot.checkpointed_route = st.route_version;
   }
-  return p.flights.emplace(id, std::move(slot)).first->second;
+  FlightSlot& s = p.flights.emplace(id, std::move(slot)).first->second;
+  tellZoneSetsSinceCheckpoint(p, s, cp);
+  return s;
+}
+
+/// The flights of a partition just taken that have a checkpoint, were started and are not at
+/// their goal, loaded at once (not at their next fix): a zone set's new version reaches them
+/// while they are quiet.
+void Worker::loadFlightsOf(Partition& p) {
+  for (const std::string& id : p.known) {
+    const std::vector<std::string> t = nats::subjectTokens(id);
+    if (t.size() != 2 || !nats::validId(t[0]) || !nats::validId(t[1])) continue;  // a route or GeoJSON key
+    if (nats::partitionOf(t[0], t[1], partition_count_) != p.index || p.flights.count(id) > 0) continue;
+    const auto cp = nats_.get(nats::kFlightBucket, id);
+    if (!cp) continue;
+    try {
+      const json j = json::parse(cp->value);
+      if (j.at("approval").get<std::string>().empty() || j.at("state").value("arrived", false)) continue;
+      (void)restoreFlight(p, t[0], t[1], j);
+    } catch (const Rejected& r) {
+      log("partition " + std::to_string(p.index) + ": flight " + id + " not loaded: " + r.why);
+    } catch (const NatsError&) {
+      throw;
+    } catch (const std::exception& e) {
+      log("partition " + std::to_string(p.index) + ": flight " + id + " not loaded: " + e.what());
+    }
+  }
+}
+
+/// Before a partition goes to another worker: its flights' and its own checkpoints, so that the
+/// next holder starts where this one stopped (and knows every flight at once).
+void Worker::handOver(Partition& p) {
+  putFlightCheckpoints(p);
+  nats_.publishesComplete();
+  if (p.judged_seq > p.covered_seq) (void)putPartitionCheckpoint(p, p.judged_seq);
 }
 
 /// The approval's bundle, unpacked once per worker into the cache, registered under `id`.
@@ -348,11 +399,30 @@ void Worker::followZoneSets(Partition& p, const std::string& dir, ApprovalZones&
 
 /// Each flight of the approval unpacked in `dir` is told by an event that a zone set's version
 /// is in force for it (its next fixes are judged against it).
-void Worker::announceZoneSet(const Partition& p, const std::string& dir, const std::string& name, std::uint64_t version) {
-  for (const auto& [id, slot] : p.flights) {
-    if (slot.approval_dir != dir) continue;
-    const json e = {{"event", "zoneset_in_force"}, {"flight", slot.flight}, {"zoneset", name}, {"version", version}};
-    nats_.publishAsync(nats::eventSubject(slot.op, slot.flight), e.dump(), "zoneset." + id + "." + name + "." + std::to_string(version));
+void Worker::announceZoneSet(Partition& p, const std::string& dir, const std::string& name, std::uint64_t version) {
+  for (auto& [id, slot] : p.flights) {
+    if (slot.approval_dir == dir) tellZoneSet(id, slot, name, version);
+  }
+}
+
+/// The zoneset_in_force event of one flight; its checkpoint records the version told.
+void Worker::tellZoneSet(const std::string& id, FlightSlot& slot, const std::string& name, std::uint64_t version) {
+  const json e = {{"event", "zoneset_in_force"}, {"flight", slot.flight}, {"zoneset", name}, {"version", version}};
+  nats_.publishAsync(nats::eventSubject(slot.op, slot.flight), e.dump(), "zoneset." + id + "." + name + "." + std::to_string(version));
+  slot.dirty = true;
+}
+
+/// A flight loaded from its checkpoint is told of each zone set whose version in force here is
+/// not the one its checkpoint records (put while no worker had the flight loaded, or told by a
+/// worker that stopped before its next checkpoint: a repeat within the event stream's duplicate
+/// window is dropped by its message id).
+void Worker::tellZoneSetsSinceCheckpoint(Partition& p, FlightSlot& slot, const json& cp) {
+  const auto z = p.approvals.find(slot.approval_dir);
+  const auto told = cp.find("zonesets");
+  if (z == p.approvals.end() || told == cp.end() || !told->is_object()) return;
+  for (const auto& [name, f] : z->second.zonesets) {
+    const auto t = told->find(name);
+    if (t != told->end() && *t != f.version) tellZoneSet(slot.op + "." + slot.flight, slot, name, f.version);
   }
 }
 
@@ -481,6 +551,9 @@ void Worker::putFlightCheckpoints(Partition& p) {
     } else {
       cp["state"] = planner::flightStateJson(planner::FlightState{});
     }
+    if (const auto z = p.approvals.find(slot.approval_dir); z != p.approvals.end()) {
+      for (const auto& [name, f] : z->second.zonesets) cp["zonesets"][name] = f.version;  // the versions it was told
+    }
     nats_.putAsync(nats::kFlightBucket, id, cp.dump());
     slot.dirty = false;
   }
@@ -513,7 +586,7 @@ void Worker::commit(std::vector<Taken>& taken, const std::vector<Outgoing>& out)
 void Worker::checkpointAll() {
   last_checkpoint_ = Clock::now();
   for (Partition& p : parts_) {
-    if (p.held && p.judged_seq > p.covered_seq) putFlightCheckpoints(p);
+    if (p.held) putFlightCheckpoints(p);  // those judged or told of a zone set since the last
   }
   nats_.publishesComplete();
   for (Partition& p : parts_) {

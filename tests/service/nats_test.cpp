@@ -126,7 +126,7 @@ class NatsWorkers : public ::testing::Test {
     return e;
   }
   /// See ZurichFlights; its report is null when the approval failed.
-  ZurichFlights startZurichFlights();
+  ZurichFlights startZurichFlights(bool second_worker = true);
   std::string dir_;
   std::unique_ptr<NatsServer> server_;
   std::unique_ptr<NatsClient> client_;
@@ -304,7 +304,7 @@ std::string zurichMission(const std::string& dir) {
 }
 
 
-ZurichFlights NatsWorkers::startZurichFlights() {
+ZurichFlights NatsWorkers::startZurichFlights(bool second_worker) {
   ZurichFlights z;
   z.v1 = putZurich(server_->url(), std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/zones_ed269.json");
   auto approver = worker("approve", "ap1");
@@ -313,7 +313,7 @@ ZurichFlights NatsWorkers::startZurichFlights() {
   if (st.at("status") != "approved") return z;
   z.rep = report("a1");
   z.w1 = worker("track", "tr1");
-  z.w2 = worker("track", "tr2");
+  if (second_worker) z.w2 = worker("track", "tr2");
   for (const std::string& f : z.flights) client_->publish(nats::fixSubject("acme", f), json{{"start", {{"approval", "a1"}}}}.dump());
   return z;
 }
@@ -423,6 +423,78 @@ TEST_F(NatsWorkers, AZoneSetUpdateReachesQuietWorkersAndEachFlightIsToldWithoutA
   EXPECT_EQ(count(ev, "fix"), flights.size());  // no fix was needed for it
   std::printf("zone set version in force at every quiet worker after %.3f s (the workers look every 0.25 s)\n", seconds);
   EXPECT_LT(seconds, 10.0);  // 1 s on a quiet machine; the margin is for a loaded test run
+}
+
+/// Partitions handed over with quiet flights: the worker taking them loads their flights at once,
+/// so a zone set version put then is told to each; a version put while no worker runs is told to
+/// each flight by the worker that starts next — no fix needed either time.
+TEST_F(NatsWorkers, FlightsOfAPartitionTakenOverAreToldOfZoneSetVersionsWithoutAFix) {
+  const std::string examples = std::string(SKYLANE_SOURCE_DIR) + "/examples/approve/";
+  ZurichFlights z = startZurichFlights(false);
+  ASSERT_FALSE(z.rep.is_null());
+  for (const std::string& f : z.flights) client_->publish(nats::fixSubject("acme", f), fixAt(z.rep, 0).dump());
+  (void)waitFor([&](const std::vector<json>& e) { return count(e, "fix") >= z.flights.size(); });
+  // A second worker takes half the partitions from the first, whose flights are quiet.
+  auto w2 = worker("track", "tr2");
+  const auto holds = [](const std::string& log) {
+    std::size_t n = 0;
+    for (std::size_t at = log.find("holds partition"); at != std::string::npos; at = log.find("holds partition", at + 1)) ++n;
+    return n;
+  };
+  for (int i = 0; i < 300 && holds(w2->log()) < kPartitions / 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_EQ(holds(w2->log()), static_cast<std::size_t>(kPartitions / 2)) << w2->log();
+  const std::uint64_t v2 = putZurich(server_->url(), examples + "zones_ed269.json");
+  const auto told = [&](const std::vector<json>& e, std::uint64_t v) {
+    return static_cast<std::size_t>(std::count_if(e.begin(), e.end(), [&](const json& x) { return x.at("event") == "zoneset_in_force" && x.at("version") == v; }));
+  };
+  std::vector<json> ev = waitFor([&](const std::vector<json>& e) { return told(e, v2) >= z.flights.size(); }, 30);
+  ASSERT_EQ(told(ev, v2), z.flights.size()) << z.w1->log() << w2->log();
+  // Both stop; version 3 is put while no worker runs; the next worker tells every flight.
+  EXPECT_EQ(z.w1->kill(SIGTERM), 0);
+  EXPECT_EQ(w2->kill(SIGTERM), 0);
+  std::ofstream(dir_ + "/zones_v3.json") << test::withClosureAt(json::parse(std::ifstream(examples + "zones_ed269.json")), fixAt(z.rep, 25)).dump();
+  const std::uint64_t v3 = putZurich(server_->url(), dir_ + "/zones_v3.json");
+  auto w3 = worker("track", "tr3");
+  ev = waitFor([&](const std::vector<json>& e) { return told(e, v3) >= z.flights.size(); }, 30);
+  EXPECT_EQ(told(ev, v3), z.flights.size()) << w3->log();
+  std::set<std::string> flights;
+  for (const json& e : ev) {
+    if (e.at("event") == "zoneset_in_force" && e.at("version") == v3) flights.insert(e.at("flight").get<std::string>());
+  }
+  EXPECT_EQ(flights.size(), z.flights.size());
+  EXPECT_EQ(count(ev, "fix"), z.flights.size());  // no fix was needed
+}
+
+/// The partition a worker computes for a flight (to load a taken partition's flights at once) is
+/// the one nats-server's mapping sends its fixes to: 300 ids of 1–64 characters, 4 and 37 partitions.
+TEST_F(NatsWorkers, AFlightsPartitionIsTheOneTheServersMappingSendsItsFixesTo) {
+  NatsServer wide(std::filesystem::path(dir_) / "server37", 37);
+  ASSERT_EQ(test::runCommand(std::string(SKYLANE_BINARY) + " nats setup --nats " + wide.url() + " --partitions 37").status, 0);
+  NatsClient wide_client(wide.url(), "test");
+  const std::string chars = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_";
+  std::uint32_t state = 12345;
+  const auto next = [&] { return state = state * 1103515245u + 12345u, (state >> 8); };
+  std::vector<std::pair<std::string, std::string>> ids;
+  for (int i = 0; i < 300; ++i) {
+    std::string op(1 + next() % 64, 'a'), flight(1 + next() % 64, 'a');
+    for (char& c : op) c = chars[next() % 62];  // an id does not start with '_'
+    for (std::size_t k = 1; k < flight.size(); ++k) flight[k] = chars[next() % chars.size()];
+    ids.emplace_back(op, flight);
+  }
+  for (auto [client, partitions] : {std::pair<NatsClient*, int>{client_.get(), kPartitions}, {&wide_client, 37}}) {
+    for (const auto& [op, flight] : ids) (void)client->publish(nats::fixSubject(op, flight), "{}");
+    std::set<int> seen;
+    for (std::uint64_t s = 1; s <= ids.size(); ++s) {
+      const auto m = client->message(nats::kFixStream, s);
+      ASSERT_TRUE(m.has_value());
+      const std::vector<std::string> t = nats::subjectTokens(m->subject);
+      ASSERT_EQ(t.size(), 5u) << m->subject;
+      EXPECT_EQ(std::stoi(t[2]), nats::partitionOf(t[3], t[4], partitions)) << m->subject;
+      EXPECT_EQ(t[3], ids[s - 1].first);
+      seen.insert(std::stoi(t[2]));
+    }
+    EXPECT_EQ(seen.size(), static_cast<std::size_t>(partitions));  // every partition is reached (no constant answer)
+  }
 }
 
 TEST_F(NatsWorkers, TwoApproveWorkersDoEachRequestOnceAndABadRequestIsInvalidByName) {
