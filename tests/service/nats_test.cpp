@@ -171,6 +171,33 @@ TEST_F(NatsWorkers, AFlightsEventsEqualSkylaneTracksAndBadMessagesAreRejectedByN
   EXPECT_TRUE(tracker->running());
 }
 
+/// A flight whose only message was refused (a fix before its start) has a checkpoint without an
+/// approval; after a restart the worker restores it as not started, and its start is taken.
+TEST_F(NatsWorkers, AFlightWhoseMessagesWereAllRefusedStartsAfterARestart) {
+  auto approver = worker("approve", "ap1");
+  ASSERT_EQ(approve("a1").at("status"), "approved") << approver->log();
+  const json rep = report("a1");
+  auto first = worker("track", "tr1");
+  const std::string subject = nats::fixSubject("acme", "f1");
+  const auto of_f1 = [](const std::vector<json>& e, const std::string& type) {
+    return static_cast<std::size_t>(std::count_if(e.begin(), e.end(), [&](const json& x) {
+      return x.at("_subject") == nats::eventSubject("acme", "f1") && x.at("event") == type;
+    }));
+  };
+  client_->publish(subject, fixAt(rep, 0).dump());
+  std::vector<json> ev = waitFor([&](const std::vector<json>& e) { return of_f1(e, "rejected_input") >= 1; });
+  ASSERT_EQ(of_f1(ev, "rejected_input"), 1u) << first->log();
+  EXPECT_EQ(first->kill(SIGTERM), 0);  // a clean stop: the flight's checkpoint is written
+  ASSERT_TRUE(client_->get(nats::kFlightBucket, "acme.f1").has_value());
+  auto second = worker("track", "tr2");
+  client_->publish(subject, json{{"start", {{"approval", "a1"}}}}.dump());
+  client_->publish(subject, fixAt(rep, 1).dump());
+  ev = waitFor([&](const std::vector<json>& e) { return of_f1(e, "fix") >= 1 || of_f1(e, "rejected_input") >= 2; });
+  EXPECT_EQ(of_f1(ev, "flight_started"), 1u) << second->log();
+  EXPECT_EQ(of_f1(ev, "fix"), 1u) << second->log();
+  EXPECT_EQ(of_f1(ev, "rejected_input"), 1u);
+}
+
 /// Four flights, fixes published while the worker that holds the partitions is killed -9; a
 /// second worker (running all along, its leases refused) takes them over from the checkpoints.
 TEST_F(NatsWorkers, AKilledTrackWorkerIsReplacedAndEveryFixIsJudgedOnceWithNoEventLostOrDoubled) {
