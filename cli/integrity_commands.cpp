@@ -235,6 +235,7 @@ struct PredictOptions {
   std::string ism;
   std::string user_model = "dual_frequency";
   std::string method = "araim";
+  bool with_exclusion = false;
   bool progress = false;
   std::string buildings;
   std::string terrain;
@@ -255,6 +256,7 @@ integrity::PredictRequest predictRequest(const PredictOptions& o) {
   if (o.user_model == "single_frequency") req.model.setUserModel(integrity::UserErrorModel::kSingleFrequency);
   else if (o.user_model != "dual_frequency") throw ParseError("--user-model", 0, "--user-model", o.user_model, "dual_frequency or single_frequency");
   if (!o.ism.empty()) applyIsmFile(o.ism, req.model);
+  req.with_exclusion = o.with_exclusion;
   if (o.format != "csv" && o.format != "jsonl") throw ParseError("--format", 0, "--format", o.format, "csv or jsonl");
 
   if (!o.buildings.empty() || !o.terrain.empty()) {
@@ -285,13 +287,14 @@ std::string predictCsvLine(const integrity::PredictSample& s, integrity::Integri
 }
 
 json predictJsonLine(const integrity::PredictSample& s, const std::string& method_name,
-                     integrity::IntegrityMethod method, bool has_sky_mask) {
+                     integrity::IntegrityMethod method, bool has_sky_mask, bool with_exclusion) {
   std::vector<integrity::SatId> ids;
   for (const auto& l : s.sats) ids.push_back(l.sat);
   const bool ok = s.pl.pl_computed;
   json j;
   j["time"] = integrity::formatRfc3339(s.t);
   j["method"] = method_name;
+  if (with_exclusion) j["with_exclusion"] = true;
   j["available"] = s.pl.available;
   j["pl_computed"] = ok;
   if (!s.pl.reason.empty()) j["reason"] = s.pl.reason;
@@ -319,7 +322,7 @@ void writePredictSamples(std::ostream& out, const std::vector<integrity::Predict
     if (o.format == "csv") {
       out << predictCsvLine(s, method);
     } else {
-      out << predictJsonLine(s, o.method, method, has_sky_mask).dump() << "\n";
+      out << predictJsonLine(s, o.method, method, has_sky_mask, o.with_exclusion).dump() << "\n";
     }
   }
 }
@@ -338,8 +341,9 @@ void writePredictPlot(std::ostream& out, const std::vector<integrity::PredictSam
     nsat.push_back(static_cast<double>(s.sats.size()));
   }
   char title[200];
-  std::snprintf(title, sizeof title, "%s protection levels at %.4f°, %.4f°, %.0f m from %s", method == integrity::IntegrityMethod::kAraim ? "ARAIM" : "RAIM",
-                o.lat_deg, o.lon_deg, o.alt_m, integrity::formatRfc3339(req.start).c_str());
+  std::snprintf(title, sizeof title, "%s protection levels%s at %.4f°, %.4f°, %.0f m from %s",
+                method == integrity::IntegrityMethod::kAraim ? "ARAIM" : "RAIM", o.with_exclusion ? " with exclusion" : "", o.lat_deg,
+                o.lon_deg, o.alt_m, integrity::formatRfc3339(req.start).c_str());
   const std::string svg = renderTimeSeriesSvg(
       title, "time since start",
       x,
@@ -452,6 +456,7 @@ struct AvailabilityOptions {
   std::string map;
   int threads = 0;
   bool horizontal_only = false;
+  bool with_exclusion = false;
   bool progress = false;
 };
 
@@ -471,6 +476,7 @@ void runAvailability(const AvailabilityOptions& o) {
   if (o.threads < 0 || o.threads > 256) throw ParseError("--threads", 0, "--threads", std::to_string(o.threads), "0 (all cores) to 256");
   req.threads = o.threads;
   req.araim.horizontal_only = o.horizontal_only;
+  req.with_exclusion = o.with_exclusion;
   if (!o.ism.empty()) applyIsmFile(o.ism, req.model);
   const integrity::OrbitSource orbits = loadOrbits(o.almanacs, o.navs);
   maps::OutputSet outputs;  // staged first: a path that cannot be written fails before the work
@@ -491,8 +497,8 @@ void runAvailability(const AvailabilityOptions& o) {
   const double cov = map.coveragePercent(99.5);
   if (map_svg) {
     char title[200];
-    std::snprintf(title, sizeof title, "%s availability%s, %s + %s, mask %.0f°, step %s", o.method == "araim" ? "ARAIM" : "RAIM",
-                  o.horizontal_only ? " (horizontal)" : " (LPV-200)", integrity::formatRfc3339(req.start).c_str(),
+    std::snprintf(title, sizeof title, "%s%s availability%s, %s + %s, mask %.0f°, step %s", o.method == "araim" ? "ARAIM" : "RAIM",
+                  o.with_exclusion ? " FDE" : "", o.horizontal_only ? " (horizontal)" : " (LPV-200)", integrity::formatRfc3339(req.start).c_str(),
                   o.duration.c_str(), o.mask_deg, o.step.c_str());
     char footer[200];
     std::snprintf(footer, sizeof footer, "%.1f° grid, %zu user-epochs; %.2f %% of the area has ≥ 99.5 %% availability",
@@ -534,6 +540,7 @@ void addIntegrityCommands(CLI::App& app) {
   c->add_option("--ism", pr->ism, "JSON file with an ism object overriding the defaults");
   c->add_option("--user-model", pr->user_model, "dual_frequency or single_frequency");
   c->add_option("--method", pr->method, "integrity method: araim (default) or raim");
+  c->add_flag("--fde", pr->with_exclusion, "PLs of a user who detects and excludes: the worst exclusion outcome, each with its share of the budget");
   c->add_option("--buildings", pr->buildings, "GeoJSON buildings: drop satellites behind them (sky mask at the place)");
   c->add_option("--terrain", pr->terrain, "terrain raster: ground under --buildings, and drop satellites behind the terrain");
   c->add_option("--ground-amsl", pr->ground_amsl_m, "flat ground under --buildings at this altitude AMSL [m] (default 0)");
@@ -556,6 +563,7 @@ void addIntegrityCommands(CLI::App& app) {
   c->add_option("--map", av->map, "write an SVG world map with a colour scale");
   c->add_option("--threads", av->threads, "worker threads (0 = all cores)");
   c->add_flag("--horizontal-only", av->horizontal_only, "availability from HPL <= HAL only (H-ARAIM)");
+  c->add_flag("--fde", av->with_exclusion, "PLs of a user who detects and excludes (worst exclusion outcome)");
   c->add_flag("--progress", av->progress, "show a progress bar even when stderr is not a terminal");
   c->callback([av] { runAvailability(*av); });
 

@@ -66,7 +66,7 @@ AvailabilityMap computeAvailability(const OrbitSource& orbits, const Availabilit
           looks.push_back({sat, {az, el}});
         }
         const Geometry g = buildGeometry(looks, req.model, tau);
-        const PlSummary s = protectionLevels(g, req.method, req.model, req.raim, req.araim);
+        const PlSummary s = protectionLevels(g, req.method, req.model, req.raim, req.araim, req.with_exclusion);
         ++cell.epochs;
         cell.available += s.available ? 1 : 0;
         if (s.pl_computed) {

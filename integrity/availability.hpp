@@ -23,6 +23,7 @@ struct AvailabilityRequest {
   ErrorModel model;
   RaimConfig raim;
   AraimConfig araim;
+  bool with_exclusion = false;  ///< the PLs of a user who excludes (PredictRequest::with_exclusion)
   int threads = 0;  ///< 0 = all hardware threads
 };
 

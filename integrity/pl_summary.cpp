@@ -1,5 +1,7 @@
 #include "integrity/pl_summary.hpp"
 
+#include "integrity/araim/exclusion.hpp"
+
 namespace skylane::integrity {
 
 PlSummary summarize(const RaimPl& pl, const Requirements& req) {
@@ -27,9 +29,11 @@ PlSummary summarize(const AraimResult& r) {
 }
 
 PlSummary protectionLevels(const Geometry& g, IntegrityMethod method, const ErrorModel& model, const RaimConfig& raim,
-                           const AraimConfig& araim) {
-  return method == IntegrityMethod::kAraim ? summarize(araimProtectionLevels(g, model, araim))
-                                           : summarize(raimProtectionLevels(g, raim), araim.requirements);
+                           const AraimConfig& araim, bool with_exclusion) {
+  if (method == IntegrityMethod::kAraim) {
+    return summarize(with_exclusion ? araimFdeProtectionLevels(g, model, araim) : araimProtectionLevels(g, model, araim));
+  }
+  return summarize(with_exclusion ? raimFdeProtectionLevels(g, raim) : raimProtectionLevels(g, raim), araim.requirements);
 }
 
 }  // namespace skylane::integrity

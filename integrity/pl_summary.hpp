@@ -29,8 +29,10 @@ struct PlSummary {
 [[nodiscard]] PlSummary summarize(const AraimResult& r);
 
 /// \brief Protection levels of a geometry with the chosen method (availability from the ARAIM
-/// config's requirements for both methods).
+/// config's requirements for both methods). `with_exclusion`: the predicted PLs of a user who
+/// detects and excludes (araimFdeProtectionLevels, raimFdeProtectionLevels), the maximum over
+/// the exclusion outcomes each with its share of the budget; otherwise those of detection only.
 [[nodiscard]] PlSummary protectionLevels(const Geometry& g, IntegrityMethod method, const ErrorModel& model,
-                                         const RaimConfig& raim, const AraimConfig& araim);
+                                         const RaimConfig& raim, const AraimConfig& araim, bool with_exclusion = false);
 
 }  // namespace skylane::integrity

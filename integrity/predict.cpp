@@ -36,7 +36,7 @@ PredictSample predictAt(const OrbitSource& orbits, const PredictRequest& req, co
   }
   const Geometry g = buildGeometry(s.sats, req.model, tau);
   s.dops = computeDops(g);
-  s.pl = protectionLevels(g, method, req.model, req.raim, req.araim);
+  s.pl = protectionLevels(g, method, req.model, req.raim, req.araim, req.with_exclusion);
   return s;
 }
 

@@ -25,6 +25,9 @@ struct PredictRequest {
   ErrorModel model;
   RaimConfig raim;
   AraimConfig araim;  ///< its requirements are the ones used for availability
+  /// The PLs of a user who detects and excludes: the maximum over the exclusion outcomes
+  /// (pl_summary.hpp protectionLevels); false: detection only.
+  bool with_exclusion = false;
   /// Buildings and terrain around the place (maps::computeSkyMask): a satellite above
   /// mask_rad but not above its azimuth bin's blocked elevation is dropped.
   std::optional<maps::SkyMask> sky_mask;

@@ -190,6 +190,7 @@ integrity::PredictSample Approver::Impl::predictAt(const maps::Geodetic& g, cons
   req.mask_rad = maps::deg2rad(m.mask_deg);
   req.model = m.model;
   req.sky_mask = mask;
+  req.with_exclusion = m.with_exclusion;
   integrity::PredictSample s = integrity::predictAt(orbits, req, t, m.method);
   if (m.navigation.kind == NavigationKind::kReceiver) {
     // The receiver states its PLs: they hold wherever it is (the satellites are still counted).

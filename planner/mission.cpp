@@ -559,13 +559,14 @@ void readDataFiles(const JsonNode& root, const std::string& base_dir, Mission& m
 }
 
 void readIntegrity(const JsonNode& n, Mission& m) {
-  n.requireKnownFields({"method", "mask_deg", "user_model", "sample_s", "cost_weight", "cost_cell_m"});
+  n.requireKnownFields({"method", "fde", "mask_deg", "user_model", "sample_s", "cost_weight", "cost_cell_m"});
   if (n.has("method")) {
     const std::string meth = n.at("method").str();
     if (meth == "raim") m.method = integrity::IntegrityMethod::kRaim;
     else if (meth == "araim") m.method = integrity::IntegrityMethod::kAraim;
     else n.at("method").fail("\"raim\" or \"araim\"");
   }
+  if (n.has("fde")) m.with_exclusion = n.at("fde").boolean();
   if (n.has("mask_deg")) m.mask_deg = n.at("mask_deg").number();
   if (n.has("user_model")) {
     const std::string u = n.at("user_model").str();

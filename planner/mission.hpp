@@ -113,6 +113,7 @@ struct Mission {
   std::set<std::string> authorisations;
   std::vector<std::string> orbit_files;
   integrity::IntegrityMethod method = integrity::IntegrityMethod::kRaim;
+  bool with_exclusion = false;  ///< `integrity.fde`: the predicted PLs of a user who excludes
   double mask_deg = 5.0;
   integrity::ErrorModel model;
   NavigationModel navigation;  ///< how the PLs are predicted (default: GNSS alone)

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <tuple>
@@ -139,6 +140,58 @@ RaimConfig fdeOutcomeConfig(const Geometry& g, const RaimConfig& cfg, RaimFdeRes
 }
 
 }  // namespace
+
+namespace {
+
+/// `g` without the satellites `removed` (ascending indices).
+Geometry withoutSatellitesSet(const Geometry& g, const std::vector<int>& removed) {
+  Geometry out = g;
+  for (auto it = removed.rbegin(); it != removed.rend(); ++it) out = out.without(*it);
+  return out;
+}
+
+/// Calls `visit` with every set of 1 to `max_r` of the indices 0..n−1 (ascending) whose removal
+/// leaves more than `m` satellites, in lexicographic order; stops when `visit` returns false.
+bool forEachExclusion(int n, int m, int max_r, std::vector<int>& set, int from,
+                      const std::function<bool(const std::vector<int>&)>& visit) {
+  if (static_cast<int>(set.size()) == max_r || n - static_cast<int>(set.size()) - 1 <= m) return true;
+  for (int i = from; i < n; ++i) {
+    set.push_back(i);
+    const bool go_on = visit(set) && forEachExclusion(n, m, max_r, set, i + 1, visit);
+    set.pop_back();
+    if (!go_on) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+RaimPl raimFdeProtectionLevels(const Geometry& g, const RaimConfig& cfg) {
+  const int n_exc = raimExclusionCandidates(g.numSats(), g.numStates(), cfg.max_exclusions);
+  const double share = cfg.exclusion_pl == ExclusionPl::kAllocated ? 1.0 / (n_exc + 1.0) : 1.0;
+  const RaimConfig outcome = outcomeConfig(cfg, share);
+  RaimPl worst = raimProtectionLevels(g, outcome);
+  if (!worst.available) return worst;
+  if (n_exc > kMaxPredictedExclusionOutcomes) {
+    worst.available = false;
+    worst.reason = std::to_string(n_exc) + " exclusion outcomes: more than the " + std::to_string(kMaxPredictedExclusionOutcomes) +
+                   " predicted (lower raim.max_exclusions)";
+    return worst;
+  }
+  std::vector<int> set;
+  (void)forEachExclusion(g.numSats(), g.numStates(), cfg.max_exclusions, set, 0, [&](const std::vector<int>& removed) {
+    const RaimPl pl = raimProtectionLevels(withoutSatellitesSet(g, removed), outcome);
+    if (!pl.available) {
+      worst.available = false;
+      worst.reason = "after excluding " + std::to_string(removed.size()) + " satellite(s): " + pl.reason;
+      return false;
+    }
+    worst.hpl_m = std::max(worst.hpl_m, pl.hpl_m);
+    worst.vpl_m = std::max(worst.vpl_m, pl.vpl_m);
+    return true;
+  });
+  return worst;
+}
 
 RaimFdeResult raimFde(const Geometry& g, const Eigen::VectorXd& prefit, const RaimConfig& fde_cfg) {
   RaimFdeResult out;

@@ -107,6 +107,19 @@ struct RaimFdeResult {
 /// (the detection threshold, from P_fa, is unchanged).
 [[nodiscard]] RaimConfig outcomeConfig(const RaimConfig& cfg, double budget_share);
 
+/// \brief The predicted protection levels of a user who detects and excludes (raimFde): the
+/// maximum over the outcomes — no exclusion, and each set of up to max_exclusions satellites
+/// whose removal leaves redundancy — of the PL of the outcome's geometry with the outcome's
+/// budget (outcomeConfig with ρ = 1/(N_exc + 1) under kAllocated, the whole budget under
+/// kRemainingGeometry). Whatever the measurements, raimFde's PL on any epoch of this geometry
+/// is one of these, so it never exceeds them. Not available when an outcome's PL is not, or
+/// when there are more than kMaxPredictedExclusionOutcomes outcomes. The slopes and the
+/// critical satellites are the no-exclusion outcome's.
+[[nodiscard]] RaimPl raimFdeProtectionLevels(const Geometry& g, const RaimConfig& cfg);
+
+/// \brief The most exclusion outcomes raimFdeProtectionLevels evaluates (C(40, 2) = 780 fit).
+inline constexpr int kMaxPredictedExclusionOutcomes = 5000;
+
 /// \brief Least-squares residual test, then w-test exclusion of the worst satellite while the
 /// test fails and exclusions remain. `prefit` holds measured − predicted ranges [m].
 [[nodiscard]] RaimFdeResult raimFde(const Geometry& g, const Eigen::VectorXd& prefit, const RaimConfig& cfg);

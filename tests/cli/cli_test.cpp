@@ -199,6 +199,51 @@ TEST(Cli, AvailabilityMapHasCellsColourScaleAndCoastlines) {
   EXPECT_NE(text.find("availability"), std::string::npos);
 }
 
+/// --fde: the predicted PLs of a user who excludes — never below detection only, and above it
+/// (the budget is shared among the exclusion outcomes); availability no higher.
+TEST(Cli, PredictAndAvailabilityWithExclusionGiveTheLargerPlsOfAUserWhoExcludes) {
+  const std::string alm = test::dataPath("gnss/alm01jan2020.txt");
+  for (const std::string method : {"raim", "araim"}) {
+    const std::string predict = "integrity predict --format jsonl --method " + method + " --almanac " + alm +
+                                " --lat 47.4 --lon 8.5 --start 2020-01-01T00:00:00Z --duration 2h --step 20m";
+    const RunResult plain = run(predict), fde = run(predict + " --fde");
+    ASSERT_EQ(plain.status, 0) << plain.out;
+    ASSERT_EQ(fde.status, 0) << fde.out;
+    std::istringstream a(plain.out), b(fde.out);
+    int epochs = 0, larger = 0;
+    for (std::string la, lb; std::getline(a, la) && std::getline(b, lb);) {
+      const auto p = nlohmann::json::parse(la), f = nlohmann::json::parse(lb);
+      EXPECT_FALSE(p.contains("with_exclusion"));
+      EXPECT_EQ(f.at("with_exclusion"), true);
+      ASSERT_TRUE(p.at("pl_computed").get<bool>() && f.at("pl_computed").get<bool>()) << lb;
+      EXPECT_GE(f.at("vpl_m").get<double>(), p.at("vpl_m").get<double>()) << method << " " << lb;
+      EXPECT_GE(f.at("hpl_m").get<double>(), p.at("hpl_m").get<double>()) << method << " " << lb;
+      larger += f.at("vpl_m").get<double>() > p.at("vpl_m").get<double>() ? 1 : 0;
+      ++epochs;
+    }
+    EXPECT_EQ(epochs, 7) << method;
+    EXPECT_EQ(larger, epochs) << method;
+  }
+  const std::string availability = "integrity availability --almanac " + alm +
+                                   " --grid-deg 30 --start 2020-01-01T00:00:00Z --duration 1h --step 30m --method raim";
+  const RunResult plain = run(availability), fde = run(availability + " --fde");
+  ASSERT_EQ(plain.status, 0) << plain.out;
+  ASSERT_EQ(fde.status, 0) << fde.out;
+  std::istringstream a(plain.out), b(fde.out);
+  std::string la, lb;
+  std::getline(a, la);
+  std::getline(b, lb);
+  int cells = 0;
+  for (; std::getline(a, la) && std::getline(b, lb) && la.find(',') != std::string::npos; ++cells) {
+    double pa[7], pb[7];
+    ASSERT_EQ(std::sscanf(la.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &pa[0], &pa[1], &pa[2], &pa[3], &pa[4], &pa[5], &pa[6]), 7) << la;
+    ASSERT_EQ(std::sscanf(lb.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &pb[0], &pb[1], &pb[2], &pb[3], &pb[4], &pb[5], &pb[6]), 7) << lb;
+    EXPECT_LE(pb[3], pa[3]) << lb;  // available epochs
+    EXPECT_GT(pb[6], pa[6]) << lb;  // the largest VPL
+  }
+  EXPECT_EQ(cells, 12 * 6);
+}
+
 TEST(Cli, SkymaskPrintsBlockedElevationPerBinAndDrawsASkyPlot) {
   // GIVEN one 20 m building whose near face is 30 m north of a point 1.5 m above flat ground
   const double lat = 47.3769, lon = 8.5417;

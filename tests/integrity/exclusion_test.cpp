@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <random>
 #include <cmath>
 #include <set>
 
@@ -186,6 +187,95 @@ TEST(ExclusionPl, RaimFdeOutcomeHasItsShareOfPmdAndPhmi) {
   // p_bias at ρ·P_md: the threshold (from P_fa) is the same
   EXPECT_DOUBLE_EQ(r.pl.thresholds.threshold, p.pl.thresholds.threshold);
   EXPECT_GT(r.pl.thresholds.p_bias, p.pl.thresholds.p_bias);
+}
+
+TEST(ExclusionPl, RaimPredictionIsTheMaximumOverTheOutcomes) {
+  const Geometry g = addExampleGeometry();  // 10 satellites, 5 states
+  for (int max_exclusions : {1, 2}) {
+    RaimConfig cfg;
+    cfg.max_exclusions = max_exclusions;
+    const RaimPl fde = raimFdeProtectionLevels(g, cfg);
+    ASSERT_TRUE(fde.available) << fde.reason;
+    // By hand: ρ = 1/(N_exc + 1) of P_md and P_HMI; every single exclusion, and every pair.
+    const double rho = 1.0 / (max_exclusions == 1 ? 11.0 : 56.0);
+    RaimConfig outcome = cfg;
+    outcome.pmd = cfg.pmd * rho;
+    outcome.phmi_hor = cfg.phmi_hor * rho;
+    outcome.phmi_vert = cfg.phmi_vert * rho;
+    double hpl = raimProtectionLevels(g, outcome).hpl_m, vpl = raimProtectionLevels(g, outcome).vpl_m;
+    for (int i = 0; i < g.numSats(); ++i) {
+      const RaimPl one = raimProtectionLevels(g.without(i), outcome);
+      hpl = std::max(hpl, one.hpl_m);
+      vpl = std::max(vpl, one.vpl_m);
+      for (int j = i + 1; j < g.numSats() && max_exclusions == 2; ++j) {
+        const RaimPl two = raimProtectionLevels(g.without(j).without(i), outcome);
+        hpl = std::max(hpl, two.hpl_m);
+        vpl = std::max(vpl, two.vpl_m);
+      }
+    }
+    EXPECT_DOUBLE_EQ(fde.hpl_m, hpl) << max_exclusions;
+    EXPECT_DOUBLE_EQ(fde.vpl_m, vpl) << max_exclusions;
+    EXPECT_GT(fde.vpl_m, raimProtectionLevels(g, cfg).vpl_m);
+  }
+  // The plain rule: every outcome with the whole budget.
+  RaimConfig plain;
+  plain.exclusion_pl = ExclusionPl::kRemainingGeometry;
+  double vpl = raimProtectionLevels(g, plain).vpl_m;
+  for (int i = 0; i < g.numSats(); ++i) vpl = std::max(vpl, raimProtectionLevels(g.without(i), plain).vpl_m);
+  EXPECT_DOUBLE_EQ(raimFdeProtectionLevels(g, plain).vpl_m, vpl);
+  // Up to four out of ten (five would leave no redundancy): Σ C(10, r), r ≤ 4 = 385 outcomes.
+  RaimConfig deep;
+  deep.max_exclusions = 5;
+  EXPECT_TRUE(raimFdeProtectionLevels(g, deep).available);
+  // Thirty satellites, four exclusions: 31,930 outcomes, more than are predicted: no PL, and why.
+  std::vector<SatLook> sky;
+  for (int i = 0; i < 30; ++i) sky.push_back({SatId{Constellation::kGps, i + 1}, {0.21 * i * 7.0, 0.15 + 0.045 * i}});
+  const Geometry big = buildGeometry(sky, ErrorModel{}, 9.0);
+  deep.max_exclusions = 4;
+  const RaimPl refused = raimFdeProtectionLevels(big, deep);
+  EXPECT_FALSE(refused.available);
+  EXPECT_NE(refused.reason.find("31930 exclusion outcomes"), std::string::npos) << refused.reason;
+  deep.max_exclusions = 2;  // 465 outcomes
+  EXPECT_TRUE(raimFdeProtectionLevels(big, deep).available);
+}
+
+/// Whatever the measurements, the PL a receiver reports after FDE is one of the outcomes the
+/// prediction takes the maximum over: it never exceeds the predicted PL with exclusion.
+TEST(ExclusionPl, NoLiveFdePlExceedsThePredictionWithExclusion) {
+  const Geometry g = addExampleGeometry();
+  const ErrorModel model = ismWith(1e-5, 1e-4);
+  std::mt19937 rng(2026);
+  std::normal_distribution<double> noise;
+  std::uniform_real_distribution<double> bias(0.0, 120.0);
+  RaimConfig raim2;
+  raim2.max_exclusions = 2;
+  const RaimPl raim_pred = raimFdeProtectionLevels(g, RaimConfig{}), raim2_pred = raimFdeProtectionLevels(g, raim2);
+  const AraimConfig acfg;
+  const AraimResult araim_pred = araimFdeProtectionLevels(g, model, acfg);
+  ASSERT_TRUE(raim_pred.available && raim2_pred.available && araim_pred.pl_computed);
+  int raim_outcomes = 0, araim_outcomes = 0, exclusions = 0;
+  for (int k = 0; k < 600; ++k) {
+    Eigen::VectorXd y(g.numSats());
+    for (int i = 0; i < g.numSats(); ++i) y[i] = g.sigma_int[i] * noise(rng);
+    y[k % g.numSats()] += k % 3 == 0 ? 0.0 : bias(rng);
+    if (k % 5 == 0) y[(k / 5) % g.numSats()] += bias(rng);  // now and then a second fault
+    for (const auto& [cfg, pred] : {std::pair{RaimConfig{}, raim_pred}, std::pair{raim2, raim2_pred}}) {
+      const RaimFdeResult r = raimFde(g, y, cfg);
+      if (!r.pl.available) continue;
+      ++raim_outcomes;
+      exclusions += r.fault_excluded ? 1 : 0;
+      EXPECT_LE(r.pl.hpl_m, pred.hpl_m + 1e-9) << k;
+      EXPECT_LE(r.pl.vpl_m, pred.vpl_m + 1e-9) << k;
+    }
+    const AraimFdeResult a = araimFde(g, y, model, acfg);
+    if (!a.pl.pl_computed) continue;
+    ++araim_outcomes;
+    EXPECT_LE(a.pl.hpl_m, araim_pred.hpl_m + 1e-9) << k;
+    EXPECT_LE(a.pl.vpl_m, araim_pred.vpl_m + 1e-9) << k;
+  }
+  EXPECT_GT(raim_outcomes, 600);  // most epochs end with a PL, many after an exclusion
+  EXPECT_GT(exclusions, 200);
+  EXPECT_GT(araim_outcomes, 300);
 }
 
 }  // namespace

@@ -172,6 +172,21 @@ TEST(Approval, ClearRouteIsApprovedAsTheStraightLine) {
   EXPECT_NEAR(r.limits.level2.val_m, 150.0, 1e-12);  // k₂ · longitudinal
 }
 
+TEST(Approval, IntegrityFdePredictsThePlsOfAReceiverThatExcludes) {
+  // GIVEN the clear route, detection-only PLs and those of a receiver that excludes
+  const ApprovalReport plain = Approver(missionWith({}, "clear_fd")).approve();
+  Mission m = missionWith({}, "clear_fde");
+  m.with_exclusion = true;
+  const ApprovalReport fde = Approver(m).approve();
+  ASSERT_EQ(plain.predicted.size(), fde.predicted.size());
+  // THEN every sample's PL is the larger: the budget is shared among the exclusion outcomes
+  for (std::size_t k = 0; k < plain.predicted.size(); ++k) {
+    ASSERT_TRUE(plain.predicted[k].pl_available && fde.predicted[k].pl_available) << k;
+    EXPECT_GT(fde.predicted[k].hpl_m, plain.predicted[k].hpl_m) << k;
+    EXPECT_GT(fde.predicted[k].vpl_m, plain.predicted[k].vpl_m) << k;
+  }
+}
+
 TEST(Approval, GoalInsideAProhibitedZoneIsRejectedWithItsIdentifier) {
   const double goal_lon = kLon0 + 0.0198;
   Approver a(missionWith({circleZone("EX-TEST-GOAL", kLat0, goal_lon, 100, permanent())}, "goal_in_zone"));

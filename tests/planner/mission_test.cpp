@@ -494,6 +494,7 @@ TEST(MissionFile, OmittedFieldsTakeTheirDefaults) {
   EXPECT_EQ(d.ground_amsl_m, 0.0);
   EXPECT_EQ(d.zone_format, "auto");
   EXPECT_EQ(d.method, integrity::IntegrityMethod::kRaim);
+  EXPECT_FALSE(d.with_exclusion);
   EXPECT_EQ(d.mask_deg, defaults.mask_deg);
   EXPECT_EQ(d.sample_s, 1.0);
   EXPECT_EQ(d.cost_weight, 1.0);
@@ -507,6 +508,19 @@ TEST(MissionFile, OmittedFieldsTakeTheirDefaults) {
   EXPECT_EQ(d.max_replans, 2);
   EXPECT_TRUE(d.qgc_plan_file.empty());
   ASSERT_EQ(d.points.size(), 2u);
+}
+
+TEST(MissionFile, IntegrityFdeIsTrueOrFalse) {
+  json m = missionWithoutRoute();
+  m["start"] = {{"lat", 47.0}, {"lon", 8.0}};
+  m["goal"] = {{"lat", 47.01}, {"lon", 8.0}};
+  m["integrity"] = {{"method", "araim"}, {"fde", true}};
+  EXPECT_TRUE(parseMission(m, "m.json", ".").with_exclusion);
+  m["integrity"]["fde"] = "yes";
+  const std::string what = test::messageOf<maps::ParseError>([&] { (void)parseMission(m, "m.json", "."); });
+  EXPECT_NE(what.find("m.json"), std::string::npos) << what;
+  EXPECT_NE(what.find("integrity.fde"), std::string::npos) << what;
+  EXPECT_NE(what.find("true or false"), std::string::npos) << what;
 }
 
 TEST(MissionFile, DepartureWindowGivesLatestAndStep) {
