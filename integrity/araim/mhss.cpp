@@ -422,8 +422,10 @@ double solveProtectionLevel(const std::vector<RiskTerm>& terms, double budget, d
     (rs.risk > budget ? low : high) = x;
     if (high - low <= tol) break;
     double next = 0.5 * (low + high);
-    if (rs.slope < 0.0) {
-      const double step = (rs.risk - budget) / -rs.slope;
+    if (rs.slope < 0.0 && rs.risk > 0.0) {
+      // Newton on ln(risk): the risk falls about exponentially in PL, so its logarithm is
+      // nearly linear and the step lands near the root from far away.
+      const double step = std::log(rs.risk / budget) * rs.risk / -rs.slope;
       // Once the step is below tol/2 the estimate is that close to the root: the next point
       // goes tol/2 past it, on the side whose end of the bracket has not moved yet.
       const double newton = x + step + (std::abs(step) < 0.5 * tol ? std::copysign(0.5 * tol, step) : 0.0);
