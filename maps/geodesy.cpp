@@ -49,8 +49,11 @@ Eigen::Matrix3d rotationEcefToEnu(double lat_rad, double lon_rad) {
 
 LookAngles lookAngles(const Eigen::Vector3d& p_observer_ecef, const Eigen::Vector3d& p_target_ecef) {
   const Geodetic obs = ecefToGeodetic(p_observer_ecef);
-  const Eigen::Vector3d d_enu =
-      rotationEcefToEnu(obs.lat_rad, obs.lon_rad) * (p_target_ecef - p_observer_ecef);
+  return lookAngles(p_observer_ecef, rotationEcefToEnu(obs.lat_rad, obs.lon_rad), p_target_ecef);
+}
+
+LookAngles lookAngles(const Eigen::Vector3d& p_observer_ecef, const Eigen::Matrix3d& r_enu_ecef, const Eigen::Vector3d& p_target_ecef) {
+  const Eigen::Vector3d d_enu = r_enu_ecef * (p_target_ecef - p_observer_ecef);
   const double horiz = std::hypot(d_enu.x(), d_enu.y());
   LookAngles out;
   out.azimuth_rad = std::atan2(d_enu.x(), d_enu.y());

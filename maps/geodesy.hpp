@@ -43,6 +43,10 @@ struct LookAngles {
 /// \brief Azimuth and elevation of the target seen from the observer (both ECEF).
 [[nodiscard]] LookAngles lookAngles(const Eigen::Vector3d& p_observer_ecef,
                                     const Eigen::Vector3d& p_target_ecef);
+/// \brief The same, with the observer's rotation R_EnuEcef (rotationEcefToEnu of its geodetic
+/// position) computed once for many targets: no geodetic conversion per target, the same result.
+[[nodiscard]] LookAngles lookAngles(const Eigen::Vector3d& p_observer_ecef, const Eigen::Matrix3d& r_enu_ecef,
+                                    const Eigen::Vector3d& p_target_ecef);
 
 /// \brief Unit line-of-sight vector (east, north, up) for azimuth/elevation.
 [[nodiscard]] Eigen::Vector3d losEnu(const LookAngles& look);

@@ -14,7 +14,7 @@ namespace {
 /// Light-time iterations: 3 bring the transmit time to < 1 ns for any GNSS orbit.
 constexpr int kLightTimeIterations = 3;
 
-VisibleSatellite locate(const SatId& sat, const Eigen::Vector3d& p_user, const GpsTime& t,
+VisibleSatellite locate(const SatId& sat, const Eigen::Vector3d& p_user, const Eigen::Matrix3d& r_enu_ecef, const GpsTime& t,
                         const OrbitSource::StateAt& state_at) {
   double tau = 0.075;  // ≈ 22 000 km / c
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
@@ -26,7 +26,7 @@ VisibleSatellite locate(const SatId& sat, const Eigen::Vector3d& p_user, const G
   v.sat = sat;
   v.p_ecef = p;
   v.range_m = (p - p_user).norm();
-  v.look = maps::lookAngles(p_user, p);
+  v.look = maps::lookAngles(p_user, r_enu_ecef, p);
   return v;
 }
 
@@ -62,8 +62,10 @@ void OrbitSource::forEachUsable(const GpsTime& t,
 std::vector<VisibleSatellite> OrbitSource::visible(const Eigen::Vector3d& p_user, const GpsTime& t,
                                                    double mask_rad) const {
   std::vector<VisibleSatellite> out;
+  const maps::Geodetic user = maps::ecefToGeodetic(p_user);
+  const Eigen::Matrix3d r_enu_ecef = maps::rotationEcefToEnu(user.lat_rad, user.lon_rad);  // once, not per satellite
   forEachUsable(t, [&](const SatId& sat, const StateAt& state_at) {
-    const VisibleSatellite v = locate(sat, p_user, t, state_at);
+    const VisibleSatellite v = locate(sat, p_user, r_enu_ecef, t, state_at);
     if (v.look.elevation_rad >= mask_rad) out.push_back(v);
   });
   std::sort(out.begin(), out.end(), [](const VisibleSatellite& a, const VisibleSatellite& b) { return a.sat < b.sat; });

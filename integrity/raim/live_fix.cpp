@@ -39,12 +39,16 @@ Linearised linearise(const std::vector<Located>& located, const std::vector<int>
                      const LiveFixConfig& cfg, std::array<double, kNumConstellations>& clock, bool& clocks_set) {
   Linearised out;
   const maps::Geodetic user = maps::ecefToGeodetic(x);
+  const Eigen::Matrix3d r_enu_ecef = maps::rotationEcefToEnu(user.lat_rad, user.lon_rad);
   const double tau = cfg.model.iono_tau_vert_m.value_or(ionoTauVert_m(geomagneticLatitude(user)));
   std::vector<SatLook> looks;
   std::vector<double> ranges;
+  looks.reserve(active.size());
+  ranges.reserve(active.size());
+  out.index.reserve(active.size());
   for (int k : active) {
     const Located& s = located[static_cast<std::size_t>(k)];
-    const maps::LookAngles look = maps::lookAngles(x, s.sat_ecef_m);
+    const maps::LookAngles look = maps::lookAngles(x, r_enu_ecef, s.sat_ecef_m);
     if (look.elevation_rad < cfg.elevation_mask_rad) continue;
     looks.push_back({s.sat, look});
     ranges.push_back((s.sat_ecef_m - x).norm());
@@ -274,8 +278,10 @@ std::vector<LocatedRange> rangesAboveMask(const std::vector<RawRange>& ranges, c
                                           const OrbitSource* orbits, double elevation_mask_rad) {
   std::vector<SatId> missing;
   std::vector<LocatedRange> out;
+  const maps::Geodetic at = maps::ecefToGeodetic(r_ecef);
+  const Eigen::Matrix3d r_enu_ecef = maps::rotationEcefToEnu(at.lat_rad, at.lon_rad);
   for (LocatedRange& l : locateRanges(ranges, r_ecef, t, orbits, missing)) {
-    if (maps::lookAngles(r_ecef, l.sat_ecef_m).elevation_rad < elevation_mask_rad) continue;
+    if (maps::lookAngles(r_ecef, r_enu_ecef, l.sat_ecef_m).elevation_rad < elevation_mask_rad) continue;
     out.push_back(std::move(l));
   }
   return out;

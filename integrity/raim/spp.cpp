@@ -112,10 +112,11 @@ class CorrectedRanges {
 
   const std::vector<LocatedRange>& from(const Eigen::Vector3d& x) {
     const maps::Geodetic user = maps::ecefToGeodetic(x);
+    const Eigen::Matrix3d r_enu_ecef = maps::rotationEcefToEnu(user.lat_rad, user.lon_rad);
     ranges_.clear();
     for (const Measurement& m : meas_) {
       const Eigen::Vector3d p = earthRotationCorrection(m.p_sat_tx, (m.p_sat_tx - x).norm() / kSpeedOfLight_mps);
-      const maps::LookAngles look = maps::lookAngles(x, p);
+      const maps::LookAngles look = maps::lookAngles(x, r_enu_ecef, p);
       double pr = m.pr_m + m.sat_clock_m;
       if (look.elevation_rad >= mask_rad_) {
         // Galileo E1 shares L1's frequency; the GPS model stands in for NeQuick G here.
@@ -129,9 +130,11 @@ class CorrectedRanges {
 
   /// Whether a single-frequency measurement is above the mask at x.
   bool anySingleFrequencyAbove(const Eigen::Vector3d& x) const {
+    const maps::Geodetic user = maps::ecefToGeodetic(x);
+    const Eigen::Matrix3d r_enu_ecef = maps::rotationEcefToEnu(user.lat_rad, user.lon_rad);
     return std::any_of(meas_.begin(), meas_.end(), [&](const Measurement& m) {
       const Eigen::Vector3d p = earthRotationCorrection(m.p_sat_tx, (m.p_sat_tx - x).norm() / kSpeedOfLight_mps);
-      return !m.iono_free && maps::lookAngles(x, p).elevation_rad >= mask_rad_;
+      return !m.iono_free && maps::lookAngles(x, r_enu_ecef, p).elevation_rad >= mask_rad_;
     });
   }
 
