@@ -14,7 +14,7 @@ namespace {
 /// Light-time iterations: 3 bring the transmit time to < 1 ns for any GNSS orbit.
 constexpr int kLightTimeIterations = 3;
 
-VisibleSatellite locate(const SatId& sat, const Eigen::Vector3d& p_user, const Eigen::Matrix3d& r_enu_ecef, const GpsTime& t,
+VisibleSatellite lightTimeSolution(const SatId& sat, const Eigen::Vector3d& p_user, const Eigen::Matrix3d& r_enu_ecef, const GpsTime& t,
                         const OrbitSource::StateAt& state_at) {
   double tau = 0.075;  // ≈ 22 000 km / c
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
@@ -42,10 +42,13 @@ void OrbitSource::addNavigation(const NavigationData& nav, const std::string& fi
   files_.push_back(ephemerisEpochs(file.empty() ? "navigation data" : file, nav));
 }
 
-void OrbitSource::forEachUsable(const GpsTime& t,
-                                const std::function<void(const SatId&, const StateAt&)>& fn) const {
+void OrbitSource::forEachUsable(const GpsTime& t, const std::function<void(const SatId&, const StateAt&)>& fn,
+                                const std::vector<SatId>* only) const {
+  const auto wanted = [only](const SatId& sat) { return !only || std::find(only->begin(), only->end(), sat) != only->end(); };
   std::set<SatId> done, nav_sats;
-  for (const BroadcastEphemeris& e : nav_.ephemerides) nav_sats.insert(e.sat);
+  for (const BroadcastEphemeris& e : nav_.ephemerides) {
+    if (wanted(e.sat)) nav_sats.insert(e.sat);
+  }
   for (const SatId& sat : nav_sats) {
     const BroadcastEphemeris* eph = selectEphemeris(nav_, sat, t);
     if (!eph) continue;
@@ -53,7 +56,7 @@ void OrbitSource::forEachUsable(const GpsTime& t,
     fn(sat, [eph](const GpsTime& tt) { return satelliteState(*eph, tt); });
   }
   for (const AlmanacRecord& a : almanac_) {
-    if (a.health != 0 || done.count(a.sat)) continue;
+    if (a.health != 0 || done.count(a.sat) || !wanted(a.sat)) continue;
     done.insert(a.sat);
     fn(a.sat, [&a](const GpsTime& tt) { return almanacState(a, tt); });
   }
@@ -61,13 +64,23 @@ void OrbitSource::forEachUsable(const GpsTime& t,
 
 std::vector<VisibleSatellite> OrbitSource::visible(const Eigen::Vector3d& p_user, const GpsTime& t,
                                                    double mask_rad) const {
+  return located(p_user, t, mask_rad, nullptr);
+}
+
+std::vector<VisibleSatellite> OrbitSource::locate(const std::vector<SatId>& sats, const Eigen::Vector3d& p_user,
+                                                  const GpsTime& t) const {
+  return located(p_user, t, -M_PI / 2.0, &sats);
+}
+
+std::vector<VisibleSatellite> OrbitSource::located(const Eigen::Vector3d& p_user, const GpsTime& t, double mask_rad,
+                                                   const std::vector<SatId>* only) const {
   std::vector<VisibleSatellite> out;
   const maps::Geodetic user = maps::ecefToGeodetic(p_user);
   const Eigen::Matrix3d r_enu_ecef = maps::rotationEcefToEnu(user.lat_rad, user.lon_rad);  // once, not per satellite
   forEachUsable(t, [&](const SatId& sat, const StateAt& state_at) {
-    const VisibleSatellite v = locate(sat, p_user, r_enu_ecef, t, state_at);
+    const VisibleSatellite v = lightTimeSolution(sat, p_user, r_enu_ecef, t, state_at);
     if (v.look.elevation_rad >= mask_rad) out.push_back(v);
-  });
+  }, only);
   std::sort(out.begin(), out.end(), [](const VisibleSatellite& a, const VisibleSatellite& b) { return a.sat < b.sat; });
   return out;
 }

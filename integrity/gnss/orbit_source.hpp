@@ -40,6 +40,11 @@ class OrbitSource {
   /// entries for the same satellite when one is valid at t.
   [[nodiscard]] std::vector<VisibleSatellite> visible(const Eigen::Vector3d& p_user_ecef, const GpsTime& t,
                                                       double mask_rad) const;
+  /// \brief The satellites of `sats` that have a usable orbit at t, seen from `p_user_ecef`
+  /// whatever their elevation: visible()'s light-time solution for these satellites only (a
+  /// receiver's ranges name the few it tracks; the rest of the constellation is not computed).
+  [[nodiscard]] std::vector<VisibleSatellite> locate(const std::vector<SatId>& sats, const Eigen::Vector3d& p_user_ecef,
+                                                     const GpsTime& t) const;
   /// \brief Every healthy satellite's ECEF position for a user anywhere on Earth at time t:
   /// evaluated 75 ms (a typical flight time) before t and turned by the Earth's rotation over
   /// those 75 ms. Against the per-user light-time solution of visible() the direction differs by
@@ -51,8 +56,13 @@ class OrbitSource {
   [[nodiscard]] std::size_t size() const { return almanac_.size() + nav_.ephemerides.size(); }
 
  private:
-  /// Calls fn for every satellite usable at t: a valid broadcast ephemeris wins over the almanac.
-  void forEachUsable(const GpsTime& t, const std::function<void(const SatId&, const StateAt&)>& fn) const;
+  /// Calls fn for every satellite usable at t (of `only`, when given): a valid broadcast
+  /// ephemeris wins over the almanac.
+  void forEachUsable(const GpsTime& t, const std::function<void(const SatId&, const StateAt&)>& fn,
+                     const std::vector<SatId>* only = nullptr) const;
+  /// The located satellites above mask_rad (of `only`, when given), sorted by satellite.
+  [[nodiscard]] std::vector<VisibleSatellite> located(const Eigen::Vector3d& p_user_ecef, const GpsTime& t, double mask_rad,
+                                                      const std::vector<SatId>* only) const;
 
   std::vector<AlmanacRecord> almanac_;
   NavigationData nav_;

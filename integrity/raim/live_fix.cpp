@@ -30,6 +30,7 @@ struct Linearised {
   std::array<double, kNumConstellations> clock{};  ///< receiver clocks at the solution [m]
   Geometry g;
   Eigen::VectorXd y;          ///< prefit residuals at the last linearisation point
+  WlsSolution wls;            ///< solveWls(g.G, g.sigma_int), when converge() made it
   std::vector<int> index;     ///< per geometry row: index into the located ranges
 };
 
@@ -93,9 +94,9 @@ Linearised converge(const RangesSeenFrom& ranges_from, const std::vector<int>& a
   for (int it = 0; it < kMaxIterations; ++it) {
     Linearised lin = linearise(ranges_from(x), active, x, cfg, clock, clocks_set);
     if (!lin.ok) return Linearised{};
-    const WlsSolution w = solveWls(lin.g.G, lin.g.sigma_int);
-    if (!w.ok) return Linearised{};
-    dx = w.S * lin.y;
+    lin.wls = solveWls(lin.g.G, lin.g.sigma_int);
+    if (!lin.wls.ok) return Linearised{};
+    dx = lin.wls.S * lin.y;
     x = maps::LocalFrame(lin.user).enuToEcef(dx.head<3>());
     out = std::move(lin);
     for (std::size_t c = 0; c < out.g.clocks.size(); ++c) clock[static_cast<int>(out.g.clocks[c])] += dx[3 + static_cast<Eigen::Index>(c)];
@@ -146,8 +147,8 @@ GeometryCheck checkGeometry(const Linearised& lin, const LiveFixConfig& cfg) {
     out.fails = out.statistic > out.threshold;
     return out;
   }
-  out.pl = summarize(raimProtectionLevels(lin.g, cfg.raim), cfg.araim.requirements);
-  const WlsSolution w = solveWls(lin.g.G, lin.g.sigma_int);
+  const WlsSolution& w = lin.wls;
+  out.pl = summarize(raimProtectionLevels(lin.g, w, cfg.raim), cfg.araim.requirements);
   const Eigen::VectorXd r = lin.y - lin.g.G * (w.S * lin.y);
   out.statistic = r.cwiseQuotient(lin.g.sigma_int).norm();
   const int dof = lin.g.numSats() - lin.g.numStates();
@@ -251,18 +252,18 @@ std::vector<LocatedRange> locateRanges(const std::vector<RawRange>& ranges, cons
                                        const GpsTime& t, const OrbitSource* orbits, std::vector<SatId>& missing) {
   std::vector<LocatedRange> located;
   located.reserve(ranges.size());
+  std::vector<SatId> without_position;
+  for (const RawRange& r : ranges) {
+    if (!r.sat_ecef_m) without_position.push_back(r.sat);
+  }
   std::vector<VisibleSatellite> visible;
-  bool looked_up = false;
+  if (orbits && !without_position.empty()) visible = orbits->locate(without_position, x0_ecef, t);
   for (const RawRange& r : ranges) {
     if (!std::isfinite(r.pr_m)) throw std::invalid_argument("solveLiveFix: pseudorange of " + r.sat.str() + " is not finite");
     if (r.sat_ecef_m) {
       if (!r.sat_ecef_m->allFinite()) throw std::invalid_argument("solveLiveFix: position of " + r.sat.str() + " is not finite");
       located.push_back({r.sat, r.pr_m, *r.sat_ecef_m});
       continue;
-    }
-    if (orbits && !looked_up) {
-      visible = orbits->visible(x0_ecef, t, -M_PI / 2.0);  // every satellite above the horizon plane or not
-      looked_up = true;
     }
     const auto it = std::find_if(visible.begin(), visible.end(), [&](const VisibleSatellite& v) { return v.sat == r.sat; });
     if (it == visible.end()) {

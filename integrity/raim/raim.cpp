@@ -58,7 +58,13 @@ RaimPl raimProtectionLevels(const Geometry& g, const RaimConfig& cfg) {
                  std::to_string(m + 1) + " for " + std::to_string(m) + " unknowns";
     return out;
   }
-  const WlsSolution wls = solveWls(g.G, g.sigma_int);
+  return raimProtectionLevels(g, solveWls(g.G, g.sigma_int), cfg);
+}
+
+RaimPl raimProtectionLevels(const Geometry& g, const WlsSolution& wls, const RaimConfig& cfg) {
+  RaimPl out;
+  const int n = g.numSats(), m = g.numStates();
+  if (n <= m) return raimProtectionLevels(g, cfg);  // says why
   if (!wls.ok) {
     out.reason = "singular geometry: the satellites do not fix position and clock";
     return out;
@@ -217,19 +223,19 @@ RaimFdeResult raimFde(const Geometry& g, const Eigen::VectorXd& prefit, const Ra
     out.final_geometry = cur;
     if (n <= m) {  // no redundancy: no test possible
       out.threshold = 0;
-      out.pl = raimProtectionLevels(cur, cfg);
+      out.pl = raimProtectionLevels(cur, wls, cfg);
       break;
     }
     const RaimThresholds th = raimThresholds(n - m, cfg.pfa, cfg.pmd);
     out.threshold = th.threshold;
     if (out.test_statistic <= th.threshold) {
       if (round > 0) out.fault_excluded = true;
-      out.pl = raimProtectionLevels(cur, cfg);
+      out.pl = raimProtectionLevels(cur, wls, cfg);
       break;
     }
     if (round == 0) out.fault_detected = true;
     if (round >= cfg.max_exclusions || n - 1 <= m) {  // cannot exclude further: no valid PL
-      out.pl = raimProtectionLevels(cur, cfg);
+      out.pl = raimProtectionLevels(cur, wls, cfg);
       out.pl.available = false;
       out.pl.reason = "fault detected and not excluded";
       break;

@@ -82,6 +82,9 @@ struct RaimPl {
 /// \brief Slope-based HPL/VPL for the geometry with integrity σ's. Fewer than states + 1
 /// satellites, or a singular geometry, give `available = false` with the reason; never NaN.
 [[nodiscard]] RaimPl raimProtectionLevels(const Geometry& g, const RaimConfig& cfg);
+/// \brief The same with the geometry's weighted least-squares solution already at hand
+/// (`wls` = solveWls(g.G, g.sigma_int)).
+[[nodiscard]] RaimPl raimProtectionLevels(const Geometry& g, const WlsSolution& wls, const RaimConfig& cfg);
 
 /// \brief The outcome of fault detection and exclusion on one epoch's measurements.
 struct RaimFdeResult {

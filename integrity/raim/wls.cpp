@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace skylane::integrity {
 namespace {
@@ -12,6 +13,22 @@ namespace {
 /// Reciprocal condition below which GᵀWG counts as singular (a degenerate sky): far above
 /// the 1e-16 of double round-off so the covariance is still meaningful.
 constexpr double kMinRcond = 1e-12;
+
+/// Position and one clock per constellation: the most unknowns a geometry has.
+constexpr int kMaxStates = 3 + kNumConstellations;
+
+/// GᵀWG and its inverse, on the stack (no allocation per solve).
+using NormalMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxStates, kMaxStates>;
+
+/// The reciprocal condition number of N in the 1-norm, 1 / (‖N‖₁ ‖N⁻¹‖₁), from its computed
+/// inverse: exact where an estimate (Hager's, as Eigen's LDLT::rcond) can only be larger; NaN
+/// when the inverse is not finite, 0 for a zero matrix.
+double reciprocalCondition(const NormalMatrix& N, const NormalMatrix& P) {
+  const double norm_n = N.cwiseAbs().colwise().sum().maxCoeff();
+  const double norm_p = P.cwiseAbs().colwise().sum().maxCoeff();
+  if (!(norm_n > 0.0) || !(norm_p > 0.0)) return 0.0;
+  return 1.0 / (norm_n * norm_p);
+}
 
 }  // namespace
 
@@ -82,14 +99,17 @@ Geometry Geometry::without(int index) const {
 WlsSolution solveWls(const Eigen::MatrixXd& G, const Eigen::VectorXd& sigma) {
   WlsSolution out;
   const int n = static_cast<int>(G.rows()), m = static_cast<int>(G.cols());
+  if (m > kMaxStates) throw std::invalid_argument("solveWls: " + std::to_string(m) + " unknowns, at most " + std::to_string(kMaxStates));
   if (n < m || m == 0) return out;
-  const Eigen::VectorXd w = sigma.array().square().inverse();
-  const Eigen::MatrixXd GtW = G.transpose() * w.asDiagonal();
-  const Eigen::MatrixXd N = GtW * G;
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(N);
-  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > kMinRcond)) return out;
-  out.P = ldlt.solve(Eigen::MatrixXd::Identity(m, m));
-  out.S = out.P * GtW;
+  const Eigen::MatrixXd GtW = G.transpose() * sigma.array().square().inverse().matrix().asDiagonal();
+  const NormalMatrix N = GtW * G;
+  const Eigen::LDLT<NormalMatrix> ldlt(N);
+  // GᵀWG of a geometry that fixes every unknown is positive definite: every pivot positive.
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 0.0).all()) return out;
+  const NormalMatrix P = ldlt.solve(NormalMatrix::Identity(m, m));
+  if (!(reciprocalCondition(N, P) > kMinRcond)) return out;
+  out.P = P;
+  out.S = P * GtW;
   out.ok = out.S.allFinite();
   return out;
 }
