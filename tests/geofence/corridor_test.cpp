@@ -9,6 +9,7 @@
 #include <functional>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -157,6 +158,31 @@ TEST(Corridor, MarginsDoNotJumpWhereTheUnionStopsHelpingAtAJoint) {
   EXPECT_NEAR(base.margin_h_m, 24.0 - 1.0 - 5.0, 1e-9);  // HAL - offset from the second leg - HPL
   EXPECT_EQ(base.segment, 1u);
   EXPECT_NEAR(base.margin_v_m, (60.0 - 5.0) - (100.0 - 18.0), 1e-9);  // volume bottom - band floor
+}
+
+TEST(Corridor, AVolumeCentredOnAWaypointIsDecidedWithoutCoveringTheArcOfEqualMargins) {
+  // GIVEN fuzz_fence's seed corridor as a path (level, then a 5 m climb; level-1 limits HAL
+  // 1.8 m, VAL 0.6 m) and volumes centred on its first waypoint and on its turn, HPL 900 m,
+  // VPL 300 m: far outside. Every point of the disk's boundary behind the end cap (or outside
+  // the turn) is 900 m from the path, so the union's margin hal − HPL is attained along an arc,
+  // and the branch and bound, narrowing it to HAL/1000, ran into its 200,000-cell cap (a
+  // fuzz_fence timeout). The union gains nothing there, which the first boundary point shows.
+  const std::vector<Eigen::Vector3d> path{{0, 0, 515}, {170, 120, 515}, {320, 255, 520}};
+  const AlertLimits limits{1.8, 0.6};
+  const Corridor c(path, limits);
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < 50; ++k) {
+    for (const Eigen::Vector3d& at : {path[0], path[1]}) {
+      const Containment r = c.contains({at, 900.0, 300.0});
+      // THEN the best single piece's exact margins: h = HAL − 0 − HPL, v = VAL − VPL
+      ASSERT_EQ(r.verdict, Verdict::kOutside);
+      EXPECT_FALSE(r.across_joint);
+      EXPECT_NEAR(r.margin_h_m, 1.8 - 900.0, 1e-9);
+      EXPECT_NEAR(r.margin_v_m, 0.6 - 300.0, 1e-9);
+    }
+  }
+  // AND quickly: 100 checks in well under 2 s (each took the cap's 200,000 cells before)
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
 }
 
 TEST(Corridor, VerdictsAndMarginsAreFrameInvariant) {
