@@ -342,12 +342,22 @@ Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_
     // certified lower bound when it beats the best piece by more than the tolerance. Where the
     // other pieces add nothing (the common case well outside), the union's margin equals the
     // best piece's min(h, v) and the two are the same quantity summed in different orders: a
-    // bare `>` was decided by their last bit, which depends on the frame's rounding, and flipped
-    // the report between the piece's (h, v) and the union's (L, L) — margin_h -11.3 m in one
-    // frame, -26.4 m in the rotated one (clang ASan build). A gain within the tolerance is none.
+    // bare `>` was decided by their last bit, which depends on the frame's rounding. A gain within
+    // the tolerance is none. But the gain is known only to the search's accuracy (HAL/1000, far
+    // coarser than the tolerance), and where the search stops within it depends on the frame: its
+    // quadtree cells are axis-aligned in the map frame, so a rotated scene gets other cells and
+    // another certified bound. So a union that gains less than the accuracy is reported in one
+    // frame and not in another, and the report must not jump there. The deciding margin does not
+    // (L against min(h, v), which differ by the gain); the horizontal one did: the union's (L, L)
+    // against the piece's (h, v) put margin_h at -26.35 m in one frame and -11.30 m in the
+    // rotated one (Fence.WholeSceneTranslatedAndRotated trial 199, clang ASan build: the union
+    // gains 7.6 mm, the accuracy is 24 mm). The union's horizontal room is at least the best
+    // piece's h (the union holds that piece's footprint), so margin_h is max(L, h): a valid
+    // bound, and the piece's h on both sides of the switch where the vertical margin decides.
     if (u.lower > best.margin_m + tolerance_m) {
       out.across_joint = true;
-      out.margin_h_m = out.margin_v_m = u.lower;
+      out.margin_h_m = std::max(u.lower, out.margin_h_m);
+      out.margin_v_m = u.lower;
       out.verdict = u.lower > tolerance_m ? Verdict::kInside
                                           : (u.upper < -tolerance_m ? Verdict::kOutside : Verdict::kIndeterminate);
       return out;
