@@ -208,8 +208,16 @@ struct BoundCell {
 /// is bounded on a quadtree cell (centre q, circumradius ρ) from below by the column margin of
 /// the pieces' bounds with reach ρ (valid for every column of the cell), and from above by f
 /// at any point of the disk. Best-first branch and bound narrows the two to
-/// `accuracy_m`.
-UnionMargin unionMargin(const MarginField& f, const Eigen::Vector2d& c2, double hpl, double accuracy_m) {
+/// `accuracy_m`, or stops as soon as the upper bound is at most `no_gain_m`: then the union
+/// cannot beat the best single piece by more than the tolerance and its bounds are not used.
+/// That stop matters where the minimum over the disk is attained along an arc, not at a point —
+/// a disk centred on a waypoint, whose boundary behind the end cap (or outside the turn) is all
+/// at distance HPL from the path: narrowing the bounds there to `accuracy_m` means covering the
+/// whole arc with cells of that size (π·HPL / accuracy cells, up to the 200,000-cell cap: 4.5 s
+/// for the 900 m volumes fuzz_fence checks on its own seed, a timeout), while the union's
+/// margin there equals the best piece's (hal − HPL) and the first boundary point evaluated
+/// shows it.
+UnionMargin unionMargin(const MarginField& f, const Eigen::Vector2d& c2, double hpl, double accuracy_m, double no_gain_m) {
   std::priority_queue<BoundCell> cells;
   const double half0 = std::max(hpl, accuracy_m);
   cells.push({f.bound(c2, half0 * std::sqrt(2.0)), c2, half0});
@@ -218,7 +226,7 @@ UnionMargin unionMargin(const MarginField& f, const Eigen::Vector2d& c2, double 
   for (int evaluations = 0; !cells.empty(); ++evaluations) {
     const BoundCell cell = cells.top();
     lower = cell.lower;
-    if (lower >= upper - accuracy_m || evaluations > 200000) break;
+    if (lower >= upper - accuracy_m || upper <= no_gain_m || evaluations > 200000) break;
     cells.pop();
     // f at the cell's point nearest to its centre inside the disk tightens the upper bound.
     const Eigen::Vector2d x = (cell.q - c2).norm() > hpl ? Eigen::Vector2d(c2 + hpl * (cell.q - c2).normalized()) : cell.q;
@@ -329,17 +337,27 @@ Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_
   Containment out;
   const BestPiece best = bestSinglePiece(field, c2, hpl, tolerance_m, out);
   if (best.margin_m < tolerance_m && best.reached >= 2) {
-    const UnionMargin u = unionMargin(field, c2, hpl, std::max(tolerance_m, 1e-3 * hal));
+    const UnionMargin u = unionMargin(field, c2, hpl, std::max(tolerance_m, 1e-3 * hal), best.margin_m + tolerance_m);
     // lower ≤ the union margin ≤ upper (a point of the volume has margin `upper`); report the
     // certified lower bound when it beats the best piece by more than the tolerance. Where the
     // other pieces add nothing (the common case well outside), the union's margin equals the
     // best piece's min(h, v) and the two are the same quantity summed in different orders: a
-    // bare `>` was decided by their last bit, which depends on the frame's rounding, and flipped
-    // the report between the piece's (h, v) and the union's (L, L) — margin_h -11.3 m in one
-    // frame, -26.4 m in the rotated one (clang ASan build). A gain within the tolerance is none.
+    // bare `>` was decided by their last bit, which depends on the frame's rounding. A gain within
+    // the tolerance is none. But the gain is known only to the search's accuracy (HAL/1000, far
+    // coarser than the tolerance), and where the search stops within it depends on the frame: its
+    // quadtree cells are axis-aligned in the map frame, so a rotated scene gets other cells and
+    // another certified bound. So a union that gains less than the accuracy is reported in one
+    // frame and not in another, and the report must not jump there. The deciding margin does not
+    // (L against min(h, v), which differ by the gain); the horizontal one did: the union's (L, L)
+    // against the piece's (h, v) put margin_h at -26.35 m in one frame and -11.30 m in the
+    // rotated one (Fence.WholeSceneTranslatedAndRotated trial 199, clang ASan build: the union
+    // gains 7.6 mm, the accuracy is 24 mm). The union's horizontal room is at least the best
+    // piece's h (the union holds that piece's footprint), so margin_h is max(L, h): a valid
+    // bound, and the piece's h on both sides of the switch where the vertical margin decides.
     if (u.lower > best.margin_m + tolerance_m) {
       out.across_joint = true;
-      out.margin_h_m = out.margin_v_m = u.lower;
+      out.margin_h_m = std::max(u.lower, out.margin_h_m);
+      out.margin_v_m = u.lower;
       out.verdict = u.lower > tolerance_m ? Verdict::kInside
                                           : (u.upper < -tolerance_m ? Verdict::kOutside : Verdict::kIndeterminate);
       return out;

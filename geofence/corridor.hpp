@@ -96,8 +96,10 @@ struct Containment {
   /// (On a sloping segment a larger HPL also moves the vertical band: margin_h is the horizontal
   /// room alone.) Hence a volume that reaches one piece only — a path's ends among them — is
   /// decided exactly, up to the tolerance. Across a joint (the volume reaches several pieces and
-  /// their union holds it better than any one piece, by more than the tolerance) both fields
-  /// hold the one combined margin: min over the volume's columns
+  /// their union holds it better than any one piece, by more than the tolerance) margin_v holds
+  /// the one combined margin L, and margin_h max(L, the best piece's horizontal margin) (the
+  /// union's horizontal room is at least that piece's; so margin_h does not jump where the union
+  /// stops helping and the vertical margin decides). L is min over the volume's columns
   /// (the vertical segments through its disk) of how far the column lies inside the union of
   /// the pieces — the largest δ such that the column grown by δ up and down lies in the height
   /// bands of pieces whose horizontal margin there is ≥ δ (two pieces' bands may cover a column

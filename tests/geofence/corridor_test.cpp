@@ -9,6 +9,7 @@
 #include <functional>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -157,6 +158,64 @@ TEST(Corridor, MarginsDoNotJumpWhereTheUnionStopsHelpingAtAJoint) {
   EXPECT_NEAR(base.margin_h_m, 24.0 - 1.0 - 5.0, 1e-9);  // HAL - offset from the second leg - HPL
   EXPECT_EQ(base.segment, 1u);
   EXPECT_NEAR(base.margin_v_m, (60.0 - 5.0) - (100.0 - 18.0), 1e-9);  // volume bottom - band floor
+}
+
+TEST(Corridor, MarginHDoesNotJumpWhereTheUnionGainsLessThanTheSearchAccuracy) {
+  // GIVEN trial 199 of Fence.WholeSceneTranslatedAndRotated: a volume below the turn, 26.36 m
+  // below the second leg's band (v) and 11.30 m horizontally beyond it (h), level-1 limits HAL
+  // 24 m, VAL 18 m. The union of the legs gains 7.6 mm over that leg, less than the branch and
+  // bound's accuracy (HAL/1000 = 24 mm): its certified bound beat the piece in one frame and not
+  // in the rotated one (clang ASan build), and the report flipped between the union's (L, L) =
+  // (-26.35, -26.35) and the piece's (h, v) = (-11.30, -26.36).
+  const std::vector<Eigen::Vector3d> path{{0, 0, 100}, {400, 14.596468731341119, 110}, {547.53945159247439, 400, 100}};
+  const ProtectionVolume volume{{382.0924875725035, 21.380898356221877, 152.3447748932457}, 16.154114946330786, 1.6276334237202144};
+  const AlertLimits limits{24.0, 18.0};
+  // The second leg's horizontal margin by hand: HAL − distance to the segment − HPL.
+  const Eigen::Vector2d a = path[1].head<2>(), d = (path[2] - path[1]).head<2>(), x = volume.p_map.head<2>();
+  const double t = std::clamp((x - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+  const double h_leg2 = 24.0 - (x - (a + t * d)).norm() - volume.hpl_m;
+  // WHEN the scene is moved to 2,000 frames
+  std::mt19937 rng(199);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < 2000; ++k) {
+    const double yaw = 2 * kPi * u(rng);
+    const Eigen::Vector3d shift(-1e5 + 2e5 * u(rng), -1e5 + 2e5 * u(rng), 0.0);
+    std::vector<Eigen::Vector3d> p2;
+    for (const Eigen::Vector3d& p : path) p2.push_back(moved(p, yaw, shift));
+    const Containment c = Corridor(p2, limits).contains({moved(volume.p_map, yaw, shift), volume.hpl_m, volume.vpl_m});
+    // THEN, whether or not the union is reported, margin_h is the leg's h (the union's horizontal
+    // room is at least the leg's) and margin_v is within the accuracy of the leg's v
+    ASSERT_EQ(c.verdict, Verdict::kOutside) << "frame " << k;
+    EXPECT_EQ(c.segment, 1u) << "frame " << k;
+    ASSERT_NEAR(c.margin_h_m, h_leg2, 1e-6) << "frame " << k << (c.across_joint ? " (union)" : " (piece)");
+    ASSERT_NEAR(c.margin_v_m, -26.36, 0.024 + 0.01) << "frame " << k;
+  }
+  EXPECT_NEAR(h_leg2, -11.30, 0.01);
+}
+
+TEST(Corridor, AVolumeCentredOnAWaypointIsDecidedWithoutCoveringTheArcOfEqualMargins) {
+  // GIVEN fuzz_fence's seed corridor as a path (level, then a 5 m climb; level-1 limits HAL
+  // 1.8 m, VAL 0.6 m) and volumes centred on its first waypoint and on its turn, HPL 900 m,
+  // VPL 300 m: far outside. Every point of the disk's boundary behind the end cap (or outside
+  // the turn) is 900 m from the path, so the union's margin hal − HPL is attained along an arc,
+  // and the branch and bound, narrowing it to HAL/1000, ran into its 200,000-cell cap (a
+  // fuzz_fence timeout). The union gains nothing there, which the first boundary point shows.
+  const std::vector<Eigen::Vector3d> path{{0, 0, 515}, {170, 120, 515}, {320, 255, 520}};
+  const AlertLimits limits{1.8, 0.6};
+  const Corridor c(path, limits);
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < 50; ++k) {
+    for (const Eigen::Vector3d& at : {path[0], path[1]}) {
+      const Containment r = c.contains({at, 900.0, 300.0});
+      // THEN the best single piece's exact margins: h = HAL − 0 − HPL, v = VAL − VPL
+      ASSERT_EQ(r.verdict, Verdict::kOutside);
+      EXPECT_FALSE(r.across_joint);
+      EXPECT_NEAR(r.margin_h_m, 1.8 - 900.0, 1e-9);
+      EXPECT_NEAR(r.margin_v_m, 0.6 - 300.0, 1e-9);
+    }
+  }
+  // AND quickly: 100 checks in well under 2 s (each took the cap's 200,000 cells before)
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
 }
 
 TEST(Corridor, VerdictsAndMarginsAreFrameInvariant) {
