@@ -1,11 +1,14 @@
 #include "planner/lattice_search.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <queue>
+#include <set>
 #include <unordered_map>
 
 namespace skylane::planner {
@@ -147,12 +150,34 @@ class LatticeAStar {
     }
     // Both ends are valid: the motion's inner samples every resolution_m.
     if (!innerSamplesValid(l_.position(indexOf(e.parent)), x)) {
-      n.g_best = std::numeric_limits<double>::infinity();  // another parent may still reach it
+      failed_.insert({e.parent, e.key});
+      reopen(e.key, x);
       return false;
     }
     n.closed = true;
     n.parent = e.parent;
     return true;
+  }
+  /// The motion reaching a node failed: it is reached again from each expanded neighbour whose
+  /// motion to it has not failed (an entry that lost to the failed one at push time is gone).
+  void reopen(std::uint64_t key, const Eigen::Vector3d& x) {
+    NodeRecord& n = nodes_[key];
+    n.g_best = std::numeric_limits<double>::infinity();
+    const NodeIndex c = indexOf(key);
+    auto from = [&](const NodeIndex& m) {
+      const std::uint64_t mk = keyOf(m);
+      const auto it = nodes_.find(mk);
+      if (it == nodes_.end() || !it->second.closed || it->second.valid != 1 || failed_.count({mk, key})) return;
+      const Eigen::Vector3d y = l_.position(m);
+      const double g = it->second.g_best + l_.cost(y, x);
+      if (g >= nodes_[key].g_best) return;
+      nodes_[key].g_best = g;
+      open_.push({g + heuristic(x), g, key, mk});
+    };
+    for (const auto& mv : kMoves) from({c.i - mv[0], c.j - mv[1], c.k});
+    for (int dk : {-1, 1}) {
+      if (std::abs(c.k + dk) <= l_.layers) from({c.i, c.j, c.k + dk});
+    }
   }
   /// The samples strictly between a and b (motionIsValid's, without its ends).
   bool innerSamplesValid(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -207,7 +232,15 @@ class LatticeAStar {
   std::chrono::steady_clock::time_point t0_;
   std::priority_queue<OpenEntry, std::vector<OpenEntry>, OpenOrder> open_;
   std::unordered_map<std::uint64_t, NodeRecord> nodes_;
+  std::set<std::pair<std::uint64_t, std::uint64_t>> failed_;  ///< motions (parent, node) found invalid
 };
+
+/// The objective of a path on the lattice's terms (length × (1 + extra cost at each middle)).
+double pathCost(const Lattice& l, const std::vector<Eigen::Vector3d>& path) {
+  double c = 0.0;
+  for (std::size_t i = 1; i < path.size(); ++i) c += l.cost(path[i - 1], path[i]);
+  return c;
+}
 
 /// The lattice steps tried, coarse to fine: the leg's length / 128 clamped to
 /// [2·resolution, 40 m], halved down to the motion resolution.
@@ -222,23 +255,41 @@ std::vector<double> latticeSteps(const PathProblem& p) {
 
 }  // namespace
 
+std::vector<Eigen::Vector3d> withoutCollinearVertices(const std::vector<Eigen::Vector3d>& path) {
+  std::vector<Eigen::Vector3d> out;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    if (out.size() >= 1 && i + 1 < path.size()) {
+      const Eigen::Vector3d a = path[i] - out.back(), b = path[i + 1] - path[i];
+      if (a.cross(b).norm() <= 1e-9 * a.norm() * b.norm() && a.dot(b) > 0.0) continue;
+    }
+    out.push_back(path[i]);
+  }
+  return out;
+}
+
 LatticeResult latticeSearch(const PathProblem& p, const LatticeOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   LatticeResult r;
   const std::vector<double> steps = latticeSteps(p);
+  double best = std::numeric_limits<double>::infinity();
   for (int half_layers : {0, 1}) {
+    int finer_left = 1;  // after the first lattice that finds a path, one finer one more
     for (double h : steps) {
       // Layers above and below only on the coarser lattices: they triple the nodes, and a leg
       // they help (a zone whose floor or ceiling the height surface meets) is rarely that narrow.
       if (half_layers > 0 && h < 2.0 * p.resolution_m) continue;
+      if (r.found && finer_left-- == 0) break;
       const Lattice lattice(p, h, half_layers);
-      r.step_m = h;
-      r.layers = 2 * half_layers + 1;
       std::vector<Eigen::Vector3d> path;
-      if (LatticeAStar(lattice, o, r, t0).run(path)) {
+      if (LatticeAStar(lattice, o, r, t0).run(path) && pathCost(lattice, path) < best) {
+        best = pathCost(lattice, path);
         r.found = true;
         r.points = std::move(path);
-        break;
+        r.step_m = h;
+        r.layers = 2 * half_layers + 1;
+      } else if (!r.found) {
+        r.step_m = h;
+        r.layers = 2 * half_layers + 1;
       }
       if (r.stopped_by_budget || r.stopped_by_time) break;
     }

@@ -186,8 +186,8 @@ void planWithOmpl(const PathProblem& p, PathResult& out) {
 }
 
 /// Refines a valid path (a lattice seed) with the PathSimplifier under the problem's objective
-/// (shortcuts, vertex reduction, B-spline smoothing: each change kept only when its motions are
-/// valid at the problem's resolution).
+/// (shortcuts and vertex reduction: each change kept only when its motions are valid at the
+/// problem's resolution and, for shortcuts, when it lowers the objective).
 void refineWithOmpl(const PathProblem& p, const std::vector<Eigen::Vector3d>& seed, PathResult& out) {
   const std::lock_guard<std::mutex> lock(omplMutex());
   ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
@@ -206,9 +206,17 @@ void refineWithOmpl(const PathProblem& p, const std::vector<Eigen::Vector3d>& se
     path.append(s.get());
   }
   if (p.simplify) {
+    // Shortcuts and vertex reduction until neither changes the path (at most kRefinePasses):
+    // simplifyMax's collapseCloseVertices, quadratic in the vertices, and its B-spline
+    // subdivision took most of the time on a lattice seed of hundreds of vertices.
+    constexpr int kRefinePasses = 8;
     const auto t1 = std::chrono::steady_clock::now();
     og::PathSimplifier simplifier(si, ob::GoalPtr(), objective);
-    simplifier.simplifyMax(path);
+    for (int pass = 0; pass < kRefinePasses; ++pass) {
+      const bool reduced = simplifier.reduceVertices(path);
+      const bool shortened = simplifier.shortcutPath(path);
+      if (!reduced && !shortened) break;
+    }
     out.simplify_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   }
   out.points.clear();

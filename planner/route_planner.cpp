@@ -112,18 +112,27 @@ void planFromLatticeSeed(const PathProblem& p, PathResult& out) {
   out.planning_time_s += seed.time_s;
   out.stopped_by_time = out.stopped_by_time || seed.stopped_by_time;
   if (!seed.found) return;
-  PathResult refined;
-  omplModule().refine(p, seed.points, refined);
-  out.simplify_time_s += refined.simplify_time_s;
-  if (everyMotionValid(p, refined.points)) {
-    out.points = std::move(refined.points);
-    out.cost = refined.cost;
-  } else if (everyMotionValid(p, seed.points)) {
-    out.points = seed.points;
-    out.cost = polylineLength(seed.points);
-  } else {
-    return;
+  // The first that passes the check: the refined seed with its straight runs merged (fewer
+  // vertices for the simplifier), the refined seed as searched, the seed itself.
+  std::vector<std::vector<Eigen::Vector3d>> candidates;
+  double cost = 0.0;
+  for (const std::vector<Eigen::Vector3d>& start : {withoutCollinearVertices(seed.points), seed.points}) {
+    PathResult refined;
+    omplModule().refine(p, start, refined);
+    out.simplify_time_s += refined.simplify_time_s;
+    if (everyMotionValid(p, refined.points)) {
+      candidates.push_back(std::move(refined.points));
+      cost = refined.cost;
+      break;
+    }
   }
+  if (candidates.empty() && everyMotionValid(p, seed.points)) {
+    candidates.push_back(seed.points);
+    cost = polylineLength(seed.points);
+  }
+  if (candidates.empty()) return;
+  out.points = std::move(candidates.front());
+  out.cost = cost;
   out.status = PathStatus::kExact;
   out.lattice_seed = true;
 }
