@@ -287,9 +287,9 @@ LatticeResult latticeSearch(const PathProblem& p, const LatticeOptions& o) {
         r.points = std::move(path);
         r.step_m = h;
         r.layers = 2 * half_layers + 1;
-      } else if (!r.found) {
-        r.step_m = h;
-        r.layers = 2 * half_layers + 1;
+      } else if (!r.found) {  // the finest step searched, and its layers
+        r.layers = r.step_m == 0.0 || h < r.step_m ? 2 * half_layers + 1 : r.layers;
+        r.step_m = r.step_m == 0.0 ? h : std::min(r.step_m, h);
       }
       if (r.stopped_by_budget || r.stopped_by_time) break;
     }

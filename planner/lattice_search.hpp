@@ -47,7 +47,7 @@ struct LatticeOptions {
 struct LatticeResult {
   bool found = false;
   std::vector<Eigen::Vector3d> points;  ///< start … goal (every motion checked every resolution_m)
-  double step_m = 0.0;                  ///< the lattice step that found it (or the last tried)
+  double step_m = 0.0;                  ///< the lattice step that found it (else the finest searched)
   int layers = 0;                       ///< height layers of that lattice (1 or 3)
   std::uint64_t state_checks = 0;       ///< validity checks of nodes and of motions' samples
   std::uint64_t expansions = 0;         ///< entries taken from the open list over every step tried

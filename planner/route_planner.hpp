@@ -89,7 +89,7 @@ struct PathResult {
   /// \brief The lattice seed was searched (the OMPL search found no exact path, or kLattice).
   bool lattice_searched = false;
   bool lattice_seed = false;            ///< the route is the refined lattice seed
-  double lattice_step_m = 0.0;          ///< the step of the lattice that found it (or the last tried)
+  double lattice_step_m = 0.0;          ///< the step of the lattice that found it (else the finest searched)
   std::uint64_t lattice_state_checks = 0;  ///< validity checks the lattice search made
   bool lattice_budget_spent = false;       ///< the lattice search ended on its check budget
   double lattice_time_s = 0.0;

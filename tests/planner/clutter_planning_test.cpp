@@ -184,6 +184,7 @@ TEST(ClutterPlanning, AWallAcrossTheFieldLeavesNoRouteAndTheLatticeSaysSo) {
   EXPECT_NE(r.status, PathStatus::kExact);
   EXPECT_TRUE(r.lattice_searched);
   EXPECT_FALSE(r.lattice_seed);
+  EXPECT_DOUBLE_EQ(r.lattice_step_m, p.resolution_m);  // down to the finest step
   // Every lattice searched to its end (the reachable side exhausted), not cut short.
   EXPECT_FALSE(r.lattice_budget_spent);
   EXPECT_FALSE(r.stopped_by_time);
