@@ -1,6 +1,6 @@
 #pragma once
 /// \file
-/// \brief A lattice seed for routes through clutter: weighted A* over a state lattice of the
+/// \brief A lattice seed for routes through clutter: A* over a state lattice of the
 /// planning query's free space, coarse to fine, with the same state-validity predicate and the
 /// same motion check as every route (docs/method.md §7.1, "Clutter").
 ///
@@ -17,16 +17,16 @@
 /// the lattice's shortest path. A heuristic inflated by ε > 1 (I. Pohl, "Heuristic search viewed
 /// as path finding in a graph", Artificial Intelligence 1(3), 1970) finds one at most ε times
 /// it after fewer checks; on the 48 km² clutter bench ε = 1.5 took a quarter of the checks for a
-/// route 10 % longer, and the checks cost less than the sampling of the longer route. Lattices of this kind for planning are
-/// those of M. Pivtoraiko, R. A. Knepper and A. Kelly, "Differentially constrained mobile robot
+/// route 10 % longer, and the approval as long in all (the longer route has more samples).
+/// Lattices of this kind for planning are those of M. Pivtoraiko, R. A. Knepper and A. Kelly, "Differentially constrained mobile robot
 /// motion planning in state lattices", Journal of Field Robotics 26(3), 2009.
 ///
 /// Step length relative to free space: the first step is the leg's length / 128 clamped to
 /// [2·resolution, 40 m]; a lattice that finds no path is halved, down to the motion resolution,
 /// so that a passage about as wide as the finest step (plus the planning volume the predicate
 /// already holds) is found when one exists; the lattice after the first that finds one is
-/// searched too, and the cheaper path kept (a coarse lattice passes fewer gaps: a detour). Each step is tried first on the leg's own height
-/// surface; then the steps of at least 2·resolution with a layer above and below. Deterministic:
+/// searched too, and the cheaper path kept (a coarse lattice passes fewer gaps: a detour). Each
+/// step is tried first on the leg's own height surface; then the steps of at least 2·resolution with a layer above and below. Deterministic:
 /// the same problem gives the same seed (ties broken by node index).
 
 #include "planner/route_planner.hpp"
