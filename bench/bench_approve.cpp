@@ -7,7 +7,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "geofence/corridor.hpp"
+
+#include <algorithm>
 #include <cmath>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -94,7 +98,7 @@ std::string cityMission(planner::PlannerKind kind) {
 }
 
 void run(benchmark::State& state, const std::string& mission_path) {
-  double length = 0, planning = 0, iterations = 0;
+  double length = 0, planning = 0, iterations = 0, lattice_checks = 0;
   int approved = 0, n = 0;
   for (auto _ : state) {
     planner::Approver a(planner::loadMission(mission_path));  // loading is part of the job
@@ -102,6 +106,7 @@ void run(benchmark::State& state, const std::string& mission_path) {
     length += r.planner.length_m;
     planning += r.planner.planning_time_s;
     iterations += static_cast<double>(r.planner.iterations);
+    lattice_checks += static_cast<double>(r.planner.lattice_state_checks);
     approved += r.approved ? 1 : 0;
     ++n;
   }
@@ -109,6 +114,7 @@ void run(benchmark::State& state, const std::string& mission_path) {
   state.counters["planning_s"] = planning / n;
   state.counters["approved"] = static_cast<double>(approved) / n;
   state.counters["iterations"] = static_cast<double>(iterations) / n;
+  if (lattice_checks > 0) state.counters["lattice_checks"] = lattice_checks / n;
 }
 
 void BM_ApproveBundledExample(benchmark::State& state) { run(state, kExample); }
@@ -135,5 +141,131 @@ void BM_ApproveCity(benchmark::State& state) {
   run(state, cityMission(kind));
 }
 BENCHMARK(BM_ApproveCity)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// --- clutter (issue 22): 10,000 zones in 48 km² ------------------------------------------------
+
+/// The clutter field: 10,000 prohibited circles (radius 15–40 m, uniform) scattered uniformly
+/// over 8 km × 6 km, none within 150 m of the start (1 km, 1 km) or the goal (7 km, 5 km); the
+/// search box (the two points ± 1 km) is exactly the field. Circles: centre x, y and radius [m].
+struct ClutterField {
+  std::vector<Eigen::Vector3d> circles;
+  Eigen::Vector2d start{1000, 1000}, goal{7000, 5000};
+};
+
+const ClutterField& clutterField() {
+  static const ClutterField field = [] {
+    ClutterField f;
+    std::mt19937_64 rng(22);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    while (f.circles.size() < 10000) {
+      const Eigen::Vector2d c(u(rng) * 8000, u(rng) * 6000);
+      const double r = 15 + 25 * u(rng);
+      if ((c - f.start).norm() < 150 + r || (c - f.goal).norm() < 150 + r) continue;
+      f.circles.emplace_back(c.x(), c.y(), r);
+    }
+    return f;
+  }();
+  return field;
+}
+
+/// Independently of the planner: the fraction of the field within `grow_m` of a circle, and
+/// whether a route exists, on a 2 m grid: a cell is free when its whole square is farther than
+/// radius + grow_m from every centre (conservative), and the free cells holding the start and the
+/// goal are joined through free cells sharing an edge (breadth-first search). A chain of such
+/// squares is a flyable route: a "yes" proves one exists.
+std::pair<double, bool> clutterProof(const ClutterField& f, double grow_m) {
+  constexpr double kCell = 2.0;
+  const int nx = static_cast<int>(8000 / kCell), ny = static_cast<int>(6000 / kCell);
+  std::vector<char> blocked(static_cast<std::size_t>(nx) * ny, 0);
+  for (const Eigen::Vector3d& c : f.circles) {
+    const double reach = c.z() + grow_m;
+    for (int i = std::max(0, static_cast<int>((c.x() - reach) / kCell) - 1); i < std::min(nx, static_cast<int>((c.x() + reach) / kCell) + 2); ++i) {
+      for (int j = std::max(0, static_cast<int>((c.y() - reach) / kCell) - 1); j < std::min(ny, static_cast<int>((c.y() + reach) / kCell) + 2); ++j) {
+        // Nearest point of the cell's square to the centre.
+        const double qx = std::clamp(c.x(), i * kCell, (i + 1) * kCell), qy = std::clamp(c.y(), j * kCell, (j + 1) * kCell);
+        if (std::hypot(qx - c.x(), qy - c.y()) <= reach) blocked[static_cast<std::size_t>(j) * nx + i] = 1;
+      }
+    }
+  }
+  const double fraction = static_cast<double>(std::count(blocked.begin(), blocked.end(), 1)) / static_cast<double>(blocked.size());
+  auto cell = [&](const Eigen::Vector2d& p) { return static_cast<std::size_t>(p.y() / kCell) * nx + static_cast<std::size_t>(p.x() / kCell); };
+  std::vector<char> seen(blocked.size(), 0);
+  std::deque<std::size_t> queue{cell(f.start)};
+  seen[queue.front()] = 1;
+  while (!queue.empty()) {
+    const std::size_t k = queue.front();
+    queue.pop_front();
+    if (k == cell(f.goal)) return {fraction, true};
+    const int i = static_cast<int>(k % nx), j = static_cast<int>(k / nx);
+    for (auto [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+      if (i + di < 0 || i + di >= nx || j + dj < 0 || j + dj >= ny) continue;
+      const std::size_t n = static_cast<std::size_t>(j + dj) * nx + static_cast<std::size_t>(i + di);
+      if (blocked[n] || seen[n]) continue;
+      seen[n] = 1;
+      queue.push_back(n);
+    }
+  }
+  return {fraction, false};
+}
+
+/// Writes the clutter field's zones once and a mission through it with `algorithm` (the
+/// receiver declares HPL 4 m / VPL 6 m, so the planning volume is known: the level-1 box, or
+/// 1.2 × the PLs where larger); returns the mission file.
+std::string clutterMission(const std::string& algorithm) {
+  const std::string dir = "/tmp/skylane-bench-clutter";
+  const ClutterField& f = clutterField();
+  if (!std::filesystem::exists(dir + "/zones.json")) {
+    std::filesystem::create_directories(dir);
+    json zones = json::array();
+    for (std::size_t i = 0; i < f.circles.size(); ++i) {
+      const Eigen::Vector3d& c = f.circles[i];
+      zones.push_back({{"identifier", "CLUTTER-" + std::to_string(i)}, {"country", "CHE"}, {"name", "generated"},
+                       {"type", "COMMON"}, {"restriction", "PROHIBITED"}, {"reason", {"OTHER"}},
+                       {"applicability", json::array({{{"permanent", "YES"}}})},
+                       {"geometry", {{{"uomDimensions", "M"}, {"lowerLimit", 0}, {"lowerVerticalReference", "AGL"},
+                                       {"upperLimit", 150}, {"upperVerticalReference", "AGL"},
+                                       {"horizontalProjection", {{"type", "Circle"},
+                                                                 {"center", {kLon0 + dLon(c.x()), kLat0 + dLat(c.y())}},
+                                                                 {"radius", c.z()}}}}}}});
+    }
+    std::ofstream(dir + "/zones.json") << json{{"formatVersion", "1.0.0"}, {"UASZoneList", zones}}.dump();
+  }
+  const std::string path = dir + "/mission_" + algorithm + ".json";
+  json m{{"name", "10,000 zones in 48 km²"},
+         {"vehicle", {{"lateral_m", 1.2}, {"longitudinal_m", 1.0}, {"cruise_speed_mps", 15}}},
+         {"k1", 1.2}, {"k2", 150},
+         {"start", {{"lat", kLat0 + dLat(f.start.y())}, {"lon", kLon0 + dLon(f.start.x())}}},
+         {"goal", {{"lat", kLat0 + dLat(f.goal.y())}, {"lon", kLon0 + dLon(f.goal.x())}}},
+         {"altitude", {{"cruise_agl_m", 60}, {"min_agl_m", 30}, {"max_agl_m", 120}}},
+         {"departure", "2020-01-01T14:00:00Z"},
+         {"zones", {dir + "/zones.json"}},
+         {"ground_amsl_m", 408},
+         {"orbits", {std::string(SKYLANE_TEST_DATA) + "/gnss/alm01jan2020.txt"}},
+         {"navigation", {{"kind", "receiver"}, {"hpl_m", 4.0}, {"vpl_m", 6.0}}},
+         {"integrity", {{"sample_s", 1.0}, {"cost_weight", 0.0}}},
+         {"planner", {{"algorithm", algorithm}, {"time_limit_s", 30.0}, {"iterations", 10000}, {"seed", 5},
+                      {"resolution_m", 5.0}, {"margin_m", 1000}}}};
+  std::ofstream(path) << m.dump(1);
+  return path;
+}
+
+/// The clutter case with RRT* (its lattice fallback engages when it finds no route) and with
+/// the lattice seed at once. Counters: the blocked fraction (zones grown by the planning
+/// volume) and whether the independent grid search proves a route exists.
+void BM_ApproveClutter(benchmark::State& state) {
+  const std::string algorithm = state.range(0) == 0 ? "rrtstar" : "lattice";
+  state.SetLabel(algorithm);
+  const std::string path = clutterMission(algorithm);
+  const planner::Mission mission = planner::loadMission(path);
+  const geofence::LevelLimits limits = geofence::alertLimits(mission.vehicle, mission.levels);
+  const double grow_m = std::max(limits.level1.hal_m, 1.2 * mission.navigation.hpl_m);
+  const double bare = clutterProof(clutterField(), 0.0).first;
+  const auto [grown, exists] = clutterProof(clutterField(), grow_m + 1.0);
+  run(state, path);
+  state.counters["blocked_bare"] = bare;
+  state.counters["blocked_grown"] = grown;
+  state.counters["route_exists"] = exists ? 1.0 : 0.0;
+}
+BENCHMARK(BM_ApproveClutter)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace

@@ -133,6 +133,11 @@ struct PlannerStats {
   std::uint64_t iterations = 0;  ///< planner iterations in all
   bool stopped_by_time = false;  ///< some search ended at the time limit (then not reproducible)
   int departures_tried = 0;
+  /// Legs whose OMPL search found no exact path and that searched the lattice seed (or all legs,
+  /// with the "lattice" algorithm); legs whose route is the refined seed.
+  int lattice_legs_searched = 0, lattice_legs_seeded = 0;
+  std::uint64_t lattice_state_checks = 0;  ///< in all
+  double lattice_step_m = 0.0;             ///< of the last leg that searched the lattice
 };
 
 /// \brief One input file of an approval and its SHA-256 when the approver read it.

@@ -268,6 +268,12 @@ LegPlan Approver::Impl::planLegs(const ApprovalSetup& setup, const maps::GpsTime
     stats.planning_time_s += plan.last.planning_time_s + plan.last.simplify_time_s;
     stats.iterations += plan.last.iterations;
     stats.stopped_by_time = stats.stopped_by_time || plan.last.stopped_by_time;
+    if (plan.last.lattice_searched) {
+      ++stats.lattice_legs_searched;
+      stats.lattice_legs_seeded += plan.last.lattice_seed ? 1 : 0;
+      stats.lattice_state_checks += plan.last.lattice_state_checks;
+      stats.lattice_step_m = plan.last.lattice_step_m;
+    }
     if (plan.last.status != PathStatus::kExact) {
       plan.ok = false;
       plan.failed_leg = leg;
@@ -314,6 +320,7 @@ PathProblem Approver::Impl::legProblem(const ApprovalSetup& setup, const maps::G
   prob.seed = m.seed + static_cast<std::uint64_t>(attempt) * 7919u + leg;
   prob.planner = m.planner;
   prob.simplify = m.simplify;
+  prob.lattice_fallback = m.lattice_fallback;
   return prob;
 }
 
@@ -328,6 +335,10 @@ Reason Approver::Impl::planningReason(const ApprovalSetup& setup, const maps::Gp
   if (last.status != PathStatus::kInvalidStart && last.status != PathStatus::kInvalidGoal) {
     r.message = "no route found for leg " + std::to_string(plan.failed_leg) + " within " + std::to_string(last.iterations) +
                 " planner iterations (" + status + (last.stopped_by_time ? ", stopped by the time limit)" : ")") +
+                (last.lattice_searched ? ", nor on a lattice down to a " + fmtMetres(last.lattice_step_m) + " step (" +
+                                             std::to_string(last.lattice_state_checks) + " states checked" +
+                                             (last.lattice_budget_spent ? ", its whole budget)" : ")")
+                                       : std::string()) +
                 legBlockers(plan.pts.back(), setup.stops[plan.failed_leg], departure, setup.zones_until) +
                 "; a wider search box (planner.margin_m " + fmtMetres(m.margin_m) + ") or more planner.iterations (" +
                 std::to_string(m.iterations) + ") may find one";

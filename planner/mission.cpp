@@ -629,10 +629,11 @@ void readPolicy(const JsonNode& p, Mission& m) {
 
 void readPlannerSettings(const JsonNode& p, Mission& m) {
   p.requireKnownFields(
-      {"algorithm", "time_limit_s", "iterations", "seed", "resolution_m", "simplify", "margin_m", "max_replans"});
+      {"algorithm", "time_limit_s", "iterations", "seed", "resolution_m", "simplify", "margin_m", "max_replans",
+       "lattice_fallback"});
   if (p.has("algorithm")) {
     const auto k = parsePlannerKind(p.at("algorithm").str());
-    if (!k) p.at("algorithm").fail("\"rrtstar\", \"informed_rrtstar\", \"bitstar\" or \"prmstar\"");
+    if (!k) p.at("algorithm").fail("\"rrtstar\", \"informed_rrtstar\", \"bitstar\", \"prmstar\" or \"lattice\"");
     m.planner = *k;
   }
   if (p.has("time_limit_s")) m.time_limit_s = p.at("time_limit_s").positiveUpTo(kMaxTimeLimit_s, "s");
@@ -648,6 +649,7 @@ void readPlannerSettings(const JsonNode& p, Mission& m) {
   }
   if (p.has("resolution_m")) m.resolution_m = p.at("resolution_m").positiveUpTo(kMaxPlannerLength_m, "m");
   if (p.has("simplify")) m.simplify = p.at("simplify").boolean();
+  if (p.has("lattice_fallback")) m.lattice_fallback = p.at("lattice_fallback").boolean();
   if (p.has("margin_m")) m.margin_m = p.at("margin_m").positiveUpTo(kMaxPlannerLength_m, "m");
   if (p.has("max_replans")) {
     const double r = p.at("max_replans").number();

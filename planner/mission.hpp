@@ -127,6 +127,9 @@ struct Mission {
   std::uint64_t seed = 1;
   double resolution_m = 2.0;
   bool simplify = true;
+  /// When the OMPL search finds no exact path, search a lattice seed and refine it
+  /// (planner/lattice_search.hpp); "lattice" as the algorithm searches it at once.
+  bool lattice_fallback = true;
   double margin_m = 300.0;     ///< the search box reaches this far beyond start, waypoints and goal
   int max_replans = 2;         ///< per departure, after a violation
 };

@@ -120,6 +120,7 @@ ob::PlannerPtr makePlanner(PlannerKind kind, const ob::SpaceInformationPtr& si) 
     case PlannerKind::kInformedRrtStar: planner = std::make_shared<og::InformedRRTstar>(si); break;
     case PlannerKind::kBitStar: planner = std::make_shared<og::BITstar>(si); break;
     case PlannerKind::kPrmStar: planner = std::make_shared<og::PRMstar>(si); break;
+    case PlannerKind::kLattice: break;  // planPath searches the lattice seed without OMPL's planners
   }
   return planner;
 }
@@ -184,11 +185,51 @@ void planWithOmpl(const PathProblem& p, PathResult& out) {
   takeSolution(ss, objective, p, out);
 }
 
+/// Refines a valid path (a lattice seed) with the PathSimplifier under the problem's objective
+/// (shortcuts and vertex reduction: each change kept only when its motions are valid at the
+/// problem's resolution and, for shortcuts, when it lowers the objective).
+void refineWithOmpl(const PathProblem& p, const std::vector<Eigen::Vector3d>& seed, PathResult& out) {
+  const std::lock_guard<std::mutex> lock(omplMutex());
+  ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
+  ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(p.seed % 4294967291ULL + 1));
+
+  const std::shared_ptr<ob::RealVectorStateSpace> space = searchSpace(p);
+  const auto si = std::make_shared<ob::SpaceInformation>(space);
+  si->setStateValidityChecker([&p](const ob::State* s) { return p.is_valid(toVector(s)); });
+  si->setStateValidityCheckingResolution(std::min(1.0, p.resolution_m / space->getMaximumExtent()));
+  si->setup();
+  const ob::OptimizationObjectivePtr objective = objectiveFor(si, p);
+  og::PathGeometric path(si);
+  for (const Eigen::Vector3d& x : seed) {
+    ob::ScopedState<> s(space);
+    for (int i = 0; i < 3; ++i) s[i] = x[i];
+    path.append(s.get());
+  }
+  if (p.simplify) {
+    // Shortcuts and vertex reduction until neither changes the path (at most kRefinePasses):
+    // simplifyMax's collapseCloseVertices, quadratic in the vertices, and its B-spline
+    // subdivision took most of the time on a lattice seed of hundreds of vertices.
+    constexpr int kRefinePasses = 8;
+    const auto t1 = std::chrono::steady_clock::now();
+    og::PathSimplifier simplifier(si, ob::GoalPtr(), objective);
+    for (int pass = 0; pass < kRefinePasses; ++pass) {
+      const bool reduced = simplifier.reduceVertices(path);
+      const bool shortened = simplifier.shortcutPath(path);
+      if (!reduced && !shortened) break;
+    }
+    out.simplify_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  }
+  out.points.clear();
+  for (std::size_t i = 0; i < path.getStateCount(); ++i) out.points.push_back(toVector(path.getState(i)));
+  out.cost = path.cost(objective).value();
+}
+
 }  // namespace
 }  // namespace skylane::planner::detail
 
 /// The module's one exported symbol (its name carries kOmplModuleAbi).
-extern "C" __attribute__((visibility("default"))) const skylane::planner::detail::OmplModule* skylane_ompl_module_v1() {
-  static const skylane::planner::detail::OmplModule module{&skylane::planner::detail::planWithOmpl};
+extern "C" __attribute__((visibility("default"))) const skylane::planner::detail::OmplModule* skylane_ompl_module_v2() {
+  static const skylane::planner::detail::OmplModule module{&skylane::planner::detail::planWithOmpl,
+                                                           &skylane::planner::detail::refineWithOmpl};
   return &module;
 }

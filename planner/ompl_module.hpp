@@ -17,10 +17,14 @@ struct OmplModule {
   /// times, iterations and stopped_by_time of `out`. Serialised inside (OMPL's seed generator
   /// is process-wide).
   void (*plan)(const PathProblem& problem, PathResult& out);
+  /// \brief Refines a valid path (a lattice seed) with OMPL's PathSimplifier under the problem's
+  /// objective when problem.simplify: fills points, cost and simplify_time_s of `out`. The caller
+  /// checks every motion of the result again. Serialised and seeded like plan.
+  void (*refine)(const PathProblem& problem, const std::vector<Eigen::Vector3d>& seed, PathResult& out);
 };
 
 /// \brief The interface version the module and skylane agree on (in the entry point's name).
-inline constexpr int kOmplModuleAbi = 1;
+inline constexpr int kOmplModuleAbi = 2;
 /// \brief File name of the module.
 inline constexpr const char* kOmplModuleFile = "libskylane_ompl.so";
 

@@ -127,7 +127,7 @@ json zonesJson(const ApprovalReport& r) {
 }
 
 json plannerJson(const ApprovalReport& r) {
-  return {{"algorithm", r.planner.algorithm},
+  json j = {{"algorithm", r.planner.algorithm},
           {"status", r.planner.status},
           {"straight_line", r.planner.straight_line},
           {"planning_time_s", std::round(r.planner.planning_time_s * 1e4) / 1e4},
@@ -137,6 +137,15 @@ json plannerJson(const ApprovalReport& r) {
           {"stopped_by_time", r.planner.stopped_by_time},
           {"departures_tried", r.planner.departures_tried},
           {"seed", r.mission.seed}};
+  // Only when some leg searched the lattice seed (planner/lattice_search.hpp): reports of routes
+  // the OMPL search found read as before.
+  if (r.planner.lattice_legs_searched > 0) {
+    j["lattice"] = {{"legs_searched", r.planner.lattice_legs_searched},
+                    {"legs_seeded", r.planner.lattice_legs_seeded},
+                    {"state_checks", r.planner.lattice_state_checks},
+                    {"last_step_m", r.planner.lattice_step_m}};
+  }
+  return j;
 }
 
 /// The inputs' digests: the approval can be audited and replayed against exactly these files.

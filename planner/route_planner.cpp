@@ -1,6 +1,7 @@
 #include "planner/route_planner.hpp"
 
 #include "maps/module_loader.hpp"
+#include "planner/lattice_search.hpp"
 #include "planner/ompl_module.hpp"
 
 #include <cmath>
@@ -21,12 +22,14 @@ std::string_view plannerName(PlannerKind k) {
     case PlannerKind::kInformedRrtStar: return "informed_rrtstar";
     case PlannerKind::kBitStar: return "bitstar";
     case PlannerKind::kPrmStar: return "prmstar";
+    case PlannerKind::kLattice: return "lattice";
   }
   return "?";
 }
 
 std::optional<PlannerKind> parsePlannerKind(std::string_view name) {
-  for (PlannerKind k : {PlannerKind::kRrtStar, PlannerKind::kInformedRrtStar, PlannerKind::kBitStar, PlannerKind::kPrmStar}) {
+  for (PlannerKind k : {PlannerKind::kRrtStar, PlannerKind::kInformedRrtStar, PlannerKind::kBitStar, PlannerKind::kPrmStar,
+                        PlannerKind::kLattice}) {
     if (plannerName(k) == name) return k;
   }
   return std::nullopt;
@@ -50,15 +53,6 @@ double polylineLength(const std::vector<Eigen::Vector3d>& points) {
 }
 
 namespace {
-
-bool motionValid(const PathProblem& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const double len = (b - a).norm();
-  const int steps = std::max(1, static_cast<int>(std::ceil(len / p.resolution_m)));
-  for (int i = 0; i <= steps; ++i) {
-    if (!p.is_valid(a + (b - a) * (static_cast<double>(i) / steps))) return false;
-  }
-  return true;
-}
 
 void checkProblem(const PathProblem& p) {
   if (!p.is_valid) throw std::invalid_argument("planPath: a state validity predicate is required");
@@ -86,14 +80,61 @@ std::optional<PathStatus> invalidEnd(const PathProblem& p) {
 /// first route that is not a straight line.
 const detail::OmplModule& omplModule() {
   static const detail::OmplModule& module = [] () -> const detail::OmplModule& {
-    const maps::detail::ModuleSpec spec{detail::kOmplModuleFile, "SKYLANE_OMPL_MODULE", "skylane_ompl_module_v1",
+    const maps::detail::ModuleSpec spec{detail::kOmplModuleFile, "SKYLANE_OMPL_MODULE", "skylane_ompl_module_v2",
                                         SKYLANE_OMPL_MODULE_BUILD_PATH, SKYLANE_OMPL_MODULE_INSTALL_PATH,
                                         "planning a route around obstacles"};
-    static_assert(detail::kOmplModuleAbi == 1, "rename the entry point with the ABI version");
+    static_assert(detail::kOmplModuleAbi == 2, "rename the entry point with the ABI version");
     using Entry = const detail::OmplModule* (*)();
     return *reinterpret_cast<Entry>(maps::detail::loadModuleEntry(spec))();
   }();
   return module;
+}
+
+/// Every motion of `points` valid, checked every resolution_m (the route is taken only then).
+bool everyMotionValid(const PathProblem& p, const std::vector<Eigen::Vector3d>& points) {
+  for (std::size_t i = 1; i < points.size(); ++i) {
+    if (!motionIsValid(p, points[i - 1], points[i])) return false;
+  }
+  return points.size() >= 2;
+}
+
+/// The lattice seed (planner/lattice_search.hpp), refined by OMPL and checked again: the refined
+/// path when every motion of it is valid, else the seed itself (checked the same way).
+void planFromLatticeSeed(const PathProblem& p, PathResult& out) {
+  LatticeOptions options;
+  options.time_limit_s = p.time_limit_s;
+  const LatticeResult seed = latticeSearch(p, options);
+  out.lattice_searched = true;
+  out.lattice_step_m = seed.step_m;
+  out.lattice_state_checks = seed.state_checks;
+  out.lattice_budget_spent = seed.stopped_by_budget;
+  out.lattice_time_s = seed.time_s;
+  out.planning_time_s += seed.time_s;
+  out.stopped_by_time = out.stopped_by_time || seed.stopped_by_time;
+  if (!seed.found) return;
+  // The first that passes the check: the refined seed with its straight runs merged (fewer
+  // vertices for the simplifier), the refined seed as searched, the seed itself.
+  std::vector<std::vector<Eigen::Vector3d>> candidates;
+  double cost = 0.0;
+  for (const std::vector<Eigen::Vector3d>& start : {withoutCollinearVertices(seed.points), seed.points}) {
+    PathResult refined;
+    omplModule().refine(p, start, refined);
+    out.simplify_time_s += refined.simplify_time_s;
+    if (everyMotionValid(p, refined.points)) {
+      candidates.push_back(std::move(refined.points));
+      cost = refined.cost;
+      break;
+    }
+  }
+  if (candidates.empty() && everyMotionValid(p, seed.points)) {
+    candidates.push_back(seed.points);
+    cost = polylineLength(seed.points);
+  }
+  if (candidates.empty()) return;
+  out.points = std::move(candidates.front());
+  out.cost = cost;
+  out.status = PathStatus::kExact;
+  out.lattice_seed = true;
 }
 
 }  // namespace
@@ -106,14 +147,21 @@ PathResult planPath(const PathProblem& p) {
     out.status = *invalid;
     return out;
   }
-  if (!p.extra_cost && motionValid(p, p.start_enu_m, p.goal_enu_m)) {
+  if (!p.extra_cost && motionIsValid(p, p.start_enu_m, p.goal_enu_m)) {
     out.status = PathStatus::kExact;
     out.points = {p.start_enu_m, p.goal_enu_m};
     out.length_m = out.cost = polylineLength(out.points);
     out.straight_line = true;
     return out;
   }
-  omplModule().plan(p, out);
+  if (p.planner != PlannerKind::kLattice) {
+    omplModule().plan(p, out);
+  } else {
+    out.status = PathStatus::kNoSolution;
+  }
+  if (out.status != PathStatus::kExact && (p.lattice_fallback || p.planner == PlannerKind::kLattice)) {
+    planFromLatticeSeed(p, out);
+  }
   out.length_m = polylineLength(out.points);
   return out;
 }

@@ -18,6 +18,11 @@
 /// Frazzoli 2011). A seed makes a run reproducible when the iteration budget, not the time
 /// limit, ends the search (OMPL's seed generator is re-seeded before each query). PRM* grows its
 /// roadmap in a second thread, so its result can still vary between runs.
+///
+/// Clutter (planner/lattice_search.hpp): when the OMPL search ends without an exact path, a
+/// lattice seed is searched (weighted A*, coarse to fine), refined by OMPL's PathSimplifier under
+/// the same objective, and every motion of the result is checked again every resolution_m before
+/// it is taken. PlannerKind::kLattice goes to the lattice seed at once.
 
 #include <Eigen/Core>
 
@@ -31,9 +36,9 @@
 namespace skylane::planner {
 
 /// \brief The OMPL planners offered.
-enum class PlannerKind { kRrtStar, kInformedRrtStar, kBitStar, kPrmStar };
+enum class PlannerKind { kRrtStar, kInformedRrtStar, kBitStar, kPrmStar, kLattice };
 
-/// \brief "rrtstar", "informed_rrtstar", "bitstar", "prmstar".
+/// \brief "rrtstar", "informed_rrtstar", "bitstar", "prmstar", "lattice".
 [[nodiscard]] std::string_view plannerName(PlannerKind k);
 /// \brief Parses a planner name; std::nullopt when unknown.
 [[nodiscard]] std::optional<PlannerKind> parsePlannerKind(std::string_view name);
@@ -59,6 +64,9 @@ struct PathProblem {
   /// \brief Stop as soon as a path is found whose cost is within this factor of the straight
   /// line's length (1 = run to the time limit unless the straight line itself is valid).
   double good_enough_factor = 1.0;
+  /// \brief When the OMPL search ends without an exact path, search the lattice seed
+  /// (planner/lattice_search.hpp) and refine it; kLattice searches it at once.
+  bool lattice_fallback = true;
 };
 
 /// \brief How the query ended (OMPL's PlannerStatus, in skylane's words).
@@ -78,6 +86,13 @@ struct PathResult {
   bool stopped_by_time = false;         ///< the time limit ended the search (not reproducible)
   std::string planner;
   bool straight_line = false;           ///< the direct segment was valid and taken without search
+  /// \brief The lattice seed was searched (the OMPL search found no exact path, or kLattice).
+  bool lattice_searched = false;
+  bool lattice_seed = false;            ///< the route is the refined lattice seed
+  double lattice_step_m = 0.0;          ///< the step of the lattice that found it (else the finest searched)
+  std::uint64_t lattice_state_checks = 0;  ///< validity checks the lattice search made
+  bool lattice_budget_spent = false;       ///< the lattice search ended on its check budget
+  double lattice_time_s = 0.0;
 };
 
 /// \brief Plans one path. The straight segment is tried first (it is optimal when valid).

@@ -540,6 +540,10 @@ TEST(Mission, ErrorsNameTheField) {
                   {"departure", "2020-01-01T14:00:00Z"},
                   {"orbits", {"a.txt"}}};
   EXPECT_NO_THROW((void)parseMission(good, "m.json", "."));
+  json lattice = good;
+  lattice["planner"] = {{"algorithm", "lattice"}, {"lattice_fallback", false}};
+  EXPECT_EQ(parseMission(lattice, "m.json", ".").planner, PlannerKind::kLattice);
+  EXPECT_FALSE(parseMission(lattice, "m.json", ".").lattice_fallback);
   struct Case {
     std::function<void(json&)> edit;
     std::string expected;
@@ -547,7 +551,8 @@ TEST(Mission, ErrorsNameTheField) {
   const std::vector<Case> cases{
       {[](json& j) { j["wings"] = 2; }, "$.wings"},
       {[](json& j) { j.erase("goal"); }, "$.goal"},
-      {[](json& j) { j["planner"] = {{"algorithm", "astar"}}; }, "rrtstar"},
+      {[](json& j) { j["planner"] = {{"algorithm", "astar"}}; }, "\"prmstar\" or \"lattice\""},
+      {[](json& j) { j["planner"] = {{"lattice_fallback", "yes"}}; }, "$.planner.lattice_fallback"},
       {[](json& j) { j["departure"] = "tomorrow"; }, "RFC 3339"},
       {[](json& j) { j["altitude"] = {{"cruise_agl_m", 200}}; }, "cruise_agl_m ≤ max_agl_m"},
       {[](json& j) { j["vehicle"]["cruise_speed_mps"] = 0; }, "$.vehicle.cruise_speed_mps"},

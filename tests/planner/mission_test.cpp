@@ -504,6 +504,7 @@ TEST(MissionFile, OmittedFieldsTakeTheirDefaults) {
   EXPECT_EQ(d.seed, 1u);
   EXPECT_EQ(d.resolution_m, 2.0);
   EXPECT_TRUE(d.simplify);
+  EXPECT_TRUE(d.lattice_fallback);  // a leg the OMPL search cannot plan searches the lattice seed
   EXPECT_EQ(d.margin_m, 300.0);
   EXPECT_EQ(d.max_replans, 2);
   EXPECT_TRUE(d.qgc_plan_file.empty());
