@@ -156,7 +156,11 @@ Obstructions::Obstructions(std::vector<airspace::Zone> zones, std::vector<maps::
     }
   }
   zone_counts_.reserve(zones_.size());
-  for (const airspace::Zone& z : zones_) zone_counts_.push_back(counts(z, policy_));
+  always_active_.reserve(zones_.size());
+  for (const airspace::Zone& z : zones_) {
+    zone_counts_.push_back(counts(z, policy_));
+    always_active_.push_back(z.applicability.empty());
+  }
   for (const ScenePiece& p : scene_.pieces()) {
     pieces_in_band_ = pieces_in_band_ && p.prism.floor_h_ell_m >= kSceneFloor_h_ell_m &&
                       p.prism.ceiling_h_ell_m <= kSceneCeiling_h_ell_m;
@@ -166,7 +170,8 @@ Obstructions::Obstructions(std::vector<airspace::Zone> zones, std::vector<maps::
 std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) const {
   // Zones count when the policy says so and they are active in the interval; obstacles always.
   const auto accept = [&](PieceOwner owner, std::size_t i) {
-    return owner == PieceOwner::kObstacle || (zone_counts_[i] && airspace::isActiveDuring(zones_[i], v.t0, v.t1));
+    return owner == PieceOwner::kObstacle ||
+           (zone_counts_[i] && (always_active_[i] || airspace::isActiveDuring(zones_[i], v.t0, v.t1)));
   };
   // A volume taller than the scene's height band (a VPL of kilometres from a poor geometry) is
   // cut to the band when every piece lies inside it (unlimited limits are cut to the band; a

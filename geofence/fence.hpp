@@ -158,6 +158,9 @@ class Obstructions {
   std::vector<airspace::Zone> zones_;
   std::vector<maps::Building> buildings_;
   std::vector<bool> zone_counts_;
+  /// Per zone: it has no applicability periods (always active), so a check need not read the
+  /// zone itself to know (the zones are large; reading one per candidate misses the cache).
+  std::vector<bool> always_active_;
   std::vector<KeepInVolume> keep_in_;
   Scene scene_;
   bool pieces_in_band_ = true;  ///< every piece within the scene's height band (volumes may be cut to it)

@@ -10,7 +10,6 @@
 #include <exception>
 #include <limits>
 #include <optional>
-#include <tuple>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -151,18 +150,28 @@ class PieceGrid {
   /// Most cells along one axis.
   static constexpr int kMaxCellsPerAxis = 4096;
 
-  void build(std::vector<detail::FclBox> boxes);
-  /// Appends to `out` every piece whose AABB meets `q` (closed boxes), in no particular order.
-  void collect(const detail::FclBox& q, std::vector<std::size_t>& out) const;
+  /// `keys[i]` is what collect() reports for piece i (its ownerKey()).
+  void build(std::vector<detail::FclBox> boxes, std::vector<std::uint64_t> keys);
+  /// Appends to `out` the key of every piece whose AABB meets `q` (closed boxes), in no
+  /// particular order.
+  void collect(const detail::FclBox& q, std::vector<std::uint64_t>& out) const;
 
  private:
   struct FloatBox {
     float lo[3];
     float hi[3];
   };
+  /// A piece's entry in a cell: its FCL AABB (read in order with the cell, so the exact test
+  /// needs no look-up elsewhere) and the cell of the box's lower corner (for reporting it once).
   struct Entry {
-    FloatBox box;  ///< the piece's AABB rounded outwards
+    detail::FclBox box;
     std::uint32_t piece;
+    std::uint16_t cx0, cy0;
+  };
+  /// A piece's FCL AABB and the cell of its lower corner.
+  struct PieceBox {
+    detail::FclBox box;
+    int cx0 = 0, cy0 = 0;
   };
   /// x rounded down (up) to a float: the float box holds the double one.
   static float floatBelow(double x) {
@@ -197,7 +206,7 @@ class PieceGrid {
   /// Calls f(cell) for each cell of piece i's box; false (and no call) when it spans too many.
   template <typename F>
   bool forCells(std::size_t i, F&& f) const {
-    const detail::FclBox& b = boxes_[i];
+    const detail::FclBox& b = boxes_[i].box;
     const int cx0 = cellX(b.min[0]), cx1 = cellX(b.max[0]), cy0 = cellY(b.min[1]), cy1 = cellY(b.max[1]);
     if (static_cast<std::size_t>(cx1 - cx0 + 1) * static_cast<std::size_t>(cy1 - cy0 + 1) > kMaxCellsPerPiece) return false;
     for (int cy = cy0; cy <= cy1; ++cy) {
@@ -206,7 +215,8 @@ class PieceGrid {
     return true;
   }
 
-  std::vector<detail::FclBox> boxes_;          ///< per piece, FCL's AABB
+  std::vector<PieceBox> boxes_;            ///< per piece, FCL's AABB
+  std::vector<std::uint64_t> keys_;        ///< per piece, what collect() reports
   std::vector<std::uint32_t> cell_start_;  ///< nx·ny + 1 offsets into entries_
   std::vector<Entry> entries_;
   std::vector<std::uint32_t> big_pieces_;
@@ -214,14 +224,17 @@ class PieceGrid {
   int nx_ = 1, ny_ = 1;
 };
 
-void PieceGrid::build(std::vector<detail::FclBox> aabbs) {
-  boxes_ = std::move(aabbs);
+void PieceGrid::build(std::vector<detail::FclBox> aabbs, std::vector<std::uint64_t> keys) {
+  keys_ = std::move(keys);
+  boxes_.clear();
+  boxes_.reserve(aabbs.size());
+  for (const detail::FclBox& b : aabbs) boxes_.push_back({b});
   entries_.clear();
   big_pieces_.clear();
   cell_start_.assign(2, 0);
   if (boxes_.empty()) return;
   double x_lo = kInf, y_lo = kInf, x_hi = -kInf, y_hi = -kInf, area = 0;
-  for (const detail::FclBox& b : boxes_) {
+  for (const detail::FclBox& b : aabbs) {
     x_lo = std::min(x_lo, b.min[0]);
     y_lo = std::min(y_lo, b.min[1]);
     x_hi = std::max(x_hi, b.max[0]);
@@ -242,6 +255,10 @@ void PieceGrid::build(std::vector<detail::FclBox> aabbs) {
   nx_ = std::clamp(static_cast<int>(std::ceil((x_hi - x_lo) * inv_cell_)), 1, kMaxCellsPerAxis);
   ny_ = std::clamp(static_cast<int>(std::ceil((y_hi - y_lo) * inv_cell_)), 1, kMaxCellsPerAxis);
   const std::size_t cells = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
+  for (PieceBox& b : boxes_) {
+    b.cx0 = cellX(b.box.min[0]);
+    b.cy0 = cellY(b.box.min[1]);
+  }
   // Two passes (count, then fill) into one flat array.
   std::vector<std::uint32_t> next(cells + 1, 0);
   for (std::size_t i = 0; i < boxes_.size(); ++i) {
@@ -251,16 +268,18 @@ void PieceGrid::build(std::vector<detail::FclBox> aabbs) {
   cell_start_ = next;
   entries_.resize(cell_start_.back());
   for (std::size_t i = 0; i < boxes_.size(); ++i) {
-    (void)forCells(i, [&](std::size_t c) { entries_[next[c]++] = Entry{outward(boxes_[i]), static_cast<std::uint32_t>(i)}; });
+    const PieceBox& b = boxes_[i];
+    (void)forCells(i, [&](std::size_t c) {
+      entries_[next[c]++] = Entry{b.box, static_cast<std::uint32_t>(i), static_cast<std::uint16_t>(b.cx0), static_cast<std::uint16_t>(b.cy0)};
+    });
   }
 }
 
-void PieceGrid::collect(const detail::FclBox& q, std::vector<std::size_t>& out) const {
+void PieceGrid::collect(const detail::FclBox& q, std::vector<std::uint64_t>& out) const {
   for (const std::uint32_t i : big_pieces_) {
-    if (overlaps(boxes_[i], q)) out.push_back(i);
+    if (overlaps(boxes_[i].box, q)) out.push_back(keys_[i]);
   }
   if (entries_.empty()) return;
-  const FloatBox qf = outward(q);
   const int cx0 = cellX(q.min[0]), cx1 = cellX(q.max[0]), cy0 = cellY(q.min[1]), cy1 = cellY(q.max[1]);
   for (int cy = cy0; cy <= cy1; ++cy) {
     const std::size_t row = static_cast<std::size_t>(cy) * static_cast<std::size_t>(nx_);
@@ -268,12 +287,11 @@ void PieceGrid::collect(const detail::FclBox& q, std::vector<std::size_t>& out) 
     for (int cx = cx0; cx <= cx1; ++cx) {
       const Entry* end = entries_.data() + cell_start_[row + static_cast<std::size_t>(cx) + 1];
       for (; e != end; ++e) {
-        if (!overlaps(e->box, qf)) continue;
-        const detail::FclBox& b = boxes_[e->piece];
-        if (!overlaps(b, q)) continue;
-        // Report from one cell only: the one holding the lower corner of box ∩ query.
-        if (cellX(std::max(b.min[0], q.min[0])) != cx || cellY(std::max(b.min[1], q.min[1])) != cy) continue;
-        out.push_back(e->piece);
+        if (!overlaps(e->box, q)) continue;
+        // Report from one cell only: the one holding the lower corner of box ∩ query (cellX and
+        // cellY do not decrease, so the cell of a maximum is the maximum of the cells).
+        if (std::max<int>(e->cx0, cx0) != cx || std::max<int>(e->cy0, cy0) != cy) continue;
+        out.push_back(keys_[e->piece]);
       }
     }
   }
@@ -306,45 +324,121 @@ Separation separationMargins(const ProtectionVolume& volume, const airspace::Pla
   return s;
 }
 
+namespace {
+
+/// What the broad phase reports for a piece, in one word that sorts owner by owner and then by
+/// piece: the owner kind (bit 63), the owner's index (bits 32–62) and the piece's (bits 0–31).
+std::uint64_t ownerKey(const ScenePiece& p, std::size_t i) {
+  return (static_cast<std::uint64_t>(p.owner == PieceOwner::kObstacle) << 63) |
+         (static_cast<std::uint64_t>(p.owner_index) << 32) | static_cast<std::uint64_t>(i);
+}
+std::size_t keyPiece(std::uint64_t key) { return static_cast<std::size_t>(key & 0xffffffffu); }
+std::uint64_t keyOwner(std::uint64_t key) { return key >> 32; }
+PieceOwner keyOwnerKind(std::uint64_t key) { return (key >> 63) != 0 ? PieceOwner::kObstacle : PieceOwner::kZone; }
+std::size_t keyOwnerIndex(std::uint64_t key) { return static_cast<std::size_t>((key >> 32) & 0x7fffffffu); }
+
+/// The pieces' shapes laid out for separationMargins' formulas: per ring edge its start, its
+/// vector, its length and squared length (computed once, as separationMargins computes them, so
+/// that the margins are the same to the bit), each piece's edges one after the other.
+class ShapeTable {
+ public:
+  void add(const airspace::PlanarPrism& p);
+  /// separationMargins(volume, piece i).
+  [[nodiscard]] Separation margins(const ProtectionVolume& volume, std::size_t i) const;
+
+ private:
+  struct Edge {
+    double ax, ay, ex, ey, length, length2;
+  };
+  struct Shape {
+    std::uint32_t first = 0, count = 0;  ///< edges; none for a disk
+    double floor = 0, ceiling = 0;
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    double radius = 0;
+  };
+  [[nodiscard]] double signedHorizontal(const Shape& p, const Eigen::Vector2d& x) const;
+  std::vector<Shape> shapes_;
+  std::vector<Edge> edges_;
+};
+
+void ShapeTable::add(const airspace::PlanarPrism& p) {
+  Shape s{static_cast<std::uint32_t>(edges_.size()), 0, p.floor_h_ell_m, p.ceiling_h_ell_m, p.centre, p.radius_m};
+  const std::size_t n = p.ring.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& a = p.ring[i];
+    const Eigen::Vector2d e = p.ring[(i + 1) % n] - a;
+    const double length = e.norm();
+    if (length == 0.0) continue;  // as signedHorizontalDistance: a repeated vertex adds nothing
+    edges_.push_back({a.x(), a.y(), e.x(), e.y(), length, length * length});
+    ++s.count;
+  }
+  shapes_.push_back(s);
+}
+
+/// signedHorizontalDistance on the table (the same operations in the same order; the least
+/// outside distance is the root of the least squared one, the root being monotonic and
+/// correctly rounded).
+double ShapeTable::signedHorizontal(const Shape& p, const Eigen::Vector2d& x) const {
+  if (p.count == 0) return (x - p.centre).norm() - p.radius;
+  double outside2 = kInf, inside = kInf;
+  bool is_inside = true;
+  for (const Edge* e = edges_.data() + p.first, *end = e + p.count; e != end; ++e) {
+    const double ax = x.x() - e->ax, ay = x.y() - e->ay;
+    const double cross = e->ex * ay - e->ey * ax;
+    if (cross < 0) is_inside = false;
+    inside = std::min(inside, cross / e->length);
+    const double t = std::clamp((ax * e->ex + ay * e->ey) / e->length2, 0.0, 1.0);
+    const double dx = ax - t * e->ex, dy = ay - t * e->ey;
+    outside2 = std::min(outside2, dx * dx + dy * dy);
+  }
+  return is_inside ? -inside : std::sqrt(outside2);
+}
+
+Separation ShapeTable::margins(const ProtectionVolume& volume, std::size_t i) const {
+  const Shape& p = shapes_[i];
+  Separation s;
+  s.margin_h_m = signedHorizontal(p, volume.p_map.head<2>()) - volume.hpl_m;
+  s.margin_v_m = std::max(p.floor - volume.p_map.z(), volume.p_map.z() - p.ceiling) - volume.vpl_m;
+  s.meets = std::max(s.margin_h_m, s.margin_v_m) <= 0;
+  s.clearance_m = std::hypot(std::max(s.margin_h_m, 0.0), std::max(s.margin_v_m, 0.0));
+  return s;
+}
+
+}  // namespace
+
 struct Scene::Impl {
   std::vector<ScenePiece> pieces;
   std::unique_ptr<detail::FclPieces> fcl;  ///< the pieces as FCL objects (libskylane_fcl.so)
   PieceGrid grid;
+  ShapeTable shapes;
 
   /// A piece and its separation from the query volume.
   using Candidate = std::pair<std::size_t, Separation>;
 
-  /// Broad phase: the pieces whose AABBs meet `reach`'s, sorted owner by owner, into `found`.
-  void candidates(const detail::FclBox& reach, std::vector<std::size_t>& found) const;
+  /// Broad phase: the keys (ownerKey) of the pieces whose AABBs meet `reach`'s, sorted owner by
+  /// owner, into `found`.
+  void candidates(const detail::FclBox& reach, std::vector<std::uint64_t>& found) const;
   /// End of the run of candidates from `first` on that share its owner.
-  [[nodiscard]] std::size_t ownerEnd(const std::vector<std::size_t>& candidates, std::size_t first) const;
+  [[nodiscard]] static std::size_t ownerEnd(const std::vector<std::uint64_t>& candidates, std::size_t first);
   /// Narrow phase of piece i against the volume (this thread's FCL query cylinder), starting
   /// from its closed-form separation.
   [[nodiscard]] Separation settle(std::size_t i, const ProtectionVolume& volume,
                                   Separation s) const;
   /// The hit (or the nearest miss) among one owner's candidates [begin, end); `group` is scratch.
-  [[nodiscard]] std::optional<SceneHit> ownerHit(const std::vector<std::size_t>& candidates, std::size_t begin,
+  [[nodiscard]] std::optional<SceneHit> ownerHit(const std::vector<std::uint64_t>& candidates, std::size_t begin,
                                                  std::size_t end, const ProtectionVolume& volume, double horizon_m,
                                                  std::vector<Candidate>& group) const;
 };
 
-void Scene::Impl::candidates(const detail::FclBox& reach, std::vector<std::size_t>& found) const {
+void Scene::Impl::candidates(const detail::FclBox& reach, std::vector<std::uint64_t>& found) const {
   found.clear();
   grid.collect(reach, found);
-  std::sort(found.begin(), found.end(), [&](std::size_t a, std::size_t b) {
-    const ScenePiece& pa = pieces[a];
-    const ScenePiece& pb = pieces[b];
-    return std::tie(pa.owner, pa.owner_index, a) < std::tie(pb.owner, pb.owner_index, b);
-  });
+  std::sort(found.begin(), found.end());
 }
 
-std::size_t Scene::Impl::ownerEnd(const std::vector<std::size_t>& found, std::size_t first) const {
-  const ScenePiece& owner = pieces[found[first]];
+std::size_t Scene::Impl::ownerEnd(const std::vector<std::uint64_t>& found, std::size_t first) {
   std::size_t last = first;
-  while (last < found.size() && pieces[found[last]].owner == owner.owner &&
-         pieces[found[last]].owner_index == owner.owner_index) {
-    ++last;
-  }
+  while (last < found.size() && keyOwner(found[last]) == keyOwner(found[first])) ++last;
   return last;
 }
 
@@ -388,12 +482,13 @@ Separation Scene::Impl::settle(std::size_t i, const ProtectionVolume& volume,
   return s;
 }
 
-std::optional<SceneHit> Scene::Impl::ownerHit(const std::vector<std::size_t>& found, std::size_t begin,
+std::optional<SceneHit> Scene::Impl::ownerHit(const std::vector<std::uint64_t>& found, std::size_t begin,
                                               std::size_t end, const ProtectionVolume& volume, double horizon_m,
                                               std::vector<Candidate>& group) const {
-  const ScenePiece& owner = pieces[found[begin]];
+  const PieceOwner owner_kind = keyOwnerKind(found[begin]);
+  const std::size_t owner_index = keyOwnerIndex(found[begin]);
   group.clear();
-  for (std::size_t k = begin; k < end; ++k) group.emplace_back(found[k], separationMargins(volume, pieces[found[k]].prism));
+  for (std::size_t k = begin; k < end; ++k) group.emplace_back(keyPiece(found[k]), shapes.margins(volume, keyPiece(found[k])));
   const auto deciding = [](const Separation& s) { return std::max(s.margin_h_m, s.margin_v_m); };
   std::sort(group.begin(), group.end(), [&](const auto& a, const auto& b) { return deciding(a.second) < deciding(b.second); });
   std::optional<SceneHit> hit;
@@ -401,10 +496,10 @@ std::optional<SceneHit> Scene::Impl::ownerHit(const std::vector<std::size_t>& fo
   for (; evaluated < group.size() && deciding(group[evaluated].second) <= kExactBand_m; ++evaluated) {
     const Separation s = settle(group[evaluated].first, volume, group[evaluated].second);
     if (s.meets) {
-      hit = SceneHit{owner.owner, owner.owner_index, group[evaluated].first, s};
+      hit = SceneHit{owner_kind, owner_index, group[evaluated].first, s};
       break;
     }
-    if (!hit || s.clearance_m < hit->separation.clearance_m) hit = SceneHit{owner.owner, owner.owner_index, group[evaluated].first, s};
+    if (!hit || s.clearance_m < hit->separation.clearance_m) hit = SceneHit{owner_kind, owner_index, group[evaluated].first, s};
   }
   if (!hit || !hit->separation.meets) {
     // The nearest of the pieces not yet evaluated, when it may lie within the horizon.
@@ -414,7 +509,7 @@ std::optional<SceneHit> Scene::Impl::ownerHit(const std::vector<std::size_t>& fo
                                           });
     if (nearest != group.end() && nearest->second.clearance_m <= horizon_m + kExactBand_m &&
         (!hit || nearest->second.clearance_m < hit->separation.clearance_m)) {
-      hit = SceneHit{owner.owner, owner.owner_index, nearest->first, settle(nearest->first, volume, nearest->second)};
+      hit = SceneHit{owner_kind, owner_index, nearest->first, settle(nearest->first, volume, nearest->second)};
     }
   }
   return hit;
@@ -423,14 +518,23 @@ std::optional<SceneHit> Scene::Impl::ownerHit(const std::vector<std::size_t>& fo
 Scene::Scene(std::vector<ScenePiece> pieces) : impl_(std::make_unique<Impl>()) {
   impl_->pieces = std::move(pieces);
   impl_->fcl = detail::fclModule().make();
-  std::vector<detail::FclBox> boxes;
-  boxes.reserve(impl_->pieces.size());
-  for (std::size_t i = 0; i < impl_->pieces.size(); ++i) {
-    validatePiece(i, impl_->pieces[i]);
-    const auto [z_lo, z_hi] = fclHeights(impl_->pieces[i].prism);
-    boxes.push_back(impl_->fcl->add(impl_->pieces[i].prism, z_lo, z_hi));
+  if (impl_->pieces.size() > std::numeric_limits<std::uint32_t>::max()) {
+    throw std::invalid_argument("a scene holds at most 4294967295 pieces, got " + std::to_string(impl_->pieces.size()));
   }
-  impl_->grid.build(std::move(boxes));
+  std::vector<detail::FclBox> boxes;
+  std::vector<std::uint64_t> keys;
+  boxes.reserve(impl_->pieces.size());
+  keys.reserve(impl_->pieces.size());
+  for (std::size_t i = 0; i < impl_->pieces.size(); ++i) {
+    const ScenePiece& p = impl_->pieces[i];
+    validatePiece(i, p);
+    if (p.owner_index >= (std::size_t{1} << 31)) throw std::invalid_argument(pieceName(i, p) + ": owner index above 2^31 − 1");
+    const auto [z_lo, z_hi] = fclHeights(p.prism);
+    boxes.push_back(impl_->fcl->add(p.prism, z_lo, z_hi));
+    keys.push_back(ownerKey(p, i));
+    impl_->shapes.add(p.prism);
+  }
+  impl_->grid.build(std::move(boxes), std::move(keys));
 }
 
 Scene::~Scene() = default;
@@ -449,17 +553,16 @@ std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizo
   const detail::FclBox reach = impl_->fcl->placeCylinder(volume.p_map, volume.hpl_m + horizon_m, volume.vpl_m + horizon_m);
   (void)impl_->fcl->placeCylinder(volume.p_map, std::max(volume.hpl_m, kFclMinSize_m), std::max(volume.vpl_m, kFclMinSize_m));
   // Per-thread scratch: no allocation per query once it has grown.
-  thread_local std::vector<std::size_t> candidates;
+  thread_local std::vector<std::uint64_t> candidates;
   thread_local std::vector<Impl::Candidate> group;
   impl_->candidates(reach, candidates);
 
   // Narrow phase, owner by owner.
   std::vector<SceneHit> hits;
   for (std::size_t first = 0; first < candidates.size();) {
-    const ScenePiece& owner = impl_->pieces[candidates[first]];
     const std::size_t begin = first;
-    first = impl_->ownerEnd(candidates, first);
-    if (!accept(owner.owner, owner.owner_index)) continue;
+    first = Impl::ownerEnd(candidates, first);
+    if (!accept(keyOwnerKind(candidates[begin]), keyOwnerIndex(candidates[begin]))) continue;
     const std::optional<SceneHit> hit = impl_->ownerHit(candidates, begin, first, volume, horizon_m, group);
     if (hit && (hit->separation.meets || hit->separation.clearance_m <= horizon_m)) hits.push_back(*hit);
   }
