@@ -25,6 +25,11 @@ struct FclBox {
   double max[3];
 };
 
+/// \brief The AABB FCL gives an unrotated vertical cylinder (centre p, radius, half height):
+/// its local box ±radius, ±half translated by p, the same sums as FCL's, so the same bits as
+/// FclPieces::placeCylinder returns — without placing anything.
+[[nodiscard]] FclBox cylinderBox(const Eigen::Vector3d& p, double radius_m, double half_m);
+
 /// \brief Which of FCL's GJK solvers (fcl::GJKSolverType).
 enum class GjkSolver { kLibccd, kIndep };
 

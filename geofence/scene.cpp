@@ -301,6 +301,10 @@ void PieceGrid::collect(const detail::FclBox& q, std::vector<std::uint64_t>& out
 
 namespace detail {
 
+FclBox cylinderBox(const Eigen::Vector3d& p, double radius_m, double half_m) {
+  return {{p.x() - radius_m, p.y() - radius_m, p.z() - half_m}, {p.x() + radius_m, p.y() + radius_m, p.z() + half_m}};
+}
+
 const FclModule& fclModule() {
   static const FclModule& module = []() -> const FclModule& {
     const maps::detail::ModuleSpec spec{kFclModuleFile, "SKYLANE_FCL_MODULE", "skylane_fcl_module_v1",
@@ -420,15 +424,22 @@ struct Scene::Impl {
   void candidates(const detail::FclBox& reach, std::vector<std::uint64_t>& found) const;
   /// End of the run of candidates from `first` on that share its owner.
   [[nodiscard]] static std::size_t ownerEnd(const std::vector<std::uint64_t>& candidates, std::size_t first);
+  /// The query volume and whether this thread's FCL query cylinder is it yet: it is placed on
+  /// the first narrow-phase distance of a query (most queries need none).
+  struct NarrowQuery {
+    const ProtectionVolume& volume;
+    bool cylinder_placed = false;
+  };
   /// Narrow phase of piece i against the volume (this thread's FCL query cylinder), starting
   /// from its closed-form separation.
-  [[nodiscard]] Separation settle(std::size_t i, const ProtectionVolume& volume,
-                                  Separation s) const;
+  [[nodiscard]] Separation settle(std::size_t i, NarrowQuery& query, Separation s) const;
   /// The hit (or the nearest miss) among one owner's candidates [begin, end); `group` is scratch.
   [[nodiscard]] std::optional<SceneHit> ownerHit(const std::vector<std::uint64_t>& candidates, std::size_t begin,
-                                                 std::size_t end, const ProtectionVolume& volume, double horizon_m,
+                                                 std::size_t end, NarrowQuery& query, double horizon_m,
                                                  std::vector<Candidate>& group) const;
 };
+
+
 
 void Scene::Impl::candidates(const detail::FclBox& reach, std::vector<std::uint64_t>& found) const {
   found.clear();
@@ -442,8 +453,12 @@ std::size_t Scene::Impl::ownerEnd(const std::vector<std::uint64_t>& found, std::
   return last;
 }
 
-Separation Scene::Impl::settle(std::size_t i, const ProtectionVolume& volume,
-                               Separation s) const {
+Separation Scene::Impl::settle(std::size_t i, NarrowQuery& query, Separation s) const {
+  const ProtectionVolume& volume = query.volume;
+  if (!query.cylinder_placed) {
+    (void)fcl->placeCylinder(volume.p_map, std::max(volume.hpl_m, kFclMinSize_m), std::max(volume.vpl_m, kFclMinSize_m));
+    query.cylinder_placed = true;
+  }
   // FCL 0.7.0's two GJK solvers each stop metres off on some elongated pairs: libccd (its
   // default) beside a piece kilometres tall (an unlimited ceiling), its own (GST_INDEP) for a
   // thin tall volume (HPL ≪ VPL) — cases kept in tests/geofence/scene_test.cpp. So libccd
@@ -483,8 +498,9 @@ Separation Scene::Impl::settle(std::size_t i, const ProtectionVolume& volume,
 }
 
 std::optional<SceneHit> Scene::Impl::ownerHit(const std::vector<std::uint64_t>& found, std::size_t begin,
-                                              std::size_t end, const ProtectionVolume& volume, double horizon_m,
+                                              std::size_t end, NarrowQuery& query, double horizon_m,
                                               std::vector<Candidate>& group) const {
+  const ProtectionVolume& volume = query.volume;
   const PieceOwner owner_kind = keyOwnerKind(found[begin]);
   const std::size_t owner_index = keyOwnerIndex(found[begin]);
   group.clear();
@@ -494,7 +510,7 @@ std::optional<SceneHit> Scene::Impl::ownerHit(const std::vector<std::uint64_t>& 
   std::optional<SceneHit> hit;
   std::size_t evaluated = 0;
   for (; evaluated < group.size() && deciding(group[evaluated].second) <= kExactBand_m; ++evaluated) {
-    const Separation s = settle(group[evaluated].first, volume, group[evaluated].second);
+    const Separation s = settle(group[evaluated].first, query, group[evaluated].second);
     if (s.meets) {
       hit = SceneHit{owner_kind, owner_index, group[evaluated].first, s};
       break;
@@ -509,7 +525,7 @@ std::optional<SceneHit> Scene::Impl::ownerHit(const std::vector<std::uint64_t>& 
                                           });
     if (nearest != group.end() && nearest->second.clearance_m <= horizon_m + kExactBand_m &&
         (!hit || nearest->second.clearance_m < hit->separation.clearance_m)) {
-      hit = SceneHit{owner_kind, owner_index, nearest->first, settle(nearest->first, volume, nearest->second)};
+      hit = SceneHit{owner_kind, owner_index, nearest->first, settle(nearest->first, query, nearest->second)};
     }
   }
   return hit;
@@ -547,11 +563,11 @@ std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizo
                                    const std::function<bool(PieceOwner, std::size_t)>& accept) const {
   checkQuery(volume, horizon_m);
   // Broad phase: the AABB of the volume's cylinder grown by the horizon, against the grid.
-  // Then this thread's FCL query cylinder is the volume itself, for the narrow phase's
-  // distances (the module keeps one per thread: no allocation per query; nothing between here
-  // and the last distance places another).
-  const detail::FclBox reach = impl_->fcl->placeCylinder(volume.p_map, volume.hpl_m + horizon_m, volume.vpl_m + horizon_m);
-  (void)impl_->fcl->placeCylinder(volume.p_map, std::max(volume.hpl_m, kFclMinSize_m), std::max(volume.vpl_m, kFclMinSize_m));
+  // The narrow phase's distances are from this thread's FCL query cylinder, placed as the
+  // volume itself before the first one (the module keeps one per thread: no allocation per
+  // query; nothing between then and the last distance places another).
+  const detail::FclBox reach = detail::cylinderBox(volume.p_map, volume.hpl_m + horizon_m, volume.vpl_m + horizon_m);
+  Impl::NarrowQuery narrow{volume};
   // Per-thread scratch: no allocation per query once it has grown.
   thread_local std::vector<std::uint64_t> candidates;
   thread_local std::vector<Impl::Candidate> group;
@@ -563,7 +579,7 @@ std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizo
     const std::size_t begin = first;
     first = Impl::ownerEnd(candidates, first);
     if (!accept(keyOwnerKind(candidates[begin]), keyOwnerIndex(candidates[begin]))) continue;
-    const std::optional<SceneHit> hit = impl_->ownerHit(candidates, begin, first, volume, horizon_m, group);
+    const std::optional<SceneHit> hit = impl_->ownerHit(candidates, begin, first, narrow, horizon_m, group);
     if (hit && (hit->separation.meets || hit->separation.clearance_m <= horizon_m)) hits.push_back(*hit);
   }
   return hits;

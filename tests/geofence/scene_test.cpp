@@ -1,5 +1,7 @@
 #include "geofence/scene.hpp"
 
+#include "geofence/fcl_module.hpp"
+
 #include "airspace/zone_geometry.hpp"
 #include "tests/test_util.hpp"
 
@@ -940,6 +942,26 @@ TEST(Scene, BroadPhaseOverManyPiecesFindsWhatBruteForceFinds) {
   }
   EXPECT_GT(reported, 1500);  // the queries reach zones, not only empty space
   EXPECT_GT(checked, 1000000);
+}
+
+// The broad phase's query box is computed without FCL (detail::cylinderBox); it must be FCL's
+// own AABB of the query cylinder to the bit, or the grid would not find what FCL's broad phase
+// finds at touching boxes.
+TEST(Scene, QueryBoxIsFclsCylinderBoxToTheBit) {
+  const std::unique_ptr<detail::FclPieces> fcl = detail::fclModule().make();
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 20000; ++i) {
+    const double scale = std::pow(10.0, 7.0 * u(rng) - 1.0);  // 0.1 m … 1,000 km
+    const Eigen::Vector3d p(scale * (u(rng) - 0.5), scale * (u(rng) - 0.5), 3000.0 * u(rng) - 500.0);
+    const double radius = std::pow(10.0, 5.0 * u(rng) - 3.0), half = std::pow(10.0, 5.0 * u(rng) - 3.0);
+    const detail::FclBox expected = fcl->placeCylinder(p, radius, half);
+    const detail::FclBox got = detail::cylinderBox(p, radius, half);
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(got.min[k], expected.min[k]) << "case " << i << " axis " << k;
+      ASSERT_EQ(got.max[k], expected.max[k]) << "case " << i << " axis " << k;
+    }
+  }
 }
 
 }  // namespace
