@@ -228,6 +228,7 @@ void Approver::Impl::buildCostGrid(const maps::GpsTime& t_mid) {
       if (!cost.empty()) cost[k] = m.cost_weight * integrityPenalty(ratioOf(s));
     }
   }
+  cost_field = CostGrid{lower.head<2>(), cell_m, cols, rows, cost};
 }
 
 std::size_t Approver::Impl::cellOf(const Eigen::Vector3d& p) const {
@@ -248,7 +249,6 @@ geofence::ProtectionVolume Approver::Impl::planningVolume(const Eigen::Vector3d&
   return {p, h, v};
 }
 
-double Approver::Impl::extraCost(const Eigen::Vector3d& p) const { return cost[cellOf(p)]; }
 
 void Approver::Impl::placeStops() {
   if (!m.point_flights.empty() && m.point_flights.size() != m.points.size()) {

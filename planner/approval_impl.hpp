@@ -147,6 +147,7 @@ struct Approver::Impl {
   double cell_m = 50.0;
   int cols = 0, rows = 0;
   std::vector<double> cost;
+  CostGrid cost_field;  ///< `cost` for the planner (set with it)
   std::vector<Eigen::Vector2d> grid_pl;  ///< (HPL, VPL) per cell; NaN when unavailable
   bool cost_grid_built = false;
 
@@ -175,7 +176,6 @@ struct Approver::Impl {
   /// The volume a state must keep clear: the level-1 box, grown to the PL predicted there with a
   /// 20 % allowance for its change over the flight (the samples are checked exactly afterwards).
   [[nodiscard]] geofence::ProtectionVolume planningVolume(const Eigen::Vector3d& p) const;
-  [[nodiscard]] double extraCost(const Eigen::Vector3d& p) const;
   /// The mission's points at their heights, with their legs' speeds and hovers (`mission_stops`,
   /// `mission_timing`); a plan item's height breaking the altitude limits is an error naming it.
   void placeStops();

@@ -311,7 +311,7 @@ PathProblem Approver::Impl::legProblem(const ApprovalSetup& setup, const maps::G
     return valid(p, earliest, latest, penalties);
   };
   if (!cost.empty()) {
-    prob.extra_cost = [this](const Eigen::Vector3d& p) { return extraCost(p); };
+    prob.extra_cost = &cost_field;
     prob.cost_step_m = cell_m / 2.0;
   }
   prob.resolution_m = m.resolution_m;

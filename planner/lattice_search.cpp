@@ -73,7 +73,7 @@ struct Lattice {
   /// Motion cost: length, times 1 + the extra cost at its middle when there is one.
   [[nodiscard]] double cost(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
     const double len = (b - a).norm();
-    return p.extra_cost ? len * (1.0 + p.extra_cost(0.5 * (a + b))) : len;
+    return p.extra_cost ? len * (1.0 + p.extra_cost->at(0.5 * (a + b))) : len;
   }
 };
 

@@ -41,20 +41,19 @@ Eigen::Vector3d toVector(const ob::State* s) {
 /// ∫ (1 + extra_cost) ds along the path; Euclidean distance is an admissible heuristic.
 class IntegrityCostObjective : public ob::StateCostIntegralObjective {
  public:
-  IntegrityCostObjective(const ob::SpaceInformationPtr& si, std::function<double(const Eigen::Vector3d&)> extra,
-                         double step_m)
-      : ob::StateCostIntegralObjective(si, false), extra_(std::move(extra)), step_m_(step_m) {
+  IntegrityCostObjective(const ob::SpaceInformationPtr& si, const CostGrid& extra, double step_m)
+      : ob::StateCostIntegralObjective(si, false), extra_(extra), step_m_(step_m) {
     description_ = "path length + integrity cost";
   }
-  ob::Cost stateCost(const ob::State* s) const override { return ob::Cost(1.0 + extra_(toVector(s))); }
+  ob::Cost stateCost(const ob::State* s) const override { return ob::Cost(1.0 + extra_.at(toVector(s))); }
   /// Trapezoid rule over steps of at most step_m (the cost field's own resolution), rather than
   /// OMPL's validity-checking resolution, which would evaluate it every few metres.
   ob::Cost motionCost(const ob::State* s1, const ob::State* s2) const override {
     const Eigen::Vector3d a = toVector(s1), b = toVector(s2);
     const double len = (b - a).norm();
     const int n = std::max(1, static_cast<int>(std::ceil(len / step_m_)));
-    double sum = 0.5 * (extra_(a) + extra_(b));
-    for (int i = 1; i < n; ++i) sum += extra_(a + (b - a) * (static_cast<double>(i) / n));
+    double sum = 0.5 * (extra_.at(a) + extra_.at(b));
+    for (int i = 1; i < n; ++i) sum += extra_.at(a + (b - a) * (static_cast<double>(i) / n));
     return ob::Cost(len * (1.0 + sum / n));
   }
   ob::Cost motionCostHeuristic(const ob::State* s1, const ob::State* s2) const override {
@@ -62,7 +61,7 @@ class IntegrityCostObjective : public ob::StateCostIntegralObjective {
   }
 
  private:
-  std::function<double(const Eigen::Vector3d&)> extra_;
+  const CostGrid& extra_;  ///< the caller's, alive for the query
   double step_m_;
 };
 
@@ -104,7 +103,7 @@ void setProblem(og::SimpleSetup& ss, const ob::StateSpacePtr& space, const PathP
 ob::OptimizationObjectivePtr objectiveFor(const ob::SpaceInformationPtr& si, const PathProblem& p) {
   ob::OptimizationObjectivePtr objective;
   if (p.extra_cost) {
-    objective = std::make_shared<IntegrityCostObjective>(si, p.extra_cost, p.cost_step_m);
+    objective = std::make_shared<IntegrityCostObjective>(si, *p.extra_cost, p.cost_step_m);
   } else {
     objective = std::make_shared<ob::PathLengthOptimizationObjective>(si);
   }
@@ -228,7 +227,7 @@ void refineWithOmpl(const PathProblem& p, const std::vector<Eigen::Vector3d>& se
 }  // namespace skylane::planner::detail
 
 /// The module's one exported symbol (its name carries kOmplModuleAbi).
-extern "C" __attribute__((visibility("default"))) const skylane::planner::detail::OmplModule* skylane_ompl_module_v2() {
+extern "C" __attribute__((visibility("default"))) const skylane::planner::detail::OmplModule* skylane_ompl_module_v3() {
   static const skylane::planner::detail::OmplModule module{&skylane::planner::detail::planWithOmpl,
                                                            &skylane::planner::detail::refineWithOmpl};
   return &module;

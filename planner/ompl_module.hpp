@@ -24,7 +24,7 @@ struct OmplModule {
 };
 
 /// \brief The interface version the module and skylane agree on (in the entry point's name).
-inline constexpr int kOmplModuleAbi = 2;
+inline constexpr int kOmplModuleAbi = 3;
 /// \brief File name of the module.
 inline constexpr const char* kOmplModuleFile = "libskylane_ompl.so";
 

@@ -80,10 +80,10 @@ std::optional<PathStatus> invalidEnd(const PathProblem& p) {
 /// first route that is not a straight line.
 const detail::OmplModule& omplModule() {
   static const detail::OmplModule& module = [] () -> const detail::OmplModule& {
-    const maps::detail::ModuleSpec spec{detail::kOmplModuleFile, "SKYLANE_OMPL_MODULE", "skylane_ompl_module_v2",
+    const maps::detail::ModuleSpec spec{detail::kOmplModuleFile, "SKYLANE_OMPL_MODULE", "skylane_ompl_module_v3",
                                         SKYLANE_OMPL_MODULE_BUILD_PATH, SKYLANE_OMPL_MODULE_INSTALL_PATH,
                                         "planning a route around obstacles"};
-    static_assert(detail::kOmplModuleAbi == 2, "rename the entry point with the ABI version");
+    static_assert(detail::kOmplModuleAbi == 3, "rename the entry point with the ABI version");
     using Entry = const detail::OmplModule* (*)();
     return *reinterpret_cast<Entry>(maps::detail::loadModuleEntry(spec))();
   }();

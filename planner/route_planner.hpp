@@ -26,6 +26,8 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -43,6 +45,22 @@ enum class PlannerKind { kRrtStar, kInformedRrtStar, kBitStar, kPrmStar, kLattic
 /// \brief Parses a planner name; std::nullopt when unknown.
 [[nodiscard]] std::optional<PlannerKind> parsePlannerKind(std::string_view name);
 
+/// \brief A cost per metre on square cells over x–y, row by row from `lower`; a point beyond
+/// the grid takes its nearest cell's. Inline: the planner reads it at every step of every motion.
+struct CostGrid {
+  Eigen::Vector2d lower = Eigen::Vector2d::Zero();
+  double cell_m = 1.0;
+  int cols = 1, rows = 1;
+  std::vector<double> cost;  ///< cols × rows, ≥ 0
+
+  [[nodiscard]] std::size_t cellOf(const Eigen::Vector3d& p) const {
+    const int c = std::clamp(static_cast<int>((p.x() - lower.x()) / cell_m), 0, cols - 1);
+    const int r = std::clamp(static_cast<int>((p.y() - lower.y()) / cell_m), 0, rows - 1);
+    return static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c);
+  }
+  [[nodiscard]] double at(const Eigen::Vector3d& p) const { return cost[cellOf(p)]; }
+};
+
 /// \brief One planning query.
 struct PathProblem {
   Eigen::Vector3d lower_enu_m = Eigen::Vector3d::Zero();  ///< bounds of the search box
@@ -50,7 +68,7 @@ struct PathProblem {
   Eigen::Vector3d start_enu_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d goal_enu_m = Eigen::Vector3d::Zero();
   std::function<bool(const Eigen::Vector3d&)> is_valid;   ///< required
-  std::function<double(const Eigen::Vector3d&)> extra_cost;  ///< ≥ 0 per metre; empty = path length
+  const CostGrid* extra_cost = nullptr;  ///< ≥ 0 per metre (the caller keeps it); none = path length
   double cost_step_m = 25.0;   ///< the cost integral's step along a motion (trapezoid rule)
   double resolution_m = 2.0;   ///< motion checking step
   double time_limit_s = 30.0;  ///< a safety net: the iteration budget should end the search
