@@ -2,6 +2,7 @@
 // case (1,000 zones, 5,000 buildings, 10 km route) in ≤ 10 s; and the planners compared on the
 // same cases (route length and time, as counters).
 #include "planner/approval.hpp"
+#include "tests/planner/disc_field_proof.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -11,7 +12,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -168,44 +168,12 @@ const ClutterField& clutterField() {
   return field;
 }
 
-/// Independently of the planner: the fraction of the field within `grow_m` of a circle, and
-/// whether a route exists, on a 2 m grid: a cell is free when its whole square is farther than
-/// radius + grow_m from every centre (conservative), and the free cells holding the start and the
-/// goal are joined through free cells sharing an edge (breadth-first search). A chain of such
-/// squares is a flyable route: a "yes" proves one exists.
+/// Independently of the planner (tests/planner/disc_field_proof.hpp, on a 2 m grid): the
+/// fraction of the field within `grow_m` of a circle, and whether a route exists.
 std::pair<double, bool> clutterProof(const ClutterField& f, double grow_m) {
-  constexpr double kCell = 2.0;
-  const int nx = static_cast<int>(8000 / kCell), ny = static_cast<int>(6000 / kCell);
-  std::vector<char> blocked(static_cast<std::size_t>(nx) * ny, 0);
-  for (const Eigen::Vector3d& c : f.circles) {
-    const double reach = c.z() + grow_m;
-    for (int i = std::max(0, static_cast<int>((c.x() - reach) / kCell) - 1); i < std::min(nx, static_cast<int>((c.x() + reach) / kCell) + 2); ++i) {
-      for (int j = std::max(0, static_cast<int>((c.y() - reach) / kCell) - 1); j < std::min(ny, static_cast<int>((c.y() + reach) / kCell) + 2); ++j) {
-        // Nearest point of the cell's square to the centre.
-        const double qx = std::clamp(c.x(), i * kCell, (i + 1) * kCell), qy = std::clamp(c.y(), j * kCell, (j + 1) * kCell);
-        if (std::hypot(qx - c.x(), qy - c.y()) <= reach) blocked[static_cast<std::size_t>(j) * nx + i] = 1;
-      }
-    }
-  }
-  const double fraction = static_cast<double>(std::count(blocked.begin(), blocked.end(), 1)) / static_cast<double>(blocked.size());
-  auto cell = [&](const Eigen::Vector2d& p) { return static_cast<std::size_t>(p.y() / kCell) * nx + static_cast<std::size_t>(p.x() / kCell); };
-  std::vector<char> seen(blocked.size(), 0);
-  std::deque<std::size_t> queue{cell(f.start)};
-  seen[queue.front()] = 1;
-  while (!queue.empty()) {
-    const std::size_t k = queue.front();
-    queue.pop_front();
-    if (k == cell(f.goal)) return {fraction, true};
-    const int i = static_cast<int>(k % nx), j = static_cast<int>(k / nx);
-    for (auto [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-      if (i + di < 0 || i + di >= nx || j + dj < 0 || j + dj >= ny) continue;
-      const std::size_t n = static_cast<std::size_t>(j + dj) * nx + static_cast<std::size_t>(i + di);
-      if (blocked[n] || seen[n]) continue;
-      seen[n] = 1;
-      queue.push_back(n);
-    }
-  }
-  return {fraction, false};
+  const test::DiscFieldProof proof =
+      test::proveRouteThroughDiscs(f.circles, Eigen::Vector4d(0, 8000, 0, 6000), 2.0, grow_m, f.start, f.goal);
+  return {proof.blocked_fraction, proof.route};
 }
 
 /// Writes the clutter field's zones once and a mission through it with `algorithm` (the

@@ -7,6 +7,7 @@
 #include <functional>
 #include <map>
 #include <mutex>
+#include <string>
 #include <tuple>
 
 namespace skylane::integrity {
@@ -50,12 +51,22 @@ RaimThresholds raimThresholds(int dof, double pfa, double pmd) {
   return t;
 }
 
-RaimPl raimProtectionLevels(const Geometry& g, const RaimConfig& cfg) {
-  RaimPl out;
+namespace {
+
+/// Why RAIM cannot run on the geometry's satellite count, or empty when it can.
+std::string tooFewSatellites(const Geometry& g) {
   const int n = g.numSats(), m = g.numStates();
-  if (n <= m) {
-    out.reason = "too few satellites: " + std::to_string(n) + " in view, RAIM needs at least " +
-                 std::to_string(m + 1) + " for " + std::to_string(m) + " unknowns";
+  if (n > m) return {};
+  return "too few satellites: " + std::to_string(n) + " in view, RAIM needs at least " + std::to_string(m + 1) +
+         " for " + std::to_string(m) + " unknowns";
+}
+
+}  // namespace
+
+RaimPl raimProtectionLevels(const Geometry& g, const RaimConfig& cfg) {
+  if (std::string why = tooFewSatellites(g); !why.empty()) {
+    RaimPl out;
+    out.reason = std::move(why);
     return out;
   }
   return raimProtectionLevels(g, solveWls(g.G, g.sigma_int), cfg);
@@ -64,7 +75,8 @@ RaimPl raimProtectionLevels(const Geometry& g, const RaimConfig& cfg) {
 RaimPl raimProtectionLevels(const Geometry& g, const WlsSolution& wls, const RaimConfig& cfg) {
   RaimPl out;
   const int n = g.numSats(), m = g.numStates();
-  if (n <= m) return raimProtectionLevels(g, cfg);  // says why
+  out.reason = tooFewSatellites(g);
+  if (!out.reason.empty()) return out;
   if (!wls.ok) {
     out.reason = "singular geometry: the satellites do not fix position and clock";
     return out;

@@ -126,6 +126,18 @@ Eigen::Vector3d moved(const Eigen::Vector3d& p, double yaw, const Eigen::Vector3
   return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * p + t;
 }
 
+/// The containment of the volume in the corridor along the path, both turned by a random yaw and
+/// shifted by up to 100 km (drawn from rng).
+Containment containsInRandomFrame(const std::vector<Eigen::Vector3d>& path, const ProtectionVolume& volume,
+                                  const AlertLimits& limits, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double yaw = 2 * kPi * u(rng);
+  const Eigen::Vector3d shift(-1e5 + 2e5 * u(rng), -1e5 + 2e5 * u(rng), 0.0);
+  std::vector<Eigen::Vector3d> p2;
+  for (const Eigen::Vector3d& p : path) p2.push_back(moved(p, yaw, shift));
+  return Corridor(p2, limits).contains({moved(volume.p_map, yaw, shift), volume.hpl_m, volume.vpl_m});
+}
+
 TEST(Corridor, MarginsDoNotJumpWhereTheUnionStopsHelpingAtAJoint) {
   // GIVEN a volume at a turn, horizontally well inside both pieces (h 16 m and 18 m) but 27 m
   // below both (v -27 m for both): the union's margin equals the best piece's min(h, v) = v, so
@@ -138,13 +150,8 @@ TEST(Corridor, MarginsDoNotJumpWhereTheUnionStopsHelpingAtAJoint) {
   ASSERT_EQ(base.verdict, Verdict::kOutside);
   // WHEN the scene is moved to 2,000 frames (rotated, translated up to 100 km)
   std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int k = 0; k < 2000; ++k) {
-    const double yaw = 2 * kPi * u(rng);
-    const Eigen::Vector3d t(-1e5 + 2e5 * u(rng), -1e5 + 2e5 * u(rng), 0.0);
-    std::vector<Eigen::Vector3d> p2;
-    for (const Eigen::Vector3d& p : path) p2.push_back(moved(p, yaw, t));
-    const Containment c = Corridor(p2, limits).contains({moved(volume.p_map, yaw, t), volume.hpl_m, volume.vpl_m});
+    const Containment c = containsInRandomFrame(path, volume, limits, rng);
     // THEN the union gains nothing in any frame: the best piece's exact margins, the same in every
     // frame (before the fix, a clang build took the union's (v, v) in some frames on a last-bit
     // difference of two equal sums)
@@ -176,13 +183,8 @@ TEST(Corridor, MarginHDoesNotJumpWhereTheUnionGainsLessThanTheSearchAccuracy) {
   const double h_leg2 = 24.0 - (x - (a + t * d)).norm() - volume.hpl_m;
   // WHEN the scene is moved to 2,000 frames
   std::mt19937 rng(199);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int k = 0; k < 2000; ++k) {
-    const double yaw = 2 * kPi * u(rng);
-    const Eigen::Vector3d shift(-1e5 + 2e5 * u(rng), -1e5 + 2e5 * u(rng), 0.0);
-    std::vector<Eigen::Vector3d> p2;
-    for (const Eigen::Vector3d& p : path) p2.push_back(moved(p, yaw, shift));
-    const Containment c = Corridor(p2, limits).contains({moved(volume.p_map, yaw, shift), volume.hpl_m, volume.vpl_m});
+    const Containment c = containsInRandomFrame(path, volume, limits, rng);
     // THEN, whether or not the union is reported, margin_h is the leg's h (the union's horizontal
     // room is at least the leg's) and margin_v is within the accuracy of the leg's v
     ASSERT_EQ(c.verdict, Verdict::kOutside) << "frame " << k;

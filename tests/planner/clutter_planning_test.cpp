@@ -9,6 +9,8 @@
 #include "geofence/corridor.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/plane_frame.hpp"
+#include "tests/planner/disc_field_proof.hpp"
+#include "tests/planner/map_frame_json.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -16,7 +18,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <fstream>
 #include <random>
 
@@ -53,45 +54,12 @@ double segmentDistance(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const
   return (a + t * d - c).norm();
 }
 
-/// Independently of the planner: whether start and goal are joined through grid cells (1 m)
-/// whose whole square is farther than radius + grow_m from every disc centre, edge to edge
-/// (breadth-first search). A "yes" proves a route exists; `area` is x0, x1, y0, y1.
+/// Independently of the planner (disc_field_proof.hpp): whether start and goal are joined
+/// through 1 m cells farther than radius + grow_m from every disc. A "yes" proves a route exists;
+/// `area` is x0, x1, y0, y1.
 bool gridProvesARoute(const std::vector<Disc>& discs, const Eigen::Vector4d& area, double grow_m,
                       const Eigen::Vector2d& start, const Eigen::Vector2d& goal) {
-  const int nx = static_cast<int>(area[1] - area[0]), ny = static_cast<int>(area[3] - area[2]);
-  std::vector<char> blocked(static_cast<std::size_t>(nx) * ny, 0);
-  for (const Disc& c : discs) {
-    const double reach = c.z() + grow_m;
-    for (int i = std::max(0, static_cast<int>(c.x() - reach - area[0]) - 1);
-         i < std::min(nx, static_cast<int>(c.x() + reach - area[0]) + 2); ++i) {
-      for (int j = std::max(0, static_cast<int>(c.y() - reach - area[2]) - 1);
-           j < std::min(ny, static_cast<int>(c.y() + reach - area[2]) + 2); ++j) {
-        const double qx = std::clamp(c.x(), area[0] + i, area[0] + i + 1.0);
-        const double qy = std::clamp(c.y(), area[2] + j, area[2] + j + 1.0);
-        if (std::hypot(qx - c.x(), qy - c.y()) <= reach) blocked[static_cast<std::size_t>(j) * nx + i] = 1;
-      }
-    }
-  }
-  auto cell = [&](const Eigen::Vector2d& p) {
-    return static_cast<std::size_t>(p.y() - area[2]) * nx + static_cast<std::size_t>(p.x() - area[0]);
-  };
-  std::vector<char> seen(blocked.size(), 0);
-  std::deque<std::size_t> queue{cell(start)};
-  seen[queue.front()] = 1;
-  while (!queue.empty()) {
-    const std::size_t k = queue.front();
-    queue.pop_front();
-    if (k == cell(goal)) return true;
-    const int i = static_cast<int>(k % nx), j = static_cast<int>(k / nx);
-    for (auto [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-      if (i + di < 0 || i + di >= nx || j + dj < 0 || j + dj >= ny) continue;
-      const std::size_t n = static_cast<std::size_t>(j + dj) * nx + static_cast<std::size_t>(i + di);
-      if (blocked[n] || seen[n]) continue;
-      seen[n] = 1;
-      queue.push_back(n);
-    }
-  }
-  return false;
+  return test::proveRouteThroughDiscs(discs, area, 1.0, grow_m, start, goal).route;
 }
 
 // --- planPath on its own -----------------------------------------------------------------------
@@ -193,14 +161,8 @@ TEST(ClutterPlanning, AWallAcrossTheFieldLeavesNoRouteAndTheLatticeSaysSo) {
 // --- the approval of a cluttered field --------------------------------------------------------
 
 constexpr double kLat0 = 47.40, kLon0 = 8.50;
-const maps::PlaneFrame& frame() {
-  static const maps::PlaneFrame f(maps::deg2rad(kLat0), maps::deg2rad(kLon0));
-  return f;
-}
-json lonLat(const Eigen::Vector2d& xy) {
-  const Eigen::Vector2d ll = frame().toLatLon(xy);
-  return {maps::rad2deg(ll.y()), maps::rad2deg(ll.x())};
-}
+const test::MapFrameJson kMap(kLat0, kLon0);
+json lonLat(const Eigen::Vector2d& xy) { return kMap.lonLat(xy); }
 
 const Eigen::Vector4d kApprovalField{-200, 2200, -200, 1400};
 const Eigen::Vector2d kApprovalGoal{2000, 1200};

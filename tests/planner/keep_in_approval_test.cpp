@@ -8,6 +8,7 @@
 #include "airspace/zone_geometry.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/plane_frame.hpp"
+#include "tests/planner/map_frame_json.hpp"
 #include "tests/test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -23,16 +24,9 @@ namespace {
 using nlohmann::json;
 
 constexpr double kLat0 = 47.3712, kLon0 = 8.5320;
-const maps::PlaneFrame& frame() {
-  static const maps::PlaneFrame f(maps::deg2rad(kLat0), maps::deg2rad(kLon0));
-  return f;
-}
-
-/// A map-frame point (x east, y north [m]) as [lon, lat] degrees.
-json lonLat(const Eigen::Vector2d& xy) {
-  const Eigen::Vector2d ll = frame().toLatLon(xy);
-  return {maps::rad2deg(ll.y()), maps::rad2deg(ll.x())};
-}
+const test::MapFrameJson kMap(kLat0, kLon0);
+const maps::PlaneFrame& frame() { return kMap.frame(); }
+json lonLat(const Eigen::Vector2d& xy) { return kMap.lonLat(xy); }
 
 /// A GeoJSON feature: a polygon given in the map frame, with a restriction.
 json polygonFeature(const std::string& id, const std::string& restriction, const std::vector<Eigen::Vector2d>& ring) {
