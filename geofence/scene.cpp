@@ -349,6 +349,15 @@ class ShapeTable {
   void add(const airspace::PlanarPrism& p);
   /// separationMargins(volume, piece i).
   [[nodiscard]] Separation margins(const ProtectionVolume& volume, std::size_t i) const;
+  /// Asks the processor for piece i's record, then (once it is there) for its edges: a query's
+  /// pieces lie far apart in memory, and reading them one after the other waited on each.
+  void prefetchShape(std::size_t i) const { __builtin_prefetch(&shapes_[i]); }
+  void prefetchEdges(std::size_t i) const {
+    const Shape& p = shapes_[i];
+    const char* first = reinterpret_cast<const char*>(edges_.data() + p.first);
+    const char* end = reinterpret_cast<const char*>(edges_.data() + p.first + p.count);
+    for (const char* a = first; a < end; a += 64) __builtin_prefetch(a);
+  }
 
  private:
   struct Edge {
@@ -504,6 +513,7 @@ std::optional<SceneHit> Scene::Impl::ownerHit(const std::vector<std::uint64_t>& 
   const PieceOwner owner_kind = keyOwnerKind(found[begin]);
   const std::size_t owner_index = keyOwnerIndex(found[begin]);
   group.clear();
+  for (std::size_t k = begin; k < end; ++k) shapes.prefetchEdges(keyPiece(found[k]));
   for (std::size_t k = begin; k < end; ++k) group.emplace_back(keyPiece(found[k]), shapes.margins(volume, keyPiece(found[k])));
   const auto deciding = [](const Separation& s) { return std::max(s.margin_h_m, s.margin_v_m); };
   std::sort(group.begin(), group.end(), [&](const auto& a, const auto& b) { return deciding(a.second) < deciding(b.second); });
@@ -572,6 +582,7 @@ std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizo
   thread_local std::vector<std::uint64_t> candidates;
   thread_local std::vector<Impl::Candidate> group;
   impl_->candidates(reach, candidates);
+  for (const std::uint64_t key : candidates) impl_->shapes.prefetchShape(keyPiece(key));
 
   // Narrow phase, owner by owner.
   std::vector<SceneHit> hits;
