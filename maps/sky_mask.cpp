@@ -1,6 +1,7 @@
 #include "maps/sky_mask.hpp"
 
 #include "maps/geoid.hpp"
+#include "maps/grid_rings.hpp"
 
 #include <Eigen/Geometry>
 
@@ -292,27 +293,6 @@ bool ringBelowMask(const SkyMask& mask, double d_ring, double dh_max, double ear
   return maxElevation_rad(dh_max, d_ring, std::numeric_limits<double>::infinity(), earth_radius_m) <= lowest;
 }
 
-/// \brief Visits the cells of the square rings around (ci, cj), nearest first (ring 0 is the
-/// cell itself), up to ring r_max; `stop(ring)` ends the walk before a ring.
-template <class Stop, class Visit>
-void walkRings(int ci, int cj, int r_max, const Stop& stop, const Visit& visit) {
-  for (int ring = 0; ring <= r_max; ++ring) {
-    if (stop(ring)) break;
-    if (ring == 0) {
-      visit(ci, cj);
-      continue;
-    }
-    for (int c = ci - ring; c <= ci + ring; ++c) {
-      visit(c, cj - ring);
-      visit(c, cj + ring);
-    }
-    for (int r = cj - ring + 1; r <= cj + ring - 1; ++r) {
-      visit(ci - ring, r);
-      visit(ci + ring, r);
-    }
-  }
-}
-
 }  // namespace
 
 void BuildingIndex::raiseMask(SkyMask& mask, const Geodetic& observer, double refraction_k, bool cull) const {
@@ -340,11 +320,9 @@ void BuildingIndex::raiseMask(SkyMask& mask, const Geodetic& observer, double re
   const Eigen::Vector2d g = (o.p_OP_o.head<2>() - grid_min_en_) / cell_m_;
   const int ci = static_cast<int>(std::floor(std::clamp(g.x(), -1e6, 1e6)));
   const int cj = static_cast<int>(std::floor(std::clamp(g.y(), -1e6, 1e6)));
-  const int r_max = std::max({std::abs(ci), std::abs(ci - (cols_ - 1)), std::abs(cj), std::abs(cj - (rows_ - 1))});
   std::vector<char> seen(items_.size(), 0);
   const double cell_radius = cell_m_ * M_SQRT1_2 + slack;
   const auto visit = [&](int c, int r) {
-    if (c < 0 || c >= cols_ || r < 0 || r >= rows_) return;
     const Cell& cell = cells_[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols_) + static_cast<std::size_t>(c)];
     if (cell.items.empty()) return;
     const Eigen::Vector2d centre = grid_min_en_ + cell_m_ * Eigen::Vector2d(c + 0.5, r + 0.5);
@@ -362,7 +340,7 @@ void BuildingIndex::raiseMask(SkyMask& mask, const Geodetic& observer, double re
   const auto out_of_sight = [&](int ring) {
     return all_blocked || ringBelowMask(mask, (ring - 1) * cell_m_ - slack, max_top_h_ell_m_ - o.h_obs, o.R);
   };
-  walkRings(ci, cj, r_max, out_of_sight, visit);
+  walkGridRings(ci, cj, cols_, rows_, out_of_sight, visit);
 }
 
 // --- terrain ---------------------------------------------------------------------------------
