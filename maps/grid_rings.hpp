@@ -23,8 +23,8 @@ namespace skylane::maps {
 /// Each ring is clipped to the grid before it is walked, so the work is O(cols·rows + K) for K
 /// rings that reach the grid — not O(K²): an unclipped square ring around a cell of a long, thin
 /// grid (buildings strung along one axis, 3000 × 5 cells) passes ~4K² positions outside it.
-/// \return the number of positions examined: the cells visited plus one per ring walked, the
-/// caller's (and the tests') measure of the work.
+/// \return the work done: one per ring walked plus one per step of the loops along a ring's
+/// rows and columns (each step visits one or two cells), so at most cols·rows + K.
 template <class Stop, class Visit>
 std::size_t walkGridRings(int ci, int cj, int cols, int rows, const Stop& stop, const Visit& visit) {
   if (cols <= 0 || rows <= 0) return 0;
@@ -45,13 +45,17 @@ std::size_t walkGridRings(int ci, int cj, int cols, int rows, const Stop& stop, 
     const int lower = cj - ring, upper = cj + ring, left = ci - ring, right = ci + ring;
     const bool has_lower = lower >= 0, has_upper = upper < rows;  // the ring's rows inside the grid
     const bool has_left = left >= 0, has_right = right < cols;    // its columns inside the grid
-    for (int c = std::max(left, 0); c <= std::min(right, cols - 1); ++c) {
-      if (has_lower) visit(c, lower), ++work;
-      if (has_upper) visit(c, upper), ++work;
+    if (has_lower || has_upper) {
+      for (int c = std::max(left, 0); c <= std::min(right, cols - 1); ++c, ++work) {
+        if (has_lower) visit(c, lower);
+        if (has_upper) visit(c, upper);
+      }
     }
-    for (int r = std::max(lower + 1, 0); r <= std::min(upper - 1, rows - 1); ++r) {
-      if (has_left) visit(left, r), ++work;
-      if (has_right) visit(right, r), ++work;
+    if (has_left || has_right) {
+      for (int r = std::max(lower + 1, 0); r <= std::min(upper - 1, rows - 1); ++r, ++work) {
+        if (has_left) visit(left, r);
+        if (has_right) visit(right, r);
+      }
     }
   }
   return work;
