@@ -1,6 +1,7 @@
 /// \file
 /// \brief A standalone driver for the fuzz targets: runs LLVMFuzzerTestOneInput once on every
-/// file given (or every file under a directory given), in name order, with no libFuzzer — so
+/// file given (or every file under a directory given), in name order, after the target's
+/// LLVMFuzzerInitialize if it has one, with no libFuzzer — so
 /// any compiler's sanitizer build replays the corpora and the stored reproducers as a test
 /// (ctest label `fuzz`). A finding aborts, as under libFuzzer.
 
@@ -14,6 +15,8 @@
 #include <vector>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
+/// libFuzzer's optional set-up hook; a target that does not define it leaves this null.
+extern "C" __attribute__((weak)) int LLVMFuzzerInitialize(int* argc, char*** argv);
 
 namespace {
 
@@ -33,6 +36,7 @@ std::vector<std::filesystem::path> inputsOf(const std::filesystem::path& p) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (LLVMFuzzerInitialize) LLVMFuzzerInitialize(&argc, &argv);  // as libFuzzer does, once, first
   std::size_t runs = 0;
   for (int i = 1; i < argc; ++i) {
     if (!std::filesystem::exists(argv[i])) {

@@ -1,6 +1,7 @@
 #include "maps/sky_mask.hpp"
 
 #include "maps/geoid.hpp"
+#include "maps/grid_rings.hpp"
 
 #include <Eigen/Geometry>
 
@@ -25,7 +26,13 @@ constexpr double kOnBoundary_m = 1e-3;
 /// by h·D/R (height h, distance D from the origin; 1.6 cm for 100 m at 1 km), added per query
 /// on top of this fixed metre.
 constexpr double kCullSlack_m = 1.0;
-/// Most grid cells an index allocates; a wider spread of buildings gets coarser cells.
+/// Most grid cells an index allocates: kGridCellsPerBuilding per building, at least
+/// kMinGridCells, at most kMaxGridCells; a wider spread of buildings gets coarser cells. The
+/// budget follows the count, not the spread, so a few buildings far apart (one mistyped
+/// longitude puts a mast 150 km off a street block) get a small grid, not one as large as the
+/// spread: the grid's memory and a query's walk over it stay O(buildings).
+constexpr double kGridCellsPerBuilding = 64.0;
+constexpr double kMinGridCells = 4096.0;
 constexpr double kMaxGridCells = 4.0e6;
 /// An observer at most this far below flat ground [m] stands on it (rounding of AMSL ⇄ h_ell).
 constexpr double kOnGround_m = 0.01;
@@ -158,8 +165,10 @@ BuildingIndex::BuildingIndex(const std::vector<Building>& buildings, const Geode
   }
   if (items_.empty()) return;
   const Eigen::Vector2d span = hi - lo;
-  if ((span.x() / cell_m_ + 1.0) * (span.y() / cell_m_ + 1.0) > kMaxGridCells) {
-    cell_m_ = std::sqrt(span.x() * span.y() / kMaxGridCells) + std::max(span.x(), span.y()) / kMaxGridCells + cell_m_;
+  const double max_cells = std::clamp(kGridCellsPerBuilding * static_cast<double>(items_.size()), kMinGridCells, kMaxGridCells);
+  if ((span.x() / cell_m_ + 1.0) * (span.y() / cell_m_ + 1.0) > max_cells) {
+    // Then (x/c + 1)(y/c + 1) = xy/c² + (x + y)/c + 1 ≤ M + 2M + 1 for M = max_cells.
+    cell_m_ = std::sqrt(span.x() * span.y() / max_cells) + std::max(span.x(), span.y()) / max_cells + cell_m_;
   }
   grid_min_en_ = lo;
   cols_ = static_cast<int>(span.x() / cell_m_) + 1;
@@ -284,33 +293,11 @@ bool raiseByBuilding(SkyMask& mask, const ObserverPlane& o, const std::vector<Ei
   return false;
 }
 
-/// \brief Can nothing at least d_ring away, at most dh_max above the observer, rise above the
-/// lowest bin of the mask?
-bool ringBelowMask(const SkyMask& mask, double d_ring, double dh_max, double earth_radius_m) {
+/// \brief Can nothing at least d_ring away, at most dh_max above the observer, rise above
+/// `lowest_rad`, the lowest bin of the mask?
+bool ringBelowMask(double lowest_rad, double d_ring, double dh_max, double earth_radius_m) {
   if (!(d_ring > 0.0)) return false;
-  const double lowest = *std::min_element(mask.blocked_rad().begin(), mask.blocked_rad().end());
-  return maxElevation_rad(dh_max, d_ring, std::numeric_limits<double>::infinity(), earth_radius_m) <= lowest;
-}
-
-/// \brief Visits the cells of the square rings around (ci, cj), nearest first (ring 0 is the
-/// cell itself), up to ring r_max; `stop(ring)` ends the walk before a ring.
-template <class Stop, class Visit>
-void walkRings(int ci, int cj, int r_max, const Stop& stop, const Visit& visit) {
-  for (int ring = 0; ring <= r_max; ++ring) {
-    if (stop(ring)) break;
-    if (ring == 0) {
-      visit(ci, cj);
-      continue;
-    }
-    for (int c = ci - ring; c <= ci + ring; ++c) {
-      visit(c, cj - ring);
-      visit(c, cj + ring);
-    }
-    for (int r = cj - ring + 1; r <= cj + ring - 1; ++r) {
-      visit(ci - ring, r);
-      visit(ci + ring, r);
-    }
-  }
+  return maxElevation_rad(dh_max, d_ring, std::numeric_limits<double>::infinity(), earth_radius_m) <= lowest_rad;
 }
 
 }  // namespace
@@ -324,7 +311,9 @@ void BuildingIndex::raiseMask(SkyMask& mask, const Geodetic& observer, double re
   const ObserverPlane o = observerPlane(mask, observer, refraction_k, frame_);
   std::vector<Eigen::Vector2d> xy;  // corners at the observer's height, observer's plane
   bool all_blocked = false;
+  bool mask_raised = true;  // since its lowest bin was last taken (it may come raised by terrain)
   const auto process = [&](const Item& it) {
+    mask_raised = true;
     if (raiseByBuilding(mask, o, it.p_foot_o, it.up_o, it.top_h_ell_m, xy)) all_blocked = true;
   };
   if (!cull) {
@@ -340,11 +329,9 @@ void BuildingIndex::raiseMask(SkyMask& mask, const Geodetic& observer, double re
   const Eigen::Vector2d g = (o.p_OP_o.head<2>() - grid_min_en_) / cell_m_;
   const int ci = static_cast<int>(std::floor(std::clamp(g.x(), -1e6, 1e6)));
   const int cj = static_cast<int>(std::floor(std::clamp(g.y(), -1e6, 1e6)));
-  const int r_max = std::max({std::abs(ci), std::abs(ci - (cols_ - 1)), std::abs(cj), std::abs(cj - (rows_ - 1))});
   std::vector<char> seen(items_.size(), 0);
   const double cell_radius = cell_m_ * M_SQRT1_2 + slack;
   const auto visit = [&](int c, int r) {
-    if (c < 0 || c >= cols_ || r < 0 || r >= rows_) return;
     const Cell& cell = cells_[static_cast<std::size_t>(r) * static_cast<std::size_t>(cols_) + static_cast<std::size_t>(c)];
     if (cell.items.empty()) return;
     const Eigen::Vector2d centre = grid_min_en_ + cell_m_ * Eigen::Vector2d(c + 0.5, r + 0.5);
@@ -358,11 +345,16 @@ void BuildingIndex::raiseMask(SkyMask& mask, const Geodetic& observer, double re
     }
   };
   // Every cell of a ring is at least (ring − 1) cells away: stop when even the tallest
-  // building there stays below the lowest bin.
+  // building there stays below the lowest bin. That bin is taken again only after a building
+  // was processed, so a long walk over empty cells costs O(1) per ring, not O(bins).
+  double lowest_rad = kOpenSky_rad;
   const auto out_of_sight = [&](int ring) {
-    return all_blocked || ringBelowMask(mask, (ring - 1) * cell_m_ - slack, max_top_h_ell_m_ - o.h_obs, o.R);
+    if (all_blocked) return true;
+    if (mask_raised) lowest_rad = *std::min_element(mask.blocked_rad().begin(), mask.blocked_rad().end());
+    mask_raised = false;
+    return ringBelowMask(lowest_rad, (ring - 1) * cell_m_ - slack, max_top_h_ell_m_ - o.h_obs, o.R);
   };
-  walkRings(ci, cj, r_max, out_of_sight, visit);
+  walkGridRings(ci, cj, cols_, rows_, out_of_sight, visit);
 }
 
 // --- terrain ---------------------------------------------------------------------------------

@@ -109,6 +109,9 @@ class BuildingIndex {
 
   /// \brief Number of buildings.
   [[nodiscard]] std::size_t size() const { return items_.size(); }
+  /// \brief Number of grid cells: at most about 3·max(4096, 64·size()) (coarser cells for a
+  /// wider spread), whatever the spread of the buildings.
+  [[nodiscard]] std::size_t cells() const { return cells_.size(); }
   /// \brief The frame the index lives in.
   [[nodiscard]] const LocalFrame& frame() const { return frame_; }
 

@@ -258,6 +258,45 @@ TEST(SkyMaskBuildings, CulledIndexEqualsBruteForceAndBoundsDenseRayCasting) {
   }
 }
 
+TEST(SkyMaskBuildings, AMastOneHundredFiftyKilometresAwayLeavesTheStreetMaskAsBruteForce) {
+  // GIVEN a street block and, 150 km west, a 60 m mast: the fuzzer's slow input (the example's
+  // mast with its longitude mistyped 6.54° for 8.54°), 3001 × 2 cells of 50 m here
+  const double d = 50.0, H = 20.0, half_w = 10.0;
+  const BuildingIndex index({building(box(-half_w, d, half_w, d + 10), H), building(box(-150000, 0, -149998, 2), 60.0)}, kGround);
+  SkyMaskOptions brute;
+  brute.cull = false;
+  const SkyMask fast = computeSkyMask(eye(), &index, nullptr);
+  const SkyMask slow = computeSkyMask(eye(), &index, nullptr, brute);
+  // THEN the grid is within the budget of two buildings (see cells())
+  EXPECT_LE(index.cells(), 3u * 4096u + 1u);
+  // AND the culled walk over the long grid gives the brute-force mask
+  for (int k = 0; k < 360; ++k) ASSERT_EQ(fast.binBlocked_rad(k), slow.binBlocked_rad(k)) << "bin " << k;
+  // AND the block to the north shows as in ABoxToTheNorth…; the mast, 1.76 km below the
+  // tangent plane at 150 km, is below the horizon, e = atan2(60 − 1.5 − d²/2R, d) < 0
+  const double R = primeVertical_m(kGround.lat_rad);
+  EXPECT_NEAR(fast.binBlocked_rad(0), std::atan2(H - kEye_m - d * d / (2 * R), d), kAngleTol_rad);
+  const double far_m = 149999.0;
+  EXPECT_NEAR(fast.binBlocked_rad(270), std::atan2(60.0 - kEye_m - far_m * far_m / (2 * R), far_m), 1e-5);
+}
+
+TEST(SkyMaskBuildings, AFewBuildingsFarApartGetAGridSizedByTheirCountNotTheirSpread) {
+  // GIVEN the street block and a mast 150 km west and 100 km south: a 3000 × 2000 grid of
+  // 50 m cells would span them (6e6 cells, 190 MB)
+  const double d = 50.0, H = 20.0, half_w = 10.0;
+  const BuildingIndex index({building(box(-half_w, d, half_w, d + 10), H), building(box(-150000, -100000, -149998, -99998), 60.0)},
+                            kGround);
+  // THEN the grid holds at most 3·4096 + 1 cells (the budget of a few buildings, see cells())
+  EXPECT_LE(index.cells(), 3u * 4096u + 1u);
+  // AND the coarse grid still culls exactly: the brute-force mask, the block's elevation
+  SkyMaskOptions brute;
+  brute.cull = false;
+  const SkyMask fast = computeSkyMask(eye(), &index, nullptr);
+  const SkyMask slow = computeSkyMask(eye(), &index, nullptr, brute);
+  for (int k = 0; k < 360; ++k) ASSERT_EQ(fast.binBlocked_rad(k), slow.binBlocked_rad(k)) << "bin " << k;
+  const double R = primeVertical_m(kGround.lat_rad);
+  EXPECT_NEAR(fast.binBlocked_rad(0), std::atan2(H - kEye_m - d * d / (2 * R), d), kAngleTol_rad);
+}
+
 // A floor at the receiver's elevation mask: every bin is max(floor, the brute-force mask), from
 // the street and from a drone above the roofs (where the floor lets the culling skip almost all).
 TEST(SkyMaskBuildings, FloorGivesTheBruteForceMaskRaisedToTheFloor) {
