@@ -46,6 +46,9 @@ class FclPieces {
   /// \brief FCL's distance from this thread's query cylinder to piece i with the given solver
   /// (≤ 0 in contact). Throws what FCL throws.
   [[nodiscard]] virtual double distance(std::size_t i, GjkSolver solver) const = 0;
+  /// \brief Asks the processor for what distance(i, …) will read (the object, its shape and its
+  /// vertices), so that the scene can ask for several pieces before measuring the first.
+  virtual void prefetch(std::size_t i) const = 0;
 };
 
 /// \brief The entry points of the FCL module.
@@ -54,7 +57,7 @@ struct FclModule {
 };
 
 /// \brief The interface version the module and skylane agree on (in the entry point's name).
-inline constexpr int kFclModuleAbi = 1;
+inline constexpr int kFclModuleAbi = 2;
 /// \brief File name of the module.
 inline constexpr const char* kFclModuleFile = "libskylane_fcl.so";
 

@@ -307,10 +307,10 @@ FclBox cylinderBox(const Eigen::Vector3d& p, double radius_m, double half_m) {
 
 const FclModule& fclModule() {
   static const FclModule& module = []() -> const FclModule& {
-    const maps::detail::ModuleSpec spec{kFclModuleFile, "SKYLANE_FCL_MODULE", "skylane_fcl_module_v1",
+    const maps::detail::ModuleSpec spec{kFclModuleFile, "SKYLANE_FCL_MODULE", "skylane_fcl_module_v2",
                                         SKYLANE_FCL_MODULE_BUILD_PATH, SKYLANE_FCL_MODULE_INSTALL_PATH,
                                         "checking protection volumes against zones and obstacles"};
-    static_assert(kFclModuleAbi == 1, "rename the entry point with the ABI version");
+    static_assert(kFclModuleAbi == 2, "rename the entry point with the ABI version");
     using Entry = const FclModule* (*)();
     return *reinterpret_cast<Entry>(maps::detail::loadModuleEntry(spec))();
   }();
@@ -336,6 +336,9 @@ std::uint64_t ownerKey(const ScenePiece& p, std::size_t i) {
   return (static_cast<std::uint64_t>(p.owner == PieceOwner::kObstacle) << 63) |
          (static_cast<std::uint64_t>(p.owner_index) << 32) | static_cast<std::uint64_t>(i);
 }
+/// The margin that decides meeting: the volume meets the piece iff it is ≤ 0.
+double deciding(const Separation& s) { return std::max(s.margin_h_m, s.margin_v_m); }
+
 std::size_t keyPiece(std::uint64_t key) { return static_cast<std::size_t>(key & 0xffffffffu); }
 std::uint64_t keyOwner(std::uint64_t key) { return key >> 32; }
 PieceOwner keyOwnerKind(std::uint64_t key) { return (key >> 63) != 0 ? PieceOwner::kObstacle : PieceOwner::kZone; }
@@ -442,10 +445,21 @@ struct Scene::Impl {
   /// Narrow phase of piece i against the volume (this thread's FCL query cylinder), starting
   /// from its closed-form separation.
   [[nodiscard]] Separation settle(std::size_t i, NarrowQuery& query, Separation s) const;
-  /// The hit (or the nearest miss) among one owner's candidates [begin, end); `group` is scratch.
-  [[nodiscard]] std::optional<SceneHit> ownerHit(const std::vector<std::uint64_t>& candidates, std::size_t begin,
-                                                 std::size_t end, NarrowQuery& query, double horizon_m,
-                                                 std::vector<Candidate>& group) const;
+  /// One owner's candidates with their margins, sorted by deciding margin: [begin, end) of a
+  /// query's list of candidates.
+  struct OwnerGroup {
+    PieceOwner kind;
+    std::size_t index;
+    std::size_t begin, end;
+  };
+  /// Appends the candidates [begin, end) of one owner, with their margins, to `group`, sorted
+  /// by deciding margin, and asks FCL's module to prefetch the pieces the narrow phase will
+  /// measure first (the first and the nearest).
+  void appendOwnerGroup(const std::vector<std::uint64_t>& candidates, std::size_t begin, std::size_t end,
+                        const ProtectionVolume& volume, std::vector<Candidate>& group) const;
+  /// The hit (or the nearest miss) among one owner's sorted candidates.
+  [[nodiscard]] std::optional<SceneHit> ownerHit(const OwnerGroup& owner, std::vector<Candidate>& group,
+                                                 NarrowQuery& query, double horizon_m) const;
 };
 
 
@@ -506,36 +520,44 @@ Separation Scene::Impl::settle(std::size_t i, NarrowQuery& query, Separation s) 
   return s;
 }
 
-std::optional<SceneHit> Scene::Impl::ownerHit(const std::vector<std::uint64_t>& found, std::size_t begin,
-                                              std::size_t end, NarrowQuery& query, double horizon_m,
-                                              std::vector<Candidate>& group) const {
-  const ProtectionVolume& volume = query.volume;
-  const PieceOwner owner_kind = keyOwnerKind(found[begin]);
-  const std::size_t owner_index = keyOwnerIndex(found[begin]);
-  group.clear();
+void Scene::Impl::appendOwnerGroup(const std::vector<std::uint64_t>& found, std::size_t begin, std::size_t end,
+                                   const ProtectionVolume& volume, std::vector<Candidate>& group) const {
+  const auto first = static_cast<std::ptrdiff_t>(group.size());
   for (std::size_t k = begin; k < end; ++k) shapes.prefetchEdges(keyPiece(found[k]));
   for (std::size_t k = begin; k < end; ++k) group.emplace_back(keyPiece(found[k]), shapes.margins(volume, keyPiece(found[k])));
-  const auto deciding = [](const Separation& s) { return std::max(s.margin_h_m, s.margin_v_m); };
-  std::sort(group.begin(), group.end(), [&](const auto& a, const auto& b) { return deciding(a.second) < deciding(b.second); });
+  std::sort(group.begin() + first, group.end(),
+            [](const auto& a, const auto& b) { return deciding(a.second) < deciding(b.second); });
+  const auto nearest = std::min_element(group.begin() + first, group.end(), [](const auto& a, const auto& b) {
+    return a.second.clearance_m < b.second.clearance_m;
+  });
+  fcl->prefetch(group[static_cast<std::size_t>(first)].first);
+  fcl->prefetch(nearest->first);
+}
+
+std::optional<SceneHit> Scene::Impl::ownerHit(const OwnerGroup& owner, std::vector<Candidate>& group,
+                                              NarrowQuery& query, double horizon_m) const {
+  const auto at = [&](std::size_t k) -> Candidate& { return group[owner.begin + k]; };
+  const std::size_t n = owner.end - owner.begin;
   std::optional<SceneHit> hit;
   std::size_t evaluated = 0;
-  for (; evaluated < group.size() && deciding(group[evaluated].second) <= kExactBand_m; ++evaluated) {
-    const Separation s = settle(group[evaluated].first, query, group[evaluated].second);
+  for (; evaluated < n && deciding(at(evaluated).second) <= kExactBand_m; ++evaluated) {
+    const Separation s = settle(at(evaluated).first, query, at(evaluated).second);
     if (s.meets) {
-      hit = SceneHit{owner_kind, owner_index, group[evaluated].first, s};
+      hit = SceneHit{owner.kind, owner.index, at(evaluated).first, s};
       break;
     }
-    if (!hit || s.clearance_m < hit->separation.clearance_m) hit = SceneHit{owner_kind, owner_index, group[evaluated].first, s};
+    if (!hit || s.clearance_m < hit->separation.clearance_m) hit = SceneHit{owner.kind, owner.index, at(evaluated).first, s};
   }
   if (!hit || !hit->separation.meets) {
     // The nearest of the pieces not yet evaluated, when it may lie within the horizon.
-    const auto nearest = std::min_element(group.begin() + static_cast<std::ptrdiff_t>(std::min(evaluated, group.size())),
-                                          group.end(), [](const auto& a, const auto& b) {
-                                            return a.second.clearance_m < b.second.clearance_m;
-                                          });
-    if (nearest != group.end() && nearest->second.clearance_m <= horizon_m + kExactBand_m &&
+    const auto rest = group.begin() + static_cast<std::ptrdiff_t>(owner.begin + std::min(evaluated, n));
+    const auto end = group.begin() + static_cast<std::ptrdiff_t>(owner.end);
+    const auto nearest = std::min_element(rest, end, [](const auto& a, const auto& b) {
+      return a.second.clearance_m < b.second.clearance_m;
+    });
+    if (nearest != end && nearest->second.clearance_m <= horizon_m + kExactBand_m &&
         (!hit || nearest->second.clearance_m < hit->separation.clearance_m)) {
-      hit = SceneHit{owner_kind, owner_index, nearest->first, settle(nearest->first, query, nearest->second)};
+      hit = SceneHit{owner.kind, owner.index, nearest->first, settle(nearest->first, query, nearest->second)};
     }
   }
   return hit;
@@ -581,16 +603,27 @@ std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizo
   // Per-thread scratch: no allocation per query once it has grown.
   thread_local std::vector<std::uint64_t> candidates;
   thread_local std::vector<Impl::Candidate> group;
+  thread_local std::vector<Impl::OwnerGroup> owners;
   impl_->candidates(reach, candidates);
   for (const std::uint64_t key : candidates) impl_->shapes.prefetchShape(keyPiece(key));
 
-  // Narrow phase, owner by owner.
-  std::vector<SceneHit> hits;
+  // The margins of every accepted owner's pieces first (FCL's data prefetched meanwhile), then
+  // the narrow phase owner by owner.
+  group.clear();
+  owners.clear();
   for (std::size_t first = 0; first < candidates.size();) {
     const std::size_t begin = first;
     first = Impl::ownerEnd(candidates, first);
-    if (!accept(keyOwnerKind(candidates[begin]), keyOwnerIndex(candidates[begin]))) continue;
-    const std::optional<SceneHit> hit = impl_->ownerHit(candidates, begin, first, narrow, horizon_m, group);
+    const PieceOwner kind = keyOwnerKind(candidates[begin]);
+    const std::size_t index = keyOwnerIndex(candidates[begin]);
+    if (!accept(kind, index)) continue;
+    const std::size_t from = group.size();
+    impl_->appendOwnerGroup(candidates, begin, first, volume, group);
+    owners.push_back({kind, index, from, group.size()});
+  }
+  std::vector<SceneHit> hits;
+  for (const Impl::OwnerGroup& owner : owners) {
+    const std::optional<SceneHit> hit = impl_->ownerHit(owner, group, narrow, horizon_m);
     if (hit && (hit->separation.meets || hit->separation.clearance_m <= horizon_m)) hits.push_back(*hit);
   }
   return hits;
