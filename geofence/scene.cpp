@@ -33,34 +33,55 @@ constexpr double kFclMinSize_m = 1e-3;
 /// works on the vertices' hull, which then holds the piece (the safe side).
 constexpr double kConvexityTolerance = 1e-9;
 
+/// A ring's edge as the distance below takes it: its start, its vector, length and squared length.
+struct RingEdge {
+  double ax, ay, ex, ey, length, length2;
+};
+
+/// The edge from a to b; none when it has no length (a repeated vertex adds nothing).
+std::optional<RingEdge> ringEdge(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d e = b - a;
+  const double length = e.norm();
+  if (length == 0.0) return std::nullopt;
+  return RingEdge{a.x(), a.y(), e.x(), e.y(), length, length * length};
+}
+
+/// Signed horizontal distance from a point to a convex counter-clockwise ring, edge by edge:
+/// positive outside (the distance to the ring), negative inside (minus the distance to its
+/// boundary: the least distance to its edges' lines).
+class SignedRingDistance {
+ public:
+  explicit SignedRingDistance(const Eigen::Vector2d& x) : x_(x) {}
+  void add(const RingEdge& e) {
+    const double ax = x_.x() - e.ax, ay = x_.y() - e.ay;
+    const double cross = e.ex * ay - e.ey * ax;  // > 0: x left of the edge (inside side)
+    if (cross < 0) is_inside_ = false;
+    inside_ = std::min(inside_, cross / e.length);
+    const double t = std::clamp((ax * e.ex + ay * e.ey) / e.length2, 0.0, 1.0);
+    const double dx = ax - t * e.ex, dy = ay - t * e.ey;
+    outside2_ = std::min(outside2_, dx * dx + dy * dy);  // the root of the least is the least root
+  }
+  [[nodiscard]] double value() const { return is_inside_ ? -inside_ : std::sqrt(outside2_); }
+
+ private:
+  Eigen::Vector2d x_;
+  double outside2_ = kInf, inside_ = kInf;
+  bool is_inside_ = true;
+};
+
 /// Signed horizontal distance from x to the piece's shape: positive outside (distance to the
-/// shape), negative inside (minus the distance to its boundary). A convex ring's interior
-/// distance to the boundary is the least distance to its edges' lines.
+/// shape), negative inside (minus the distance to its boundary).
 double signedHorizontalDistance(const airspace::PlanarPrism& p, const Eigen::Vector2d& x) {
   if (p.ring.empty()) return (x - p.centre).norm() - p.radius_m;
-  const std::size_t n = p.ring.size();
-  double outside = kInf, inside = kInf;
-  bool is_inside = true;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d& a = p.ring[i];
-    const Eigen::Vector2d& b = p.ring[(i + 1) % n];
-    const Eigen::Vector2d e = b - a;
-    const double length = e.norm();
-    if (length == 0.0) continue;
-    const Eigen::Vector2d ax = x - a;
-    const double cross = e.x() * ax.y() - e.y() * ax.x();  // > 0: x left of the edge (inside side)
-    if (cross < 0) is_inside = false;
-    inside = std::min(inside, cross / length);
-    const double t = std::clamp(ax.dot(e) / (length * length), 0.0, 1.0);
-    outside = std::min(outside, (ax - t * e).norm());
+  SignedRingDistance d(x);
+  for (std::size_t i = 0; i < p.ring.size(); ++i) {
+    if (const auto e = ringEdge(p.ring[i], p.ring[(i + 1) % p.ring.size()])) d.add(*e);
   }
-  return is_inside ? -inside : outside;
+  return d.value();
 }
 
 /// Signed vertical distance from z to [floor, ceiling]: positive outside, negative inside.
-double signedVerticalDistance(const airspace::PlanarPrism& p, double z) {
-  return std::max(p.floor_h_ell_m - z, z - p.ceiling_h_ell_m);
-}
+double signedVerticalDistance(double floor, double ceiling, double z) { return std::max(floor - z, z - ceiling); }
 
 /// The piece's height interval as FCL gets it: finite limits as they are; an unlimited floor
 /// (ceiling) at the bottom (top) of the modelled band, or 1 km beyond the other limit when that
@@ -129,11 +150,10 @@ void checkQuery(const ProtectionVolume& volume, double horizon_m) {
 }
 
 /// Broad phase over the pieces' FCL AABBs: a uniform grid over x–y in one flat array (CSR:
-/// each cell's entries one after the other), each entry a copy of its piece's box in floats
-/// rounded outwards (a conservative first test read in order, 28 bytes an entry) and the piece
-/// index. A query visits the cells its box covers; an entry whose float box meets the query's
-/// (rounded outwards too) is tested again on FCL's own double AABB with FCL's rule (closed
-/// boxes: touching overlaps) — so the grid finds exactly the pieces FCL's
+/// each cell's entries one after the other), each entry a copy of its piece's FCL AABB, the
+/// piece index and the cell of the box's lower corner (read in order, 56 bytes an entry). A
+/// query visits the cells its box covers and tests each entry with FCL's rule (closed boxes:
+/// touching overlaps) — so the grid finds exactly the pieces FCL's
 /// DynamicAABBTreeCollisionManager::collide found, without its pointer chase down a tree of
 /// 150 k leaves and a callback per overlap. A piece spanning several cells is reported only
 /// from the cell holding the lower corner of its overlap with the query box (no duplicate, no
@@ -157,10 +177,6 @@ class PieceGrid {
   void collect(const detail::FclBox& q, std::vector<std::uint64_t>& out) const;
 
  private:
-  struct FloatBox {
-    float lo[3];
-    float hi[3];
-  };
   /// A piece's entry in a cell: its FCL AABB (read in order with the cell, so the exact test
   /// needs no look-up elsewhere) and the cell of the box's lower corner (for reporting it once).
   struct Entry {
@@ -168,30 +184,6 @@ class PieceGrid {
     std::uint32_t piece;
     std::uint16_t cx0, cy0;
   };
-  /// A piece's FCL AABB and the cell of its lower corner.
-  struct PieceBox {
-    detail::FclBox box;
-    int cx0 = 0, cy0 = 0;
-  };
-  /// x rounded down (up) to a float: the float box holds the double one.
-  static float floatBelow(double x) {
-    float f = static_cast<float>(x);
-    if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-    return f;
-  }
-  static float floatAbove(double x) {
-    float f = static_cast<float>(x);
-    if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-    return f;
-  }
-  static FloatBox outward(const detail::FclBox& b) {
-    return {{floatBelow(b.min[0]), floatBelow(b.min[1]), floatBelow(b.min[2])},
-            {floatAbove(b.max[0]), floatAbove(b.max[1]), floatAbove(b.max[2])}};
-  }
-  [[nodiscard]] static bool overlaps(const FloatBox& a, const FloatBox& q) {
-    return !(a.lo[0] > q.hi[0] || a.lo[1] > q.hi[1] || a.lo[2] > q.hi[2] || q.lo[0] > a.hi[0] ||
-             q.lo[1] > a.hi[1] || q.lo[2] > a.hi[2]);
-  }
   /// FCL's AABB::overlap.
   [[nodiscard]] static bool overlaps(const detail::FclBox& a, const detail::FclBox& q) {
     return !(a.min[0] > q.max[0] || a.min[1] > q.max[1] || a.min[2] > q.max[2] || q.min[0] > a.max[0] ||
@@ -206,7 +198,7 @@ class PieceGrid {
   /// Calls f(cell) for each cell of piece i's box; false (and no call) when it spans too many.
   template <typename F>
   bool forCells(std::size_t i, F&& f) const {
-    const detail::FclBox& b = boxes_[i].box;
+    const detail::FclBox& b = boxes_[i];
     const int cx0 = cellX(b.min[0]), cx1 = cellX(b.max[0]), cy0 = cellY(b.min[1]), cy1 = cellY(b.max[1]);
     if (static_cast<std::size_t>(cx1 - cx0 + 1) * static_cast<std::size_t>(cy1 - cy0 + 1) > kMaxCellsPerPiece) return false;
     for (int cy = cy0; cy <= cy1; ++cy) {
@@ -215,7 +207,7 @@ class PieceGrid {
     return true;
   }
 
-  std::vector<PieceBox> boxes_;            ///< per piece, FCL's AABB
+  std::vector<detail::FclBox> boxes_;      ///< per piece, FCL's AABB
   std::vector<std::uint64_t> keys_;        ///< per piece, what collect() reports
   std::vector<std::uint32_t> cell_start_;  ///< nx·ny + 1 offsets into entries_
   std::vector<Entry> entries_;
@@ -224,17 +216,15 @@ class PieceGrid {
   int nx_ = 1, ny_ = 1;
 };
 
-void PieceGrid::build(std::vector<detail::FclBox> aabbs, std::vector<std::uint64_t> keys) {
+void PieceGrid::build(std::vector<detail::FclBox> boxes, std::vector<std::uint64_t> keys) {
   keys_ = std::move(keys);
-  boxes_.clear();
-  boxes_.reserve(aabbs.size());
-  for (const detail::FclBox& b : aabbs) boxes_.push_back({b});
+  boxes_ = std::move(boxes);
   entries_.clear();
   big_pieces_.clear();
   cell_start_.assign(2, 0);
   if (boxes_.empty()) return;
   double x_lo = kInf, y_lo = kInf, x_hi = -kInf, y_hi = -kInf, area = 0;
-  for (const detail::FclBox& b : aabbs) {
+  for (const detail::FclBox& b : boxes_) {
     x_lo = std::min(x_lo, b.min[0]);
     y_lo = std::min(y_lo, b.min[1]);
     x_hi = std::max(x_hi, b.max[0]);
@@ -255,10 +245,6 @@ void PieceGrid::build(std::vector<detail::FclBox> aabbs, std::vector<std::uint64
   nx_ = std::clamp(static_cast<int>(std::ceil((x_hi - x_lo) * inv_cell_)), 1, kMaxCellsPerAxis);
   ny_ = std::clamp(static_cast<int>(std::ceil((y_hi - y_lo) * inv_cell_)), 1, kMaxCellsPerAxis);
   const std::size_t cells = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
-  for (PieceBox& b : boxes_) {
-    b.cx0 = cellX(b.box.min[0]);
-    b.cy0 = cellY(b.box.min[1]);
-  }
   // Two passes (count, then fill) into one flat array.
   std::vector<std::uint32_t> next(cells + 1, 0);
   for (std::size_t i = 0; i < boxes_.size(); ++i) {
@@ -268,16 +254,15 @@ void PieceGrid::build(std::vector<detail::FclBox> aabbs, std::vector<std::uint64
   cell_start_ = next;
   entries_.resize(cell_start_.back());
   for (std::size_t i = 0; i < boxes_.size(); ++i) {
-    const PieceBox& b = boxes_[i];
-    (void)forCells(i, [&](std::size_t c) {
-      entries_[next[c]++] = Entry{b.box, static_cast<std::uint32_t>(i), static_cast<std::uint16_t>(b.cx0), static_cast<std::uint16_t>(b.cy0)};
-    });
+    const detail::FclBox& b = boxes_[i];
+    const auto cx0 = static_cast<std::uint16_t>(cellX(b.min[0])), cy0 = static_cast<std::uint16_t>(cellY(b.min[1]));
+    (void)forCells(i, [&](std::size_t c) { entries_[next[c]++] = Entry{b, static_cast<std::uint32_t>(i), cx0, cy0}; });
   }
 }
 
 void PieceGrid::collect(const detail::FclBox& q, std::vector<std::uint64_t>& out) const {
   for (const std::uint32_t i : big_pieces_) {
-    if (overlaps(boxes_[i].box, q)) out.push_back(keys_[i]);
+    if (overlaps(boxes_[i], q)) out.push_back(keys_[i]);
   }
   if (entries_.empty()) return;
   const int cx0 = cellX(q.min[0]), cx1 = cellX(q.max[0]), cy0 = cellY(q.min[1]), cy1 = cellY(q.max[1]);
@@ -319,13 +304,23 @@ const FclModule& fclModule() {
 
 }  // namespace detail
 
-Separation separationMargins(const ProtectionVolume& volume, const airspace::PlanarPrism& piece) {
+namespace {
+
+/// The separation the two margins give (Separation's formulas).
+Separation fromMargins(double margin_h_m, double margin_v_m) {
   Separation s;
-  s.margin_h_m = signedHorizontalDistance(piece, volume.p_map.head<2>()) - volume.hpl_m;
-  s.margin_v_m = signedVerticalDistance(piece, volume.p_map.z()) - volume.vpl_m;
-  s.meets = std::max(s.margin_h_m, s.margin_v_m) <= 0;
-  s.clearance_m = std::hypot(std::max(s.margin_h_m, 0.0), std::max(s.margin_v_m, 0.0));
+  s.margin_h_m = margin_h_m;
+  s.margin_v_m = margin_v_m;
+  s.meets = std::max(margin_h_m, margin_v_m) <= 0;
+  s.clearance_m = std::hypot(std::max(margin_h_m, 0.0), std::max(margin_v_m, 0.0));
   return s;
+}
+
+}  // namespace
+
+Separation separationMargins(const ProtectionVolume& volume, const airspace::PlanarPrism& piece) {
+  return fromMargins(signedHorizontalDistance(piece, volume.p_map.head<2>()) - volume.hpl_m,
+                     signedVerticalDistance(piece.floor_h_ell_m, piece.ceiling_h_ell_m, volume.p_map.z()) - volume.vpl_m);
 }
 
 namespace {
@@ -344,9 +339,8 @@ std::uint64_t keyOwner(std::uint64_t key) { return key >> 32; }
 PieceOwner keyOwnerKind(std::uint64_t key) { return (key >> 63) != 0 ? PieceOwner::kObstacle : PieceOwner::kZone; }
 std::size_t keyOwnerIndex(std::uint64_t key) { return static_cast<std::size_t>((key >> 32) & 0x7fffffffu); }
 
-/// The pieces' shapes laid out for separationMargins' formulas: per ring edge its start, its
-/// vector, its length and squared length (computed once, as separationMargins computes them, so
-/// that the margins are the same to the bit), each piece's edges one after the other.
+/// The pieces' shapes laid out for separationMargins' formulas: each piece's ring edges
+/// (ringEdge, computed once) one after the other, so that the margins are the same to the bit.
 class ShapeTable {
  public:
   void add(const airspace::PlanarPrism& p);
@@ -363,61 +357,39 @@ class ShapeTable {
   }
 
  private:
-  struct Edge {
-    double ax, ay, ex, ey, length, length2;
-  };
   struct Shape {
     std::uint32_t first = 0, count = 0;  ///< edges; none for a disk
     double floor = 0, ceiling = 0;
     Eigen::Vector2d centre = Eigen::Vector2d::Zero();
     double radius = 0;
   };
-  [[nodiscard]] double signedHorizontal(const Shape& p, const Eigen::Vector2d& x) const;
   std::vector<Shape> shapes_;
-  std::vector<Edge> edges_;
+  std::vector<RingEdge> edges_;
 };
 
 void ShapeTable::add(const airspace::PlanarPrism& p) {
   Shape s{static_cast<std::uint32_t>(edges_.size()), 0, p.floor_h_ell_m, p.ceiling_h_ell_m, p.centre, p.radius_m};
-  const std::size_t n = p.ring.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d& a = p.ring[i];
-    const Eigen::Vector2d e = p.ring[(i + 1) % n] - a;
-    const double length = e.norm();
-    if (length == 0.0) continue;  // as signedHorizontalDistance: a repeated vertex adds nothing
-    edges_.push_back({a.x(), a.y(), e.x(), e.y(), length, length * length});
-    ++s.count;
+  for (std::size_t i = 0; i < p.ring.size(); ++i) {
+    if (const auto e = ringEdge(p.ring[i], p.ring[(i + 1) % p.ring.size()])) {
+      edges_.push_back(*e);
+      ++s.count;
+    }
   }
   shapes_.push_back(s);
 }
 
-/// signedHorizontalDistance on the table (the same operations in the same order; the least
-/// outside distance is the root of the least squared one, the root being monotonic and
-/// correctly rounded).
-double ShapeTable::signedHorizontal(const Shape& p, const Eigen::Vector2d& x) const {
-  if (p.count == 0) return (x - p.centre).norm() - p.radius;
-  double outside2 = kInf, inside = kInf;
-  bool is_inside = true;
-  for (const Edge* e = edges_.data() + p.first, *end = e + p.count; e != end; ++e) {
-    const double ax = x.x() - e->ax, ay = x.y() - e->ay;
-    const double cross = e->ex * ay - e->ey * ax;
-    if (cross < 0) is_inside = false;
-    inside = std::min(inside, cross / e->length);
-    const double t = std::clamp((ax * e->ex + ay * e->ey) / e->length2, 0.0, 1.0);
-    const double dx = ax - t * e->ex, dy = ay - t * e->ey;
-    outside2 = std::min(outside2, dx * dx + dy * dy);
-  }
-  return is_inside ? -inside : std::sqrt(outside2);
-}
-
 Separation ShapeTable::margins(const ProtectionVolume& volume, std::size_t i) const {
   const Shape& p = shapes_[i];
-  Separation s;
-  s.margin_h_m = signedHorizontal(p, volume.p_map.head<2>()) - volume.hpl_m;
-  s.margin_v_m = std::max(p.floor - volume.p_map.z(), volume.p_map.z() - p.ceiling) - volume.vpl_m;
-  s.meets = std::max(s.margin_h_m, s.margin_v_m) <= 0;
-  s.clearance_m = std::hypot(std::max(s.margin_h_m, 0.0), std::max(s.margin_v_m, 0.0));
-  return s;
+  const Eigen::Vector2d x = volume.p_map.head<2>();
+  double horizontal = 0.0;
+  if (p.count == 0) {
+    horizontal = (x - p.centre).norm() - p.radius;
+  } else {
+    SignedRingDistance d(x);
+    for (const RingEdge* e = edges_.data() + p.first, *end = e + p.count; e != end; ++e) d.add(*e);
+    horizontal = d.value();
+  }
+  return fromMargins(horizontal - volume.hpl_m, signedVerticalDistance(p.floor, p.ceiling, volume.p_map.z()) - volume.vpl_m);
 }
 
 }  // namespace
@@ -461,8 +433,6 @@ struct Scene::Impl {
   [[nodiscard]] std::optional<SceneHit> ownerHit(const OwnerGroup& owner, std::vector<Candidate>& group,
                                                  NarrowQuery& query, double horizon_m) const;
 };
-
-
 
 void Scene::Impl::candidates(const detail::FclBox& reach, std::vector<std::uint64_t>& found) const {
   found.clear();
