@@ -207,11 +207,15 @@ double Approver::Impl::ratioOf(const integrity::PredictSample& s) const {
 }
 
 void Approver::Impl::buildCostGrid(const maps::GpsTime& t_mid) {
-  cell_m = m.cost_cell_m;
-  while ((upper.x() - lower.x()) * (upper.y() - lower.y()) / (cell_m * cell_m) > 20000.0) cell_m *= 1.5;
-  cols = std::max(1, static_cast<int>(std::ceil((upper.x() - lower.x()) / cell_m)));
-  rows = std::max(1, static_cast<int>(std::ceil((upper.y() - lower.y()) / cell_m)));
+  CostGrid& field = cost_field;
+  field.lower = lower.head<2>();
+  field.cell_m = m.cost_cell_m;
+  while ((upper.x() - lower.x()) * (upper.y() - lower.y()) / (field.cell_m * field.cell_m) > 20000.0) field.cell_m *= 1.5;
+  const double cell_m = field.cell_m;
+  const int cols = field.cols = std::max(1, static_cast<int>(std::ceil((upper.x() - lower.x()) / cell_m)));
+  const int rows = field.rows = std::max(1, static_cast<int>(std::ceil((upper.y() - lower.y()) / cell_m)));
   const std::size_t n = static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows);
+  std::vector<double>& cost = field.cost;
   cost.assign(m.cost_weight > 0.0 ? n : 0, 0.0);
   grid_pl.assign(n, Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
   const bool with_masks = masked();
@@ -228,19 +232,12 @@ void Approver::Impl::buildCostGrid(const maps::GpsTime& t_mid) {
       if (!cost.empty()) cost[k] = m.cost_weight * integrityPenalty(ratioOf(s));
     }
   }
-  cost_field = CostGrid{lower.head<2>(), cell_m, cols, rows, cost};
-}
-
-std::size_t Approver::Impl::cellOf(const Eigen::Vector3d& p) const {
-  const int c = std::clamp(static_cast<int>((p.x() - lower.x()) / cell_m), 0, cols - 1);
-  const int r = std::clamp(static_cast<int>((p.y() - lower.y()) / cell_m), 0, rows - 1);
-  return static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c);
 }
 
 geofence::ProtectionVolume Approver::Impl::planningVolume(const Eigen::Vector3d& p) const {
   double h = limits.level1.hal_m, v = limits.level1.val_m;
   if (!grid_pl.empty()) {
-    const Eigen::Vector2d& pl = grid_pl[cellOf(p)];
+    const Eigen::Vector2d& pl = grid_pl[cost_field.cellOf(p)];
     if (std::isfinite(pl.x())) {
       h = std::max(h, 1.2 * pl.x());
       v = std::max(v, 1.2 * pl.y());

@@ -144,10 +144,7 @@ struct Approver::Impl {
   std::vector<approval_steps::StopTiming> mission_timing;  ///< per mission stop: leg speed and hover
   Eigen::Vector3d lower = Eigen::Vector3d::Zero(), upper = Eigen::Vector3d::Zero();
   // The predicted-PL grid at cruise height (mid-flight time) and the integrity cost from it.
-  double cell_m = 50.0;
-  int cols = 0, rows = 0;
-  std::vector<double> cost;
-  CostGrid cost_field;  ///< `cost` for the planner (set with it)
+  CostGrid cost_field;  ///< its cells (also the PL grid's); its cost empty when cost_weight is 0
   std::vector<Eigen::Vector2d> grid_pl;  ///< (HPL, VPL) per cell; NaN when unavailable
   bool cost_grid_built = false;
 
@@ -172,7 +169,6 @@ struct Approver::Impl {
   /// max(HPL/HAL₂, VPL/VAL₂); ∞ without a PL.
   [[nodiscard]] double ratioOf(const integrity::PredictSample& s) const;
   void buildCostGrid(const maps::GpsTime& t_mid);
-  [[nodiscard]] std::size_t cellOf(const Eigen::Vector3d& p) const;
   /// The volume a state must keep clear: the level-1 box, grown to the PL predicted there with a
   /// 20 % allowance for its change over the flight (the samples are checked exactly afterwards).
   [[nodiscard]] geofence::ProtectionVolume planningVolume(const Eigen::Vector3d& p) const;

@@ -310,9 +310,9 @@ PathProblem Approver::Impl::legProblem(const ApprovalSetup& setup, const maps::G
     }
     return valid(p, earliest, latest, penalties);
   };
-  if (!cost.empty()) {
+  if (!cost_field.cost.empty()) {
     prob.extra_cost = &cost_field;
-    prob.cost_step_m = cell_m / 2.0;
+    prob.cost_step_m = cost_field.cell_m / 2.0;
   }
   prob.resolution_m = m.resolution_m;
   prob.time_limit_s = m.time_limit_s;

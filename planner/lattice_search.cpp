@@ -13,10 +13,11 @@
 
 namespace skylane::planner {
 
-bool motionIsValid(const PathProblem& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, std::uint64_t* checks) {
+bool motionIsValid(const PathProblem& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b, bool with_ends,
+                   std::uint64_t* checks) {
   const double len = (b - a).norm();
   const int steps = std::max(1, static_cast<int>(std::ceil(len / p.resolution_m)));
-  for (int i = 0; i <= steps; ++i) {
+  for (int i = with_ends ? 0 : 1; i <= (with_ends ? steps : steps - 1); ++i) {
     if (checks) ++*checks;
     if (!p.is_valid(a + (b - a) * (static_cast<double>(i) / steps))) return false;
   }
@@ -179,14 +180,9 @@ class LatticeAStar {
       if (std::abs(c.k + dk) <= l_.layers) from({c.i, c.j, c.k + dk});
     }
   }
-  /// The samples strictly between a and b (motionIsValid's, without its ends).
+  /// The samples strictly between a and b (motionIsValid's, without its ends), counted.
   bool innerSamplesValid(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / l_.p.resolution_m)));
-    for (int i = 1; i < steps; ++i) {
-      ++r_.state_checks;
-      if (!l_.p.is_valid(a + (b - a) * (static_cast<double>(i) / steps))) return false;
-    }
-    return true;
+    return motionIsValid(l_.p, a, b, /*with_ends=*/false, &r_.state_checks);
   }
   void expand(std::uint64_t key) {
     const NodeIndex c = indexOf(key);
@@ -281,8 +277,10 @@ LatticeResult latticeSearch(const PathProblem& p, const LatticeOptions& o) {
       if (r.found && finer_left-- == 0) break;
       const Lattice lattice(p, h, half_layers);
       std::vector<Eigen::Vector3d> path;
-      if (LatticeAStar(lattice, o, r, t0).run(path) && pathCost(lattice, path) < best) {
-        best = pathCost(lattice, path);
+      const bool found = LatticeAStar(lattice, o, r, t0).run(path);
+      const double cost = found ? pathCost(lattice, path) : 0.0;
+      if (found && cost < best) {
+        best = cost;
         r.found = true;
         r.points = std::move(path);
         r.step_m = h;

@@ -66,8 +66,8 @@ struct LatticeResult {
 [[nodiscard]] std::vector<Eigen::Vector3d> withoutCollinearVertices(const std::vector<Eigen::Vector3d>& path);
 
 /// \brief Whether the straight motion a → b is valid, checked every `resolution_m` (both ends
-/// included); counts the checks made.
+/// included, or only the samples between them); adds the checks made to `*checks` when given.
 [[nodiscard]] bool motionIsValid(const PathProblem& problem, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                 std::uint64_t* checks = nullptr);
+                                 bool with_ends = true, std::uint64_t* checks = nullptr);
 
 }  // namespace skylane::planner

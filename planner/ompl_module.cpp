@@ -49,12 +49,7 @@ class IntegrityCostObjective : public ob::StateCostIntegralObjective {
   /// Trapezoid rule over steps of at most step_m (the cost field's own resolution), rather than
   /// OMPL's validity-checking resolution, which would evaluate it every few metres.
   ob::Cost motionCost(const ob::State* s1, const ob::State* s2) const override {
-    const Eigen::Vector3d a = toVector(s1), b = toVector(s2);
-    const double len = (b - a).norm();
-    const int n = std::max(1, static_cast<int>(std::ceil(len / step_m_)));
-    double sum = 0.5 * (extra_.at(a) + extra_.at(b));
-    for (int i = 1; i < n; ++i) sum += extra_.at(a + (b - a) * (static_cast<double>(i) / n));
-    return ob::Cost(len * (1.0 + sum / n));
+    return ob::Cost(extra_.motionCost(toVector(s1), toVector(s2), step_m_));
   }
   ob::Cost motionCostHeuristic(const ob::State* s1, const ob::State* s2) const override {
     return ob::Cost(si_->distance(s1, s2));
@@ -85,12 +80,28 @@ std::shared_ptr<ob::RealVectorStateSpace> searchSpace(const PathProblem& p) {
   return space;
 }
 
+/// One OMPL query at a time, quiet, with OMPL's process-wide generator seeded from the problem.
+class OmplQueryScope {
+ public:
+  explicit OmplQueryScope(const PathProblem& p) {
+    ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
+    ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(p.seed % 4294967291ULL + 1));
+  }
+
+ private:
+  std::lock_guard<std::mutex> lock_{omplMutex()};  // taken before the constructor's body
+};
+
+/// The problem's validity checker, and motions checked every resolution_m metres (OMPL takes it
+/// as a fraction of the extent).
+void setValidity(ob::SpaceInformation& si, const ob::StateSpacePtr& space, const PathProblem& p) {
+  si.setStateValidityChecker([&p](const ob::State* s) { return p.is_valid(toVector(s)); });
+  si.setStateValidityCheckingResolution(std::min(1.0, p.resolution_m / space->getMaximumExtent()));
+}
+
 /// Validity checker, motion resolution, start and goal.
 void setProblem(og::SimpleSetup& ss, const ob::StateSpacePtr& space, const PathProblem& p) {
-  ss.setStateValidityChecker([&p](const ob::State* s) { return p.is_valid(toVector(s)); });
-  // Motions are checked every resolution_m metres: OMPL takes it as a fraction of the extent.
-  ss.getSpaceInformation()->setStateValidityCheckingResolution(
-      std::min(1.0, p.resolution_m / space->getMaximumExtent()));
+  setValidity(*ss.getSpaceInformation(), space, p);
   ob::ScopedState<> start(space), goal(space);
   for (int i = 0; i < 3; ++i) {
     start[i] = p.start_enu_m[i];
@@ -162,9 +173,7 @@ void takeSolution(og::SimpleSetup& ss, const ob::OptimizationObjectivePtr& objec
 
 /// Plans with OMPL (the straight line did not do).
 void planWithOmpl(const PathProblem& p, PathResult& out) {
-  const std::lock_guard<std::mutex> lock(omplMutex());
-  ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
-  ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(p.seed % 4294967291ULL + 1));
+  const OmplQueryScope scope(p);
 
   const std::shared_ptr<ob::RealVectorStateSpace> space = searchSpace(p);
   og::SimpleSetup ss(space);
@@ -188,14 +197,10 @@ void planWithOmpl(const PathProblem& p, PathResult& out) {
 /// (shortcuts and vertex reduction: each change kept only when its motions are valid at the
 /// problem's resolution and, for shortcuts, when it lowers the objective).
 void refineWithOmpl(const PathProblem& p, const std::vector<Eigen::Vector3d>& seed, PathResult& out) {
-  const std::lock_guard<std::mutex> lock(omplMutex());
-  ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
-  ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(p.seed % 4294967291ULL + 1));
-
+  const OmplQueryScope scope(p);
   const std::shared_ptr<ob::RealVectorStateSpace> space = searchSpace(p);
   const auto si = std::make_shared<ob::SpaceInformation>(space);
-  si->setStateValidityChecker([&p](const ob::State* s) { return p.is_valid(toVector(s)); });
-  si->setStateValidityCheckingResolution(std::min(1.0, p.resolution_m / space->getMaximumExtent()));
+  setValidity(*si, space, p);
   si->setup();
   const ob::OptimizationObjectivePtr objective = objectiveFor(si, p);
   og::PathGeometric path(si);

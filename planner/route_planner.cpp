@@ -98,6 +98,14 @@ bool everyMotionValid(const PathProblem& p, const std::vector<Eigen::Vector3d>& 
   return points.size() >= 2;
 }
 
+/// The path's cost under the problem's objective (OMPL's: length, or ∫ (1 + extra cost) ds).
+double objectiveCost(const PathProblem& p, const std::vector<Eigen::Vector3d>& points) {
+  if (!p.extra_cost) return polylineLength(points);
+  double cost = 0.0;
+  for (std::size_t i = 1; i < points.size(); ++i) cost += p.extra_cost->motionCost(points[i - 1], points[i], p.cost_step_m);
+  return cost;
+}
+
 /// The lattice seed (planner/lattice_search.hpp), refined by OMPL and checked again: the refined
 /// path when every motion of it is valid, else the seed itself (checked the same way).
 void planFromLatticeSeed(const PathProblem& p, PathResult& out) {
@@ -114,25 +122,24 @@ void planFromLatticeSeed(const PathProblem& p, PathResult& out) {
   if (!seed.found) return;
   // The first that passes the check: the refined seed with its straight runs merged (fewer
   // vertices for the simplifier), the refined seed as searched, the seed itself.
-  std::vector<std::vector<Eigen::Vector3d>> candidates;
-  double cost = 0.0;
+  std::optional<PathResult> taken;
   for (const std::vector<Eigen::Vector3d>& start : {withoutCollinearVertices(seed.points), seed.points}) {
     PathResult refined;
     omplModule().refine(p, start, refined);
     out.simplify_time_s += refined.simplify_time_s;
     if (everyMotionValid(p, refined.points)) {
-      candidates.push_back(std::move(refined.points));
-      cost = refined.cost;
+      taken = std::move(refined);
       break;
     }
   }
-  if (candidates.empty() && everyMotionValid(p, seed.points)) {
-    candidates.push_back(seed.points);
-    cost = polylineLength(seed.points);
+  if (!taken && everyMotionValid(p, seed.points)) {
+    taken.emplace();
+    taken->points = seed.points;
+    taken->cost = objectiveCost(p, seed.points);
   }
-  if (candidates.empty()) return;
-  out.points = std::move(candidates.front());
-  out.cost = cost;
+  if (!taken) return;
+  out.points = std::move(taken->points);
+  out.cost = taken->cost;
   out.status = PathStatus::kExact;
   out.lattice_seed = true;
 }

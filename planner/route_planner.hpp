@@ -27,6 +27,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -59,6 +60,15 @@ struct CostGrid {
     return static_cast<std::size_t>(r) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(c);
   }
   [[nodiscard]] double at(const Eigen::Vector3d& p) const { return cost[cellOf(p)]; }
+  /// ∫ (1 + cost) ds along the motion a → b by the trapezoid rule over steps of at most step_m:
+  /// the planner's objective for one motion.
+  [[nodiscard]] double motionCost(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double step_m) const {
+    const double len = (b - a).norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(len / step_m)));
+    double sum = 0.5 * (at(a) + at(b));
+    for (int i = 1; i < n; ++i) sum += at(a + (b - a) * (static_cast<double>(i) / n));
+    return len * (1.0 + sum / n);
+  }
 };
 
 /// \brief One planning query.

@@ -115,8 +115,8 @@ TEST(ClutterPlanning, AGridSearchProvesTheRouteExistsAndTheLatticeSeedFindsItCle
   EXPECT_TRUE(r.lattice_seed);
   EXPECT_GT(r.lattice_state_checks, 0u);
   // The refined route is no longer than the straight line through the clutter allows, and not
-  // absurdly long: within 1.5 × the direct distance (the seed is within ε = 1.5 of the lattice's
-  // shortest path, and the simplifier only shortens it).
+  // absurdly long: within 1.5 × the direct distance (the seed is the lattice's shortest path,
+  // plain A*, and the simplifier only shortens it).
   EXPECT_GE(r.length_m, (kGoal - kStart).norm());
   EXPECT_LT(r.length_m, 1.5 * (kGoal - kStart).norm());
 }
