@@ -4,7 +4,8 @@
 /// connection that reconnects, streams and key-value buckets made or checked at start,
 /// publishing with a message id (JetStream drops a repeat of an id within the stream's
 /// duplicate window), pull consumers that start at a stream sequence, and key-value puts and
-/// compare-and-set updates. nats.c's types stay inside nats_client.cpp.
+/// compare-and-set updates. nats.c's types stay inside the NATS module (nats_module.hpp), loaded
+/// when the first client connects.
 ///
 /// Every call that talks to the server throws NatsError when it fails (server gone, timeout,
 /// refused); a worker's loop catches it, waits, and starts its partition again from the last
@@ -60,6 +61,10 @@ struct NatsEntry {
 };
 
 class NatsPull;
+namespace detail {
+class NatsConnection;
+class NatsSubscription;
+}  // namespace detail
 
 /// \brief One connection and its JetStream context.
 class NatsClient {
@@ -128,10 +133,8 @@ class NatsClient {
   /// \brief The stream's message at a sequence; none when absent.
   [[nodiscard]] std::optional<NatsMessage> message(const std::string& stream, std::uint64_t seq);
 
-  struct Impl;
-
  private:
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<detail::NatsConnection> impl_;
 };
 
 /// \brief A pull subscription.
@@ -151,11 +154,10 @@ class NatsPull {
   /// \brief Ends the message for good (a request that can never succeed).
   static void term(const NatsMessage& m);
 
-  struct Impl;
-  explicit NatsPull(std::unique_ptr<Impl> impl);
+  explicit NatsPull(std::unique_ptr<detail::NatsSubscription> impl);
 
  private:
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<detail::NatsSubscription> impl_;
 };
 
 }  // namespace skylane::service

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <sstream>
 #include <sys/wait.h>
+#include <vector>
 
 namespace skylane {
 namespace {
@@ -166,6 +167,39 @@ TEST(Cli, PredictAraimWithGpsAndGalileoAlmanacs) {
     ++n;
   }
   EXPECT_EQ(n, 4);
+}
+
+/// The shared libraries the skylane executable names (its DT_NEEDED entries, as readelf prints them).
+std::vector<std::string> neededLibraries() {
+  const RunResult r = test::runCommand("readelf -d " + std::string(SKYLANE_BINARY));
+  EXPECT_EQ(r.status, 0) << r.out;
+  std::vector<std::string> needed;
+  std::istringstream lines(r.out);
+  for (std::string line; std::getline(lines, line);) {
+    const auto open = line.find("(NEEDED)");
+    const auto lib = line.find('[');
+    if (open != std::string::npos && lib != std::string::npos) needed.push_back(line.substr(lib + 1, line.find(']', lib) - lib - 1));
+  }
+  return needed;
+}
+
+// Start-up: the optional modules' libraries (GDAL, OMPL, FCL, nats.c with libssl) are loaded by
+// the commands that use them, and SQLite, GMP, MPFR, GeographicLib and libcrypto are linked
+// statically, so every command starts with the C and C++ run-time libraries alone.
+TEST(Cli, StartsWithTheRunTimeLibrariesOnly) {
+  const std::vector<std::string> needed = neededLibraries();
+  ASSERT_FALSE(needed.empty());
+  for (const std::string& lib : needed) {
+    for (const char* module_lib : {"libgdal", "libompl", "libfcl", "libccd", "libnats", "libssl", "libprotobuf-c"}) {
+      EXPECT_EQ(lib.rfind(module_lib, 0), std::string::npos) << lib;
+    }
+    if (SKYLANE_STATIC_DEPS_LINKED) {
+      const bool run_time = lib.rfind("libstdc++.so", 0) == 0 || lib.rfind("libm.so", 0) == 0 || lib.rfind("libgcc_s.so", 0) == 0 ||
+                            lib.rfind("libc.so", 0) == 0 || lib.rfind("ld-linux", 0) == 0 ||
+                            lib.rfind("libasan.so", 0) == 0 || lib.rfind("libubsan.so", 0) == 0;  // a sanitizer build
+      EXPECT_TRUE(run_time) << lib << " is loaded at every start";
+    }
+  }
 }
 
 TEST(Cli, SppPrintsOneJsonLinePerEpoch) {
