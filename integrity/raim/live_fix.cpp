@@ -302,32 +302,92 @@ std::optional<double> meanClockResidual_m(const std::vector<RawRange>& ranges, c
   return sum / count;
 }
 
+namespace {
+
+/// The exclusion step on a detection: the method's FDE rows of `lin`; when it names some, the
+/// kept ranges converged from lin.x and checked (`lin`, `check` become theirs, `out` records
+/// the exclusion). False when the reduced geometry is singular (`out` says so).
+bool excludeDetected(const RangesSeenFrom& ranges_from, const std::vector<int>& all, Linearised& lin, GeometryCheck& check,
+                     const LiveFixConfig& cfg, LiveFix& out) {
+  const std::vector<int> rows = excludedRows(lin, cfg);
+  if (rows.empty()) return true;
+  Linearised again = converge(ranges_from, keptRanges(lin, rows, out.excluded), lin.x, cfg);
+  if (!again.ok) {
+    out.note += "the geometry after the exclusion is singular";
+    return false;
+  }
+  lin = std::move(again);
+  check = checkAfterExclusion(ranges_from, all, lin, out.excluded, cfg);
+  out.fault_excluded = true;
+  return true;
+}
+
+/// The indices of every range seen from x0.
+std::vector<int> allRanges(const RangesSeenFrom& ranges_from, const Eigen::Vector3d& x0_ecef) {
+  std::vector<int> all(ranges_from(x0_ecef).size());
+  std::iota(all.begin(), all.end(), 0);
+  return all;
+}
+
+/// The note of a singular all-in-view geometry.
+std::string tooFewForAPosition(std::size_t ranges) {
+  return "too few satellites (" + std::to_string(ranges) + ") or a singular geometry for a position";
+}
+
+}  // namespace
+
+/// A first pass's ranges and its converged all-in-view solution (LiveFix::epoch).
+struct LiveEpoch {
+  std::vector<LocatedRange> located;
+  std::vector<int> all;
+  Linearised lin;
+  GeometryCheck check;
+};
+
 LiveFix solveEpoch(const RangesSeenFrom& ranges_from, const Eigen::Vector3d& x0_ecef, const LiveFixConfig& cfg,
                    bool exclude) {
   LiveFix out;
-  std::vector<int> all(ranges_from(x0_ecef).size());
-  std::iota(all.begin(), all.end(), 0);
+  const std::vector<int> all = allRanges(ranges_from, x0_ecef);
   Linearised lin = converge(ranges_from, all, x0_ecef, cfg);
   if (!lin.ok) {
-    out.note += "too few satellites (" + std::to_string(all.size()) + ") or a singular geometry for a position";
+    out.note += tooFewForAPosition(all.size());
     return out;
   }
   GeometryCheck check = checkGeometry(lin, cfg);
   out.fault_detected = check.fails;
-  const std::vector<int> rows = exclude && check.fails ? excludedRows(lin, cfg) : std::vector<int>{};
-  if (!rows.empty()) {
-    Linearised again = converge(ranges_from, keptRanges(lin, rows, out.excluded), lin.x, cfg);
-    if (!again.ok) {
-      out.note += "the geometry after the exclusion is singular";
-      return out;
-    }
-    lin = std::move(again);
-    check = checkAfterExclusion(ranges_from, all, lin, out.excluded, cfg);
-    out.fault_excluded = true;
-  }
+  if (exclude && check.fails && !excludeDetected(ranges_from, all, lin, check, cfg, out)) return out;
   fillSolution(lin, check, out);
   return out;
 }
+
+namespace {
+
+/// solveEpoch without exclusion over fixed ranges, keeping what excludeFaults() goes on from.
+LiveFix firstPass(std::vector<LocatedRange> located, const Eigen::Vector3d& x0_ecef, const LiveFixConfig& cfg) {
+  auto epoch = std::make_shared<LiveEpoch>();
+  epoch->located = std::move(located);
+  const RangesSeenFrom ranges_from = [&e = *epoch](const Eigen::Vector3d&) -> const std::vector<LocatedRange>& { return e.located; };
+  LiveFix out;
+  epoch->all = allRanges(ranges_from, x0_ecef);
+  epoch->lin = converge(ranges_from, epoch->all, x0_ecef, cfg);
+  if (!epoch->lin.ok) {
+    out.note += tooFewForAPosition(epoch->all.size());
+    return out;
+  }
+  epoch->check = checkGeometry(epoch->lin, cfg);
+  out.fault_detected = epoch->check.fails;
+  fillSolution(epoch->lin, epoch->check, out);
+  out.epoch = std::move(epoch);
+  return out;
+}
+
+/// The note and list of satellites without an orbit, as solveLiveFix reports them.
+void noteMissingOrbits(std::vector<SatId> missing, LiveFix& out) {
+  if (!missing.empty()) out.note = std::to_string(missing.size()) + " satellite(s) without an orbit; " + out.note;
+  out.missing_orbit = std::move(missing);
+}
+
+}  // namespace
 
 LiveFix solveLiveFix(const std::vector<RawRange>& ranges, const maps::Geodetic& initial, const GpsTime& t,
                      const LiveFixConfig& cfg, bool exclude, const OrbitSource* orbits) {
@@ -336,16 +396,30 @@ LiveFix solveLiveFix(const std::vector<RawRange>& ranges, const maps::Geodetic& 
   }
   const Eigen::Vector3d x0 = maps::geodeticToEcef(initial);
   std::vector<SatId> missing;
-  const std::vector<LocatedRange> located = locateRanges(ranges, x0, t, orbits, missing);
+  std::vector<LocatedRange> located = locateRanges(ranges, x0, t, orbits, missing);
   LiveFix out;
   if (x0.norm() < kMinEarthRadius_m) {
     out.note = "the reported position is not near the Earth's surface";
+  } else if (exclude) {
+    out = solveEpoch([&located](const Eigen::Vector3d&) -> const std::vector<LocatedRange>& { return located; }, x0, cfg, true);
   } else {
-    out = solveEpoch([&located](const Eigen::Vector3d&) -> const std::vector<LocatedRange>& { return located; }, x0, cfg,
-                     exclude);
+    out = firstPass(std::move(located), x0, cfg);
   }
-  if (!missing.empty()) out.note = std::to_string(missing.size()) + " satellite(s) without an orbit; " + out.note;
-  out.missing_orbit = std::move(missing);
+  noteMissingOrbits(std::move(missing), out);
+  return out;
+}
+
+LiveFix excludeFaults(const LiveFix& first, const LiveFixConfig& cfg) {
+  if (!first.epoch) throw std::invalid_argument("excludeFaults: the first pass has no all-in-view solution to go on from");
+  const LiveEpoch& e = *first.epoch;
+  if (!e.check.fails) return first;
+  const RangesSeenFrom ranges_from = [&e](const Eigen::Vector3d&) -> const std::vector<LocatedRange>& { return e.located; };
+  LiveFix out;
+  out.fault_detected = true;
+  Linearised lin = e.lin;
+  GeometryCheck check = e.check;
+  if (excludeDetected(ranges_from, e.all, lin, check, cfg, out)) fillSolution(lin, check, out);
+  noteMissingOrbits(first.missing_orbit, out);
   return out;
 }
 

@@ -32,6 +32,7 @@
 #include <Eigen/Core>
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -80,6 +81,8 @@ struct LiveFixConfig {
   double elevation_mask_rad = 5.0 * M_PI / 180.0;
 };
 
+struct LiveEpoch;
+
 /// \brief The outcome of one live epoch.
 struct LiveFix {
   bool solved = false;
@@ -96,6 +99,8 @@ struct LiveFix {
   double test_statistic = 0.0;       ///< of the final geometry: RAIM √WSSE (normalised), ARAIM max |Δx|/T
   double threshold = 0.0;            ///< RAIM T_d (0 without redundancy), ARAIM 1
   double fault_free_hpl_m = 0.0, fault_free_vpl_m = 0.0;  ///< the PL before the detection term
+  /// solveLiveFix without `exclude`: its ranges and all-in-view solution, for excludeFaults().
+  std::shared_ptr<const LiveEpoch> epoch;
 };
 
 /// \brief The epoch's ranges seen from a linearisation point (ECEF [m]): the satellites in the
@@ -108,6 +113,13 @@ using RangesSeenFrom = std::function<const std::vector<LocatedRange>&(const Eige
 /// solution of the remaining geometry (see the file comment for the two passes).
 [[nodiscard]] LiveFix solveEpoch(const RangesSeenFrom& ranges_from, const Eigen::Vector3d& x0_ecef,
                                  const LiveFixConfig& cfg, bool exclude);
+
+/// \brief solveLiveFix's exclusion pass on a first pass made without it: the method's FDE on
+/// the first pass's all-in-view solution, the kept ranges solved and checked (solveEpoch's
+/// second step), without solving the all-in-view geometry again. Without a detection it is the
+/// first pass. \throws std::invalid_argument when `first` has no epoch (it did not solve, or
+/// it was made with `exclude`).
+[[nodiscard]] LiveFix excludeFaults(const LiveFix& first, const LiveFixConfig& cfg);
 
 /// \brief Solves one live epoch with solveEpoch(). `initial` is the reported position (the linearisation point);
 /// `orbits` gives satellite positions a range does not carry (nullptr: every range must).

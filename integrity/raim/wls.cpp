@@ -41,6 +41,8 @@ Geometry buildGeometry(const std::vector<SatLook>& sats, const ErrorModel& model
   }
   std::sort(g.clocks.begin(), g.clocks.end());
   const int n = static_cast<int>(sats.size());
+  g.sats.reserve(sats.size());
+  g.elevation_rad.reserve(sats.size());
   g.G = Eigen::MatrixXd::Zero(n, 3 + static_cast<int>(g.clocks.size()));
   g.sigma_int.resize(n);
   g.sigma_acc.resize(n);
@@ -77,6 +79,8 @@ Geometry Geometry::without(int index) const {
     if (used) g.clocks.push_back(c);
   }
   const int m = static_cast<int>(keep.size());
+  g.sats.reserve(keep.size());
+  g.elevation_rad.reserve(keep.size());
   g.G = Eigen::MatrixXd::Zero(m, 3 + static_cast<int>(g.clocks.size()));
   g.sigma_int.resize(m);
   g.sigma_acc.resize(m);

@@ -263,9 +263,9 @@ RerunSolution rerunSolution(TrackedFlight& f, FixWork& w, bool detected) {
     }
     return again;
   }
-  // Without a detected fault the FDE would give the first pass back (nothing to exclude).
-  const integrity::LiveFix lf =
-      detected ? integrity::solveLiveFix(fix.ranges, w.pos, fix.time, f.live, true, &f.approver->orbits()) : *w.first;
+  // The FDE goes on from the first pass's all-in-view solution; without a detected fault it
+  // would give the first pass back (nothing to exclude).
+  const integrity::LiveFix lf = detected ? integrity::excludeFaults(*w.first, f.live) : *w.first;
   RerunSolution again{lf.solved && lf.pl.pl_computed, lf.position, lf.pl.hpl_m, lf.pl.vpl_m, lf.excluded, lf.note + lf.pl.reason};
   // A filter not yet aligned can start from the solution without the faulty satellite.
   if (fix.imu && !f.nav && again.ok && lf.fault_excluded) f.align(fix, lf, w.note);

@@ -373,6 +373,53 @@ TEST(LiveFix, MonteCarloWithFaultInjection) {
   EXPECT_LE(double(rerun_misleading_v) / kEpochs, bound_all);
 }
 
+TEST(LiveFix, ExcludeFaultsOnTheFirstPassIsTheRerunToTheBit) {
+  // GIVEN RAIM and ARAIM, σ_int noise and a 0–150 m bias on one satellite per epoch
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> fault_size(0.0, 150.0);
+  for (const IntegrityMethod method : {IntegrityMethod::kRaim, IntegrityMethod::kAraim}) {
+    LiveFixConfig cfg;
+    cfg.method = method;
+    int detected = 0, excluded = 0;
+    for (int k = 0; k < 400; ++k) {
+      const std::vector<Sky> all_skies = skies(cfg);
+      const Sky& s = all_skies[static_cast<std::size_t>(k) % all_skies.size()];
+      Eigen::VectorXd e = noise(s, rng);
+      e[std::uniform_int_distribution<int>(0, s.g.numSats() - 1)(rng)] += fault_size(rng);
+      const std::vector<RawRange> ranges = rangesOf(s, e);
+      // WHEN the exclusion goes on from the first pass, and when the epoch is solved with it
+      const LiveFix first = solveLiveFix(ranges, s.truth, s.t, cfg, false, nullptr);
+      ASSERT_TRUE(first.solved && first.epoch);
+      const LiveFix on = excludeFaults(first, cfg);
+      const LiveFix whole = solveLiveFix(ranges, s.truth, s.t, cfg, true, nullptr);
+      // THEN both are the same solution to the bit: position, PLs, test, exclusions, notes
+      ASSERT_EQ(on.solved, whole.solved) << k;
+      EXPECT_EQ(on.p_ecef, whole.p_ecef) << k;
+      EXPECT_EQ(on.pl.hpl_m, whole.pl.hpl_m) << k;
+      EXPECT_EQ(on.pl.vpl_m, whole.pl.vpl_m) << k;
+      EXPECT_EQ(on.pl.available, whole.pl.available) << k;
+      EXPECT_EQ(on.test_statistic, whole.test_statistic) << k;
+      EXPECT_EQ(on.threshold, whole.threshold) << k;
+      EXPECT_EQ(on.fault_detected, whole.fault_detected) << k;
+      EXPECT_EQ(on.fault_excluded, whole.fault_excluded) << k;
+      EXPECT_EQ(on.excluded, whole.excluded) << k;
+      EXPECT_EQ(on.used, whole.used) << k;
+      EXPECT_EQ(on.note, whole.note) << k;
+      detected += whole.fault_detected;
+      excluded += whole.fault_excluded;
+    }
+    // (the sample holds detections and exclusions of both methods)
+    EXPECT_GT(detected, 100) << static_cast<int>(method);
+    EXPECT_GT(excluded, 50) << static_cast<int>(method);
+  }
+  // AND a pass made with the exclusion has nothing to go on from
+  LiveFixConfig cfg;
+  const Sky s = skies(cfg).front();
+  const LiveFix whole = solveLiveFix(rangesOf(s, Eigen::VectorXd::Zero(s.g.numSats())), s.truth, s.t, cfg, true, nullptr);
+  EXPECT_FALSE(whole.epoch);
+  EXPECT_THROW((void)excludeFaults(whole, cfg), std::invalid_argument);
+}
+
 /// An NMEA epoch with a GST error ellipse (semi-major a along orientation_deg from north,
 /// semi-minor b) and altitude σ.
 NmeaFix nmeaFixWithGst(double a_m, double b_m, double orientation_deg, double sigma_alt_m) {
