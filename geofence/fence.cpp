@@ -167,26 +167,34 @@ Obstructions::Obstructions(std::vector<airspace::Zone> zones, std::vector<maps::
   }
 }
 
-std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) const {
+bool Obstructions::takes(PieceOwner owner, std::size_t i, const TimedVolume& v) const {
   // Zones count when the policy says so and they are active in the interval; obstacles always.
-  const auto accept = [&](PieceOwner owner, std::size_t i) {
-    return owner == PieceOwner::kObstacle ||
-           (zone_counts_[i] && (always_active_[i] || airspace::isActiveDuring(zones_[i], v.t0, v.t1)));
-  };
+  return owner == PieceOwner::kObstacle ||
+         (zone_counts_[i] && (always_active_[i] || airspace::isActiveDuring(zones_[i], v.t0, v.t1)));
+}
+
+std::optional<ProtectionVolume> Obstructions::sceneVolume(const ProtectionVolume& given) const {
   // A volume taller than the scene's height band (a VPL of kilometres from a poor geometry) is
   // cut to the band when every piece lies inside it (unlimited limits are cut to the band; a
   // finite one above 20 km is not): the cut volume then meets exactly the pieces the whole one
   // meets, and its vertical margins are those of the cut volume. Otherwise Scene::query refuses it.
-  ProtectionVolume volume = v.volume;
+  ProtectionVolume volume = given;
   requireValid(volume);
   const double lo = std::max(volume.p_map.z() - volume.vpl_m, kSceneFloor_h_ell_m);
   const double hi = std::min(volume.p_map.z() + volume.vpl_m, kSceneCeiling_h_ell_m);
   if (pieces_in_band_ && (lo > volume.p_map.z() - volume.vpl_m || hi < volume.p_map.z() + volume.vpl_m)) {
-    if (!(hi > lo)) return {};  // wholly above or below every zone and obstacle
+    if (!(hi > lo)) return std::nullopt;  // wholly above or below every zone and obstacle
     volume.p_map.z() = 0.5 * (lo + hi);
     volume.vpl_m = 0.5 * (hi - lo);
   }
-  const std::vector<SceneHit> hits = scene_.query(volume, horizon_m, accept);
+  return volume;
+}
+
+std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) const {
+  const std::optional<ProtectionVolume> volume = sceneVolume(v.volume);
+  if (!volume) return {};
+  const std::vector<SceneHit> hits =
+      scene_.query(*volume, horizon_m, [&](PieceOwner owner, std::size_t i) { return takes(owner, i, v); });
 
   // One check per zone or obstacle, from the piece that decides it.
   std::vector<Check> near;
@@ -256,6 +264,16 @@ std::optional<Check> Obstructions::firstConflict(const TimedVolume& v, bool with
     if (c.verdict != Verdict::kInside) return std::move(c);
   }
   return std::nullopt;
+}
+
+bool Obstructions::conflicts(const TimedVolume& v, bool with_keep_in) const {
+  if (with_keep_in) {
+    if (std::optional<Check> k = keepIn(v); k && k->verdict != Verdict::kInside) return true;
+  }
+  // Every zone or obstacle check(v, 0) reports is a conflict: met (outside or indeterminate),
+  // or at clearance 0 with a deciding margin ≤ 0 (indeterminate).
+  const std::optional<ProtectionVolume> volume = sceneVolume(v.volume);
+  return volume && scene_.reachesAny(*volume, [&](PieceOwner owner, std::size_t i) { return takes(owner, i, v); });
 }
 
 Fence::Fence(Corridor level1, Corridor level2, std::vector<airspace::Zone> zones, std::vector<maps::Building> buildings,

@@ -145,6 +145,9 @@ class Obstructions {
   /// false); the worst zone or obstacle the volume meets or may meet (indeterminate). None when
   /// the volume is clear of everything.
   [[nodiscard]] std::optional<Check> firstConflict(const TimedVolume& v, bool with_keep_in = true) const;
+  /// \brief Whether firstConflict() finds one, without building the check: no FCL distance,
+  /// no names (Scene::reachesAny). For a planner's state validity.
+  [[nodiscard]] bool conflicts(const TimedVolume& v, bool with_keep_in = true) const;
 
   [[nodiscard]] const std::vector<airspace::Zone>& zones() const { return zones_; }
   [[nodiscard]] const std::vector<maps::Building>& buildings() const { return buildings_; }
@@ -155,6 +158,12 @@ class Obstructions {
   [[nodiscard]] bool zoneCounts(std::size_t i) const { return zone_counts_.at(i); }
 
  private:
+  /// Whether the zone or obstacle counts for a check over [v.t0, v.t1).
+  [[nodiscard]] bool takes(PieceOwner owner, std::size_t i, const TimedVolume& v) const;
+  /// The volume a scene query takes: cut to the scene's height band when taller (none when
+  /// wholly above or below it).
+  [[nodiscard]] std::optional<ProtectionVolume> sceneVolume(const ProtectionVolume& given) const;
+
   std::vector<airspace::Zone> zones_;
   std::vector<maps::Building> buildings_;
   std::vector<bool> zone_counts_;

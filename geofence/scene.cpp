@@ -429,6 +429,8 @@ struct Scene::Impl {
   /// measure first (the first and the nearest).
   void appendOwnerGroup(const std::vector<std::uint64_t>& candidates, std::size_t begin, std::size_t end,
                         const ProtectionVolume& volume, std::vector<Candidate>& group) const;
+  /// Whether query() at horizon 0 reports piece i (reachesAny).
+  [[nodiscard]] bool reachedAtContact(std::size_t i, const ProtectionVolume& volume) const;
   /// The hit (or the nearest miss) among one owner's sorted candidates.
   [[nodiscard]] std::optional<SceneHit> ownerHit(const OwnerGroup& owner, std::vector<Candidate>& group,
                                                  NarrowQuery& query, double horizon_m) const;
@@ -533,6 +535,13 @@ std::optional<SceneHit> Scene::Impl::ownerHit(const OwnerGroup& owner, std::vect
   return hit;
 }
 
+bool Scene::Impl::reachedAtContact(std::size_t i, const ProtectionVolume& volume) const {
+  const double d = deciding(shapes.margins(volume, i));
+  if (d <= 0.0) return true;  // met, or (the exact predicate disagreeing) clearance 0
+  if (d > kExactBand_m) return false;
+  return airspace::cylinderMeetsPrism(volume.p_map, volume.hpl_m, volume.vpl_m, pieces[i].prism);
+}
+
 Scene::Scene(std::vector<ScenePiece> pieces) : impl_(std::make_unique<Impl>()) {
   impl_->pieces = std::move(pieces);
   impl_->fcl = detail::fclModule().make();
@@ -597,6 +606,22 @@ std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizo
     if (hit && (hit->separation.meets || hit->separation.clearance_m <= horizon_m)) hits.push_back(*hit);
   }
   return hits;
+}
+
+bool Scene::reachesAny(const ProtectionVolume& volume, const std::function<bool(PieceOwner, std::size_t)>& accept) const {
+  checkQuery(volume, 0.0);
+  const detail::FclBox reach = detail::cylinderBox(volume.p_map, volume.hpl_m, volume.vpl_m);
+  thread_local std::vector<std::uint64_t> candidates;
+  impl_->candidates(reach, candidates);
+  for (std::size_t first = 0; first < candidates.size();) {
+    const std::size_t begin = first;
+    first = Impl::ownerEnd(candidates, first);
+    if (!accept(keyOwnerKind(candidates[begin]), keyOwnerIndex(candidates[begin]))) continue;
+    for (std::size_t k = begin; k < first; ++k) {
+      if (impl_->reachedAtContact(keyPiece(candidates[k]), volume)) return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace skylane::geofence

@@ -112,6 +112,15 @@ class Scene {
   [[nodiscard]] std::vector<SceneHit> query(const ProtectionVolume& volume, double horizon_m,
                                             const std::function<bool(PieceOwner, std::size_t)>& accept) const;
 
+  /// \brief Whether query(volume, 0, accept) reports any owner, found without FCL: a piece is
+  /// reported at horizon 0 exactly when its margins put the volume in contact (deciding margin
+  /// ≤ 0, clearance 0) or, within kExactBand_m outside, when the exact predicate has them meet.
+  /// The narrow phase's FCL distances change the separation query() reports, never whether it
+  /// reports a piece at horizon 0 (settle(): FCL decides only where it agrees with the margins).
+  /// For yes/no questions such as a planner's state validity. Thread-safe.
+  /// \throws std::invalid_argument as query() does.
+  [[nodiscard]] bool reachesAny(const ProtectionVolume& volume, const std::function<bool(PieceOwner, std::size_t)>& accept) const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

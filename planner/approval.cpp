@@ -171,7 +171,7 @@ bool Approver::Impl::valid(const Eigen::Vector3d& p, const maps::GpsTime& t0, co
     if ((p - c).norm() < r) return false;
   }
   const geofence::TimedVolume v{t0, t1, planningVolume(p)};
-  return !obstructions->firstConflict(v);
+  return !obstructions->conflicts(v);
 }
 
 maps::SkyMask Approver::Impl::skyMaskAt(const maps::Geodetic& g) const {

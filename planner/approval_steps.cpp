@@ -306,7 +306,7 @@ PathProblem Approver::Impl::legProblem(const ApprovalSetup& setup, const maps::G
     const maps::GpsTime earliest = departure.plus((p.head<2>() - start_xy).norm() / fastest_mps);
     if (exempt_m > 0.0 && (p - vehicle).norm() <= exempt_m) {
       // Round the vehicle only its own point must be clear; outside a keep-in zone it may fly back in.
-      return !obstructions->firstConflict({earliest, latest, {p, 0.0, 0.0}}, /*with_keep_in=*/false);
+      return !obstructions->conflicts({earliest, latest, {p, 0.0, 0.0}}, /*with_keep_in=*/false);
     }
     return valid(p, earliest, latest, penalties);
   };

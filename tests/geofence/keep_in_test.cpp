@@ -217,6 +217,12 @@ TEST(KeepIn, FenceChecksAKeepInZoneAndZoneChecksReadClearOrMet) {
   EXPECT_NEAR(v.checks[*v.deciding].margin_h_m, -(300.0 - west_m) - 3.0, 0.01);
   ASSERT_TRUE(ob.firstConflict({t, t, {{-300, 0, 100}, 3, 3}}));
   EXPECT_FALSE(ob.firstConflict({t, t, {{-300, 0, 100}, 3, 3}}, /*with_keep_in=*/false));
+  // The yes/no form agrees: out of the fence, in the crane's zone, and clear inside.
+  EXPECT_TRUE(ob.conflicts({t, t, {{-300, 0, 100}, 3, 3}}));
+  EXPECT_FALSE(ob.conflicts({t, t, {{-300, 0, 100}, 3, 3}}, /*with_keep_in=*/false));
+  EXPECT_TRUE(ob.conflicts({t, t, {{75, 0, 100}, 3, 3}}));
+  EXPECT_TRUE(ob.conflicts({t, t, {{75, 0, 100}, 3, 3}}, /*with_keep_in=*/false));
+  EXPECT_FALSE(ob.conflicts({t, t, {{-100, 0, 100}, 3, 3}}));
 }
 
 }  // namespace

@@ -944,6 +944,64 @@ TEST(Scene, BroadPhaseOverManyPiecesFindsWhatBruteForceFinds) {
   EXPECT_GT(checked, 1000000);
 }
 
+// reachesAny answers "does query(v, 0) report anything?" without FCL; the answer must be the
+// same for every volume, above all those in contact or within the exact band of it.
+TEST(Scene, ReachesAnyIsWhetherTheQueryAtContactReportsAnything) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  constexpr double kArea_m = 3000.0;
+  // GIVEN 200 owners of one to three pieces (rings and disks, some unlimited in height)
+  std::vector<ScenePiece> pieces;
+  for (std::size_t z = 0; z < 200; ++z) {
+    const Eigen::Vector2d c(kArea_m * u(rng), kArea_m * u(rng));
+    for (int k = 0, parts = 1 + static_cast<int>(rng() % 3); k < parts; ++k) {
+      PlanarPrism q;
+      q.floor_h_ell_m = u(rng) < 0.2 ? -kInf : 400.0 + 100.0 * u(rng);
+      q.ceiling_h_ell_m = u(rng) < 0.2 ? kInf : 600.0 + 300.0 * u(rng);
+      const Eigen::Vector2d ck = c + Eigen::Vector2d(200.0 * (u(rng) - 0.5), 200.0 * (u(rng) - 0.5));
+      if (u(rng) < 0.3) {
+        q.centre = ck;
+        q.radius_m = 10.0 + 90.0 * u(rng);
+      } else {
+        q.ring = regularRing(ck, 10.0 + 90.0 * u(rng), 3 + static_cast<int>(rng() % 8), 2 * kPi * u(rng));
+      }
+      pieces.push_back({q, z % 5 == 0 ? PieceOwner::kObstacle : PieceOwner::kZone, z});
+    }
+  }
+  const Scene scene(pieces);
+  const auto accept_some = [](PieceOwner owner, std::size_t i) { return owner == PieceOwner::kObstacle || i % 3 != 1; };
+  const double offsets_m[] = {0.0, 1e-12, -1e-12, 1e-9, -1e-9, 1e-3, -1e-3, 0.0099, 0.0101, -0.02, 0.5, -0.5};
+  int reached = 0, near_contact = 0;
+  for (int i = 0; i < 20000; ++i) {
+    // WHEN a volume is placed anywhere, or sized to touch a piece to within a small offset
+    Eigen::Vector3d p(kArea_m * u(rng), kArea_m * u(rng), 350.0 + 700.0 * u(rng));
+    ProtectionVolume v{p, 2.0 + 40.0 * u(rng), 2.0 + 40.0 * u(rng)};
+    if (i % 4 != 0) {
+      const PlanarPrism& q = pieces[rng() % pieces.size()].prism;
+      const Eigen::Vector2d at = q.ring.empty() ? q.centre : q.ring[rng() % q.ring.size()];
+      v.p_map.head<2>() = at + Eigen::Vector2d(120.0 * (u(rng) - 0.5), 120.0 * (u(rng) - 0.5));
+      const Separation m = separationMargins(v, q);
+      const double offset = offsets_m[rng() % std::size(offsets_m)];
+      if (m.margin_h_m >= m.margin_v_m) {
+        v.hpl_m = std::max(0.0, v.hpl_m + m.margin_h_m + offset);
+      } else {
+        v.vpl_m = std::max(0.0, v.vpl_m + m.margin_v_m + offset);
+      }
+      ++near_contact;
+    }
+    for (const bool all : {true, false}) {
+      const std::function<bool(PieceOwner, std::size_t)> accept = all ? kAcceptAll : accept_some;
+      const bool expected = !scene.query(v, 0.0, accept).empty();
+      // THEN reachesAny gives the query's answer
+      ASSERT_EQ(scene.reachesAny(v, accept), expected) << "volume " << i << ": " << describe(v);
+      reached += expected;
+    }
+  }
+  EXPECT_GT(reached, 8000);  // both answers are common
+  EXPECT_LT(reached, 32000);
+  EXPECT_GT(near_contact, 10000);
+}
+
 // The broad phase's query box is computed without FCL (detail::cylinderBox); it must be FCL's
 // own AABB of the query cylinder to the bit, or the grid would not find what FCL's broad phase
 // finds at touching boxes.
