@@ -165,11 +165,28 @@ struct BestPiece {
   std::size_t reached = 0;  ///< pieces whose alert limit the volume reaches
 };
 
+/// Far above the rounding of a distance in the map frame (coordinates of up to 10⁷ m: 10⁻⁹ m).
+constexpr double kOutOfPlaySlack_m = 1e-6;
+
+/// Whether piece i can neither beat `floor_m` (its min(h, v) ≤ h = HAL − d − HPL lies below it)
+/// nor be reached by the volume (d > HAL + HPL), by the distance from the centre to the
+/// segment's bounding box: a lower bound on the piece's distance d, found without a square
+/// root or a division. Such a piece would change nothing in bestSinglePiece.
+bool outOfPlay(const MarginField& f, std::size_t i, const Eigen::Vector2d& c2, double hpl, double floor_m) {
+  const Eigen::Vector3d& a = f.path[i];
+  const Eigen::Vector3d& b = f.path[i + 1];
+  const double dx = std::max({0.0, std::min(a.x(), b.x()) - c2.x(), c2.x() - std::max(a.x(), b.x())});
+  const double dy = std::max({0.0, std::min(a.y(), b.y()) - c2.y(), c2.y() - std::max(a.y(), b.y())});
+  const double need_m = std::max(f.hal + hpl, f.hal - hpl - floor_m) + kOutOfPlaySlack_m;
+  return dx * dx + dy * dy > need_m * need_m;
+}
+
 BestPiece bestSinglePiece(const MarginField& f, const Eigen::Vector2d& c2, double hpl, double tolerance_m, Containment& out) {
   BestPiece best;
   std::size_t segment = 0;
   double best_other_m = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < f.segmentCount(); ++i) {
+    if (outOfPlay(f, i, c2, hpl, best.margin_m - tolerance_m)) continue;
     const PieceAt p = f.piece(i, c2, hpl);
     const auto [h, v] = f.marginsOf(p, hpl);
     // Pieces whose min(h, v) agree within the tolerance are tied (often the same quantity by

@@ -14,6 +14,7 @@
 #include <limits>
 #include <random>
 #include <stdexcept>
+#include <vector>
 
 namespace skylane::geofence {
 namespace {
@@ -471,6 +472,49 @@ TEST(Corridor, RandomClimbingEndLegsAgreeWithADenseSamplingOracle) {
   EXPECT_GT(outside, 300);
   EXPECT_GT(compared, 300);
   EXPECT_GT(cap_cases_a_slope_bound_misses, 20);
+}
+
+/// The horizontal distance from x to the segment a–b, by projection (the test's own).
+double segmentDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector2d& x) {
+  const Eigen::Vector2d d = (b - a).head<2>();
+  const double t = std::clamp((x - a.head<2>()).dot(d) / d.squaredNorm(), 0.0, 1.0);
+  return (x - (a.head<2>() + t * d)).norm();
+}
+
+TEST(Corridor, TheNearestLegDecidesALevelCorridorFromAnyDistance) {
+  // GIVEN level zig-zag corridors of 20 legs over up to 300 km (the fence benchmark's kind)
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int far = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const double span_m = trial % 2 == 0 ? 300000.0 : 3000.0;
+    std::vector<Eigen::Vector3d> path;
+    for (int i = 0; i < 21; ++i) path.emplace_back(span_m * i / 20.0, span_m * (0.5 + 0.3 * std::sin(i + trial)), 120.0);
+    const AlertLimits limits{5.0 + 50.0 * u(rng), 5.0 + 20.0 * u(rng)};
+    const Corridor c(path, limits);
+    for (int k = 0; k < 200; ++k) {
+      // WHEN a volume at the corridor's height lies anywhere, near the path or far from it
+      Eigen::Vector2d x(span_m * (1.4 * u(rng) - 0.2), span_m * (1.4 * u(rng) - 0.2));
+      if (k % 2 == 0) {
+        const std::size_t i = rng() % 20;
+        x = (path[i] + u(rng) * (path[i + 1] - path[i])).head<2>() + limits.hal_m * Eigen::Vector2d(u(rng) - 0.5, u(rng) - 0.5);
+      }
+      const ProtectionVolume v{{x.x(), x.y(), 120.0}, 0.5 + 0.4 * limits.hal_m * u(rng), 0.2 * limits.val_m * u(rng)};
+      double nearest_m = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i + 1 < path.size(); ++i) nearest_m = std::min(nearest_m, segmentDistance(path[i], path[i + 1], x));
+      const Containment in = c.contains(v);
+      // THEN the horizontal margin is the nearest leg's, HAL − d − HPL (or more across a joint)
+      const double expected_h = limits.hal_m - nearest_m - v.hpl_m;
+      if (in.across_joint) {
+        EXPECT_GE(in.margin_h_m, expected_h - 1e-6) << trial << "/" << k;
+      } else {
+        EXPECT_NEAR(in.margin_h_m, expected_h, 1e-6 * (1.0 + nearest_m)) << trial << "/" << k;
+        EXPECT_NEAR(segmentDistance(path[in.segment], path[in.segment + 1], x), nearest_m, 1e-6 * (1.0 + nearest_m));
+      }
+      far += nearest_m > 1000.0;
+    }
+  }
+  EXPECT_GT(far, 10000);
 }
 
 TEST(Corridor, SegmentBoxCornersFollowTheClimb) {
