@@ -293,10 +293,12 @@ FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const O
                          const TimedVolume& v, double horizon_m) {
   FenceVerdict out;
   const double tol = obstructions.options().tolerance_m;
+  std::optional<Check> keep_in = obstructions.keepIn(v);
+  std::vector<Check> near = obstructions.check(v, horizon_m);
+  out.checks.reserve(2 + (keep_in ? 1 : 0) + near.size());  // one allocation, no check moved twice
   out.checks.push_back(boxCheck(Level::kCorridor, level1, v.volume, tol));
   out.checks.push_back(boxCheck(Level::kAirspace, level2, v.volume, tol));
-  if (std::optional<Check> k = obstructions.keepIn(v)) out.checks.push_back(std::move(*k));
-  std::vector<Check> near = obstructions.check(v, horizon_m);
+  if (keep_in) out.checks.push_back(std::move(*keep_in));
   out.checks.insert(out.checks.end(), std::make_move_iterator(near.begin()), std::make_move_iterator(near.end()));
 
   for (int wanted : {2, 1}) {
