@@ -343,6 +343,9 @@ std::array<Eigen::Vector3d, 8> Corridor::segmentBoxCorners(std::size_t segment) 
 
 Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_m) const {
   requireValid(volume);
+  if (!(tolerance_m >= 0.0 && std::isfinite(tolerance_m))) {  // the legs' skipping relies on it too
+    throw std::invalid_argument("corridor containment tolerance must be finite and ≥ 0, got " + std::to_string(tolerance_m));
+  }
   const Eigen::Vector3d& c = volume.p_map;
   const double hpl = volume.hpl_m, vpl = volume.vpl_m, hal = limits_.hal_m, val = limits_.val_m;
   // The operating limits bound every piece.

@@ -143,7 +143,8 @@ class Corridor {
   /// \brief Whether the protection volume lies inside one piece or inside the union of the
   /// pieces it touches (across a joint), and within the operating limits. `tolerance_m`: a
   /// deciding margin with |margin| ≤ tolerance is indeterminate.
-  /// \throws std::invalid_argument for a non-finite position or a negative/non-finite PL.
+  /// \throws std::invalid_argument for a non-finite position, a negative/non-finite PL or a
+  /// negative/non-finite tolerance.
   [[nodiscard]] Containment contains(const ProtectionVolume& volume, double tolerance_m = 1e-6) const;
 
  private:

@@ -408,6 +408,20 @@ struct Scene::Impl {
   void candidates(const detail::FclBox& reach, std::vector<std::uint64_t>& found) const;
   /// End of the run of candidates from `first` on that share its owner.
   [[nodiscard]] static std::size_t ownerEnd(const std::vector<std::uint64_t>& candidates, std::size_t first);
+  /// Calls visit(kind, index, begin, end) for the run [begin, end) of each owner `accept`
+  /// takes, in order, until visit returns true; whether one did.
+  template <class Visit>
+  static bool forAcceptedOwners(const std::vector<std::uint64_t>& candidates,
+                                const std::function<bool(PieceOwner, std::size_t)>& accept, Visit&& visit) {
+    for (std::size_t first = 0; first < candidates.size();) {
+      const std::size_t begin = first;
+      first = ownerEnd(candidates, first);
+      const PieceOwner kind = keyOwnerKind(candidates[begin]);
+      const std::size_t index = keyOwnerIndex(candidates[begin]);
+      if (accept(kind, index) && visit(kind, index, begin, first)) return true;
+    }
+    return false;
+  }
   /// The query volume and whether this thread's FCL query cylinder is it yet: it is placed on
   /// the first narrow-phase distance of a query (most queries need none).
   struct NarrowQuery {
@@ -590,16 +604,12 @@ std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizo
   // the narrow phase owner by owner.
   group.clear();
   owners.clear();
-  for (std::size_t first = 0; first < candidates.size();) {
-    const std::size_t begin = first;
-    first = Impl::ownerEnd(candidates, first);
-    const PieceOwner kind = keyOwnerKind(candidates[begin]);
-    const std::size_t index = keyOwnerIndex(candidates[begin]);
-    if (!accept(kind, index)) continue;
+  Impl::forAcceptedOwners(candidates, accept, [&](PieceOwner kind, std::size_t index, std::size_t begin, std::size_t end) {
     const std::size_t from = group.size();
-    impl_->appendOwnerGroup(candidates, begin, first, volume, group);
+    impl_->appendOwnerGroup(candidates, begin, end, volume, group);
     owners.push_back({kind, index, from, group.size()});
-  }
+    return false;
+  });
   std::vector<SceneHit> hits;
   for (const Impl::OwnerGroup& owner : owners) {
     const std::optional<SceneHit> hit = impl_->ownerHit(owner, group, narrow, horizon_m);
@@ -613,15 +623,12 @@ bool Scene::reachesAny(const ProtectionVolume& volume, const std::function<bool(
   const detail::FclBox reach = detail::cylinderBox(volume.p_map, volume.hpl_m, volume.vpl_m);
   thread_local std::vector<std::uint64_t> candidates;
   impl_->candidates(reach, candidates);
-  for (std::size_t first = 0; first < candidates.size();) {
-    const std::size_t begin = first;
-    first = Impl::ownerEnd(candidates, first);
-    if (!accept(keyOwnerKind(candidates[begin]), keyOwnerIndex(candidates[begin]))) continue;
-    for (std::size_t k = begin; k < first; ++k) {
+  return Impl::forAcceptedOwners(candidates, accept, [&](PieceOwner, std::size_t, std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
       if (impl_->reachedAtContact(keyPiece(candidates[k]), volume)) return true;
     }
-  }
-  return false;
+    return false;
+  });
 }
 
 }  // namespace skylane::geofence

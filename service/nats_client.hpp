@@ -9,7 +9,10 @@
 ///
 /// Every call that talks to the server throws NatsError when it fails (server gone, timeout,
 /// refused); a worker's loop catches it, waits, and starts its partition again from the last
-/// checkpoint (track_worker.hpp).
+/// checkpoint (track_worker.hpp). The first connection loads the module; when it is missing
+/// that throws std::runtime_error naming the places looked at. NatsError is thrown inside the
+/// module and caught here by type: libstdc++ matches exception types by name across shared
+/// objects (a test connects to a refused port to keep that true).
 
 #include <chrono>
 #include <cstdint>

@@ -143,7 +143,12 @@ Connection::Connection(const std::string& url, const std::string& name, std::chr
   jo.PublishAsync.StallWait = 10000;  // a busy server slows a publisher down rather than failing it
   jo.PublishAsync.ErrHandler = &Connection::onPublishError;
   jo.PublishAsync.ErrHandlerClosure = this;
-  check("JetStream context", natsConnection_JetStream(&js_, nc_, &jo));
+  try {
+    check("JetStream context", natsConnection_JetStream(&js_, nc_, &jo));
+  } catch (const NatsError&) {
+    natsConnection_Destroy(nc_);  // the destructor does not run for a constructor that throws
+    throw;
+  }
 }
 
 void Connection::ensureStream(const NatsStreamSpec& spec) {

@@ -334,6 +334,21 @@ std::string tooFewForAPosition(std::size_t ranges) {
   return "too few satellites (" + std::to_string(ranges) + ") or a singular geometry for a position";
 }
 
+/// The all-in-view step: every range converged from x0 and checked (`out` gets the detection);
+/// false when the geometry is singular (`out` says so).
+bool solveAllInView(const RangesSeenFrom& ranges_from, const Eigen::Vector3d& x0_ecef, const LiveFixConfig& cfg,
+                    std::vector<int>& all, Linearised& lin, GeometryCheck& check, LiveFix& out) {
+  all = allRanges(ranges_from, x0_ecef);
+  lin = converge(ranges_from, all, x0_ecef, cfg);
+  if (!lin.ok) {
+    out.note += tooFewForAPosition(all.size());
+    return false;
+  }
+  check = checkGeometry(lin, cfg);
+  out.fault_detected = check.fails;
+  return true;
+}
+
 }  // namespace
 
 /// A first pass's ranges and its converged all-in-view solution (LiveFix::epoch).
@@ -347,14 +362,10 @@ struct LiveEpoch {
 LiveFix solveEpoch(const RangesSeenFrom& ranges_from, const Eigen::Vector3d& x0_ecef, const LiveFixConfig& cfg,
                    bool exclude) {
   LiveFix out;
-  const std::vector<int> all = allRanges(ranges_from, x0_ecef);
-  Linearised lin = converge(ranges_from, all, x0_ecef, cfg);
-  if (!lin.ok) {
-    out.note += tooFewForAPosition(all.size());
-    return out;
-  }
-  GeometryCheck check = checkGeometry(lin, cfg);
-  out.fault_detected = check.fails;
+  std::vector<int> all;
+  Linearised lin;
+  GeometryCheck check;
+  if (!solveAllInView(ranges_from, x0_ecef, cfg, all, lin, check, out)) return out;
   if (exclude && check.fails && !excludeDetected(ranges_from, all, lin, check, cfg, out)) return out;
   fillSolution(lin, check, out);
   return out;
@@ -368,14 +379,7 @@ LiveFix firstPass(std::vector<LocatedRange> located, const Eigen::Vector3d& x0_e
   epoch->located = std::move(located);
   const RangesSeenFrom ranges_from = [&e = *epoch](const Eigen::Vector3d&) -> const std::vector<LocatedRange>& { return e.located; };
   LiveFix out;
-  epoch->all = allRanges(ranges_from, x0_ecef);
-  epoch->lin = converge(ranges_from, epoch->all, x0_ecef, cfg);
-  if (!epoch->lin.ok) {
-    out.note += tooFewForAPosition(epoch->all.size());
-    return out;
-  }
-  epoch->check = checkGeometry(epoch->lin, cfg);
-  out.fault_detected = epoch->check.fails;
+  if (!solveAllInView(ranges_from, x0_ecef, cfg, epoch->all, epoch->lin, epoch->check, out)) return out;
   fillSolution(epoch->lin, epoch->check, out);
   out.epoch = std::move(epoch);
   return out;

@@ -117,8 +117,10 @@ using RangesSeenFrom = std::function<const std::vector<LocatedRange>&(const Eige
 /// \brief solveLiveFix's exclusion pass on a first pass made without it: the method's FDE on
 /// the first pass's all-in-view solution, the kept ranges solved and checked (solveEpoch's
 /// second step), without solving the all-in-view geometry again. Without a detection it is the
-/// first pass. \throws std::invalid_argument when `first` has no epoch (it did not solve, or
-/// it was made with `exclude`).
+/// first pass. `cfg` is the first pass's. The tracker's monitoring rerun: the FDE on the very
+/// solution whose test fired (before, it solved the epoch again from that solution's position).
+/// \throws std::invalid_argument when `first` has no epoch (it did not solve, or it was made
+/// with `exclude`).
 [[nodiscard]] LiveFix excludeFaults(const LiveFix& first, const LiveFixConfig& cfg);
 
 /// \brief Solves one live epoch with solveEpoch(). `initial` is the reported position (the linearisation point);

@@ -78,6 +78,8 @@ TEST(Corridor, StraightLevelSegmentMarginsAreTheOffsetsFromTheWalls) {
   EXPECT_EQ(c.contains({{103, 0, 100}, 2.0, 1.0}).verdict, Verdict::kInside);
   EXPECT_THROW((void)c.contains({{NAN, 0, 100}, 1.0, 1.0}), std::invalid_argument);
   EXPECT_THROW((void)c.contains({{0, 0, 100}, -1.0, 1.0}), std::invalid_argument);
+  EXPECT_THROW((void)c.contains({{50, 2, 101}, 3.0, 2.0}, -1e-6), std::invalid_argument);
+  EXPECT_THROW((void)c.contains({{50, 2, 101}, 3.0, 2.0}, NAN), std::invalid_argument);
 }
 
 TEST(Corridor, ClimbingSegmentTakesTheSlopeAcrossTheDisk) {

@@ -386,18 +386,29 @@ TEST(LiveFix, ExcludeFaultsOnTheFirstPassIsTheRerunToTheBit) {
       const Sky& s = all_skies[static_cast<std::size_t>(k) % all_skies.size()];
       Eigen::VectorXd e = noise(s, rng);
       e[std::uniform_int_distribution<int>(0, s.g.numSats() - 1)(rng)] += fault_size(rng);
-      const std::vector<RawRange> ranges = rangesOf(s, e);
+      std::vector<RawRange> ranges = rangesOf(s, e);
+      if (k % 3 == 0) ranges.push_back({SatId{Constellation::kGps, 99}, 2.2e7, std::nullopt});  // no orbit for it
       // WHEN the exclusion goes on from the first pass, and when the epoch is solved with it
       const LiveFix first = solveLiveFix(ranges, s.truth, s.t, cfg, false, nullptr);
       ASSERT_TRUE(first.solved && first.epoch);
       const LiveFix on = excludeFaults(first, cfg);
       const LiveFix whole = solveLiveFix(ranges, s.truth, s.t, cfg, true, nullptr);
-      // THEN both are the same solution to the bit: position, PLs, test, exclusions, notes
+      // THEN both are the same solution to the bit: position, clock, PLs, test, exclusions, notes
       ASSERT_EQ(on.solved, whole.solved) << k;
       EXPECT_EQ(on.p_ecef, whole.p_ecef) << k;
+      EXPECT_EQ(on.position.lat_rad, whole.position.lat_rad) << k;
+      EXPECT_EQ(on.position.lon_rad, whole.position.lon_rad) << k;
+      EXPECT_EQ(on.position.h_ell_m, whole.position.h_ell_m) << k;
+      EXPECT_EQ(on.clock_m, whole.clock_m) << k;
       EXPECT_EQ(on.pl.hpl_m, whole.pl.hpl_m) << k;
       EXPECT_EQ(on.pl.vpl_m, whole.pl.vpl_m) << k;
       EXPECT_EQ(on.pl.available, whole.pl.available) << k;
+      EXPECT_EQ(on.pl.pl_computed, whole.pl.pl_computed) << k;
+      EXPECT_EQ(on.pl.reason, whole.pl.reason) << k;
+      EXPECT_EQ(on.fault_free_hpl_m, whole.fault_free_hpl_m) << k;
+      EXPECT_EQ(on.fault_free_vpl_m, whole.fault_free_vpl_m) << k;
+      EXPECT_EQ(on.missing_orbit, whole.missing_orbit) << k;
+      EXPECT_EQ(whole.missing_orbit.size(), k % 3 == 0 ? 1u : 0u) << k;
       EXPECT_EQ(on.test_statistic, whole.test_statistic) << k;
       EXPECT_EQ(on.threshold, whole.threshold) << k;
       EXPECT_EQ(on.fault_detected, whole.fault_detected) << k;
@@ -408,7 +419,7 @@ TEST(LiveFix, ExcludeFaultsOnTheFirstPassIsTheRerunToTheBit) {
       detected += whole.fault_detected;
       excluded += whole.fault_excluded;
     }
-    // (the sample holds detections and exclusions of both methods)
+    // (the sample holds detections and exclusions of both methods, and satellites without an orbit)
     EXPECT_GT(detected, 100) << static_cast<int>(method);
     EXPECT_GT(excluded, 50) << static_cast<int>(method);
   }

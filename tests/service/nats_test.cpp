@@ -43,6 +43,19 @@ struct ZurichFlights {
   std::vector<std::string> flights = {"f1", "f2", "f3", "f4"};
 };
 
+// NatsError is thrown inside libskylane_nats.so and caught by type outside it; no server needed.
+TEST(NatsClient, ARefusedConnectionIsANatsErrorNamingTheUrl) {
+  // GIVEN a loopback port nothing listens on
+  const std::string url = "nats://127.0.0.1:" + std::to_string(test::freeTcpPort());
+  // WHEN a client connects THEN the module's NatsError reaches the caller as that type
+  try {
+    NatsClient client(url, "test", std::chrono::milliseconds(500));
+    FAIL() << "connected to " << url;
+  } catch (const service::NatsError& e) {
+    EXPECT_NE(std::string(e.what()).find("connecting to " + url), std::string::npos) << e.what();
+  }
+}
+
 class NatsWorkers : public ::testing::Test {
  protected:
   void SetUp() override {
