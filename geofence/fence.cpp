@@ -232,27 +232,38 @@ std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) c
 
 std::vector<Check> Obstructions::check(const TimedVolume& v) const { return check(v, options_.horizon_m); }
 
-std::optional<Check> Obstructions::keepIn(const TimedVolume& v) const {
-  std::vector<const KeepInVolume*> active;
+std::optional<KeepInMargins> Obstructions::keepInMarginsAt(const TimedVolume& v,
+                                                           std::vector<const KeepInVolume*>& active) const {
+  active.clear();
   for (const KeepInVolume& k : keep_in_) {
     if (airspace::isActiveDuring(zones_[k.zone], v.t0, v.t1)) active.push_back(&k);
   }
   if (active.empty()) return std::nullopt;
   requireValid(v.volume);
-  const KeepInMargins m = keepInMargins(v.volume, active);
-  const airspace::Zone& z = zones_[active[m.nearest]->zone];
+  return keepInMargins(v.volume, active);
+}
+
+Verdict Obstructions::keepInVerdict(const KeepInMargins& m) const {
+  const double deciding_m = std::min(m.margin_h_m, m.margin_v_m);
+  return deciding_m > options_.tolerance_m    ? Verdict::kInside
+         : deciding_m < -options_.tolerance_m ? Verdict::kOutside
+                                              : Verdict::kIndeterminate;
+}
+
+std::optional<Check> Obstructions::keepIn(const TimedVolume& v) const {
+  std::vector<const KeepInVolume*> active;
+  const std::optional<KeepInMargins> m = keepInMarginsAt(v, active);
+  if (!m) return std::nullopt;
+  const airspace::Zone& z = zones_[active[m->nearest]->zone];
   Check c;
   c.level = Level::kKeepIn;
-  c.index = active[m.nearest]->zone;
+  c.index = active[m->nearest]->zone;
   c.subject = z.identifier;
   c.name = z.name;
   c.restriction = std::string(airspace::restrictionLabel(z));
-  c.margin_h_m = m.margin_h_m;
-  c.margin_v_m = m.margin_v_m;
-  const double deciding_m = std::min(m.margin_h_m, m.margin_v_m);
-  c.verdict = deciding_m > options_.tolerance_m    ? Verdict::kInside
-              : deciding_m < -options_.tolerance_m ? Verdict::kOutside
-                                                   : Verdict::kIndeterminate;
+  c.margin_h_m = m->margin_h_m;
+  c.margin_v_m = m->margin_v_m;
+  c.verdict = keepInVerdict(*m);
   return c;
 }
 
@@ -267,8 +278,10 @@ std::optional<Check> Obstructions::firstConflict(const TimedVolume& v, bool with
 }
 
 bool Obstructions::conflicts(const TimedVolume& v, bool with_keep_in) const {
-  if (with_keep_in) {
-    if (std::optional<Check> k = keepIn(v); k && k->verdict != Verdict::kInside) return true;
+  if (with_keep_in) {  // keepIn()'s verdict, without the check's names
+    thread_local std::vector<const KeepInVolume*> active;
+    const std::optional<KeepInMargins> m = keepInMarginsAt(v, active);
+    if (m && keepInVerdict(*m) != Verdict::kInside) return true;
   }
   // Every zone or obstacle check(v, 0) reports is a conflict: met (outside or indeterminate),
   // or at clearance 0 with a deciding margin ≤ 0 (indeterminate).

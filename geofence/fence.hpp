@@ -160,6 +160,11 @@ class Obstructions {
  private:
   /// Whether the zone or obstacle counts for a check over [v.t0, v.t1).
   [[nodiscard]] bool takes(PieceOwner owner, std::size_t i, const TimedVolume& v) const;
+  /// The keep-in zones active in [v.t0, v.t1) (into `active`) and the volume's margins in their
+  /// union; none when no keep-in zone is active.
+  [[nodiscard]] std::optional<KeepInMargins> keepInMarginsAt(const TimedVolume& v, std::vector<const KeepInVolume*>& active) const;
+  /// The keep-in verdict of those margins (the options' tolerance).
+  [[nodiscard]] Verdict keepInVerdict(const KeepInMargins& m) const;
   /// The volume a scene query takes: cut to the scene's height band when taller (none when
   /// wholly above or below it).
   [[nodiscard]] std::optional<ProtectionVolume> sceneVolume(const ProtectionVolume& given) const;

@@ -296,8 +296,7 @@ const FclModule& fclModule() {
                                         SKYLANE_FCL_MODULE_BUILD_PATH, SKYLANE_FCL_MODULE_INSTALL_PATH,
                                         "checking protection volumes against zones and obstacles"};
     static_assert(kFclModuleAbi == 2, "rename the entry point with the ABI version");
-    using Entry = const FclModule* (*)();
-    return *reinterpret_cast<Entry>(maps::detail::loadModuleEntry(spec))();
+    return maps::detail::moduleTable<FclModule>(spec);
   }();
   return module;
 }

@@ -23,4 +23,12 @@ struct ModuleSpec {
 /// \throws std::runtime_error naming every place looked at, and why each failed.
 [[nodiscard]] void* loadModuleEntry(const ModuleSpec& spec);
 
+/// \brief The table of functions the module's entry point returns (`const Module* entry()`),
+/// loaded as loadModuleEntry() says; it lives as long as the process.
+template <class Module>
+[[nodiscard]] const Module& moduleTable(const ModuleSpec& spec) {
+  using Entry = const Module* (*)();
+  return *reinterpret_cast<Entry>(loadModuleEntry(spec))();
+}
+
 }  // namespace skylane::maps::detail

@@ -26,8 +26,7 @@ static_assert(kRasterModuleAbi == 1, "rename kEntryPoint with the ABI version");
 const RasterModule& loadModule() {
   const ModuleSpec spec{kRasterModuleFile, "SKYLANE_GDAL_MODULE", kEntryPoint, SKYLANE_GDAL_MODULE_BUILD_PATH,
                         SKYLANE_GDAL_MODULE_INSTALL_PATH, "reading rasters (terrain DEMs, geoid grids)"};
-  using Entry = const RasterModule* (*)();
-  return *reinterpret_cast<Entry>(loadModuleEntry(spec))();
+  return moduleTable<RasterModule>(spec);
 }
 
 }  // namespace

@@ -84,8 +84,7 @@ const detail::OmplModule& omplModule() {
                                         SKYLANE_OMPL_MODULE_BUILD_PATH, SKYLANE_OMPL_MODULE_INSTALL_PATH,
                                         "planning a route around obstacles"};
     static_assert(detail::kOmplModuleAbi == 3, "rename the entry point with the ABI version");
-    using Entry = const detail::OmplModule* (*)();
-    return *reinterpret_cast<Entry>(maps::detail::loadModuleEntry(spec))();
+    return maps::detail::moduleTable<detail::OmplModule>(spec);
   }();
   return module;
 }

@@ -16,8 +16,7 @@ const NatsModule& natsModule() {
                                         SKYLANE_NATS_MODULE_BUILD_PATH, SKYLANE_NATS_MODULE_INSTALL_PATH,
                                         "talking to a NATS server"};
     static_assert(kNatsModuleAbi == 1, "rename the entry point with the ABI version");
-    using Entry = const NatsModule* (*)();
-    return *reinterpret_cast<Entry>(maps::detail::loadModuleEntry(spec))();
+    return maps::detail::moduleTable<NatsModule>(spec);
   }();
   return module;
 }

@@ -322,6 +322,11 @@ bool excludeDetected(const RangesSeenFrom& ranges_from, const std::vector<int>& 
   return true;
 }
 
+/// Ranges seen alike from every point (a live epoch's: located once at the reported position).
+RangesSeenFrom fixedRanges(const std::vector<LocatedRange>& located) {
+  return [&located](const Eigen::Vector3d&) -> const std::vector<LocatedRange>& { return located; };
+}
+
 /// The indices of every range seen from x0.
 std::vector<int> allRanges(const RangesSeenFrom& ranges_from, const Eigen::Vector3d& x0_ecef) {
   std::vector<int> all(ranges_from(x0_ecef).size());
@@ -377,7 +382,7 @@ namespace {
 LiveFix firstPass(std::vector<LocatedRange> located, const Eigen::Vector3d& x0_ecef, const LiveFixConfig& cfg) {
   auto epoch = std::make_shared<LiveEpoch>();
   epoch->located = std::move(located);
-  const RangesSeenFrom ranges_from = [&e = *epoch](const Eigen::Vector3d&) -> const std::vector<LocatedRange>& { return e.located; };
+  const RangesSeenFrom ranges_from = fixedRanges(epoch->located);
   LiveFix out;
   if (!solveAllInView(ranges_from, x0_ecef, cfg, epoch->all, epoch->lin, epoch->check, out)) return out;
   fillSolution(epoch->lin, epoch->check, out);
@@ -405,7 +410,7 @@ LiveFix solveLiveFix(const std::vector<RawRange>& ranges, const maps::Geodetic& 
   if (x0.norm() < kMinEarthRadius_m) {
     out.note = "the reported position is not near the Earth's surface";
   } else if (exclude) {
-    out = solveEpoch([&located](const Eigen::Vector3d&) -> const std::vector<LocatedRange>& { return located; }, x0, cfg, true);
+    out = solveEpoch(fixedRanges(located), x0, cfg, true);
   } else {
     out = firstPass(std::move(located), x0, cfg);
   }
@@ -417,7 +422,7 @@ LiveFix excludeFaults(const LiveFix& first, const LiveFixConfig& cfg) {
   if (!first.epoch) throw std::invalid_argument("excludeFaults: the first pass has no all-in-view solution to go on from");
   const LiveEpoch& e = *first.epoch;
   if (!e.check.fails) return first;
-  const RangesSeenFrom ranges_from = [&e](const Eigen::Vector3d&) -> const std::vector<LocatedRange>& { return e.located; };
+  const RangesSeenFrom ranges_from = fixedRanges(e.located);
   LiveFix out;
   out.fault_detected = true;
   Linearised lin = e.lin;
