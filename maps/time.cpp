@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -126,7 +127,9 @@ CalendarTime utcFromGps(const GpsTime& t) {
   return calendarFromSeconds(t.totalSeconds() - leapSecondsAtGps(t));
 }
 
-std::optional<GpsTime> parseRfc3339(std::string_view text) {
+namespace {
+
+std::optional<GpsTime> parseRfc3339Text(std::string_view text) {
   // YYYY-MM-DDTHH:MM:SS[.frac](Z|±HH:MM), every digit where RFC 3339 §5.6 puts it.
   const auto digits = [&](std::size_t pos, std::size_t n, int& out) {
     if (pos + n > text.size()) return false;
@@ -179,6 +182,39 @@ std::optional<GpsTime> parseRfc3339(std::string_view text) {
   return GpsTime::fromTotalSeconds(utc_s + leapSecondsAtUtc(utc_s));
 }
 
+/// The last text read and written on this thread: a stream's fixes come in runs of the same
+/// time (every flight's fix of one second), so the last answer is given again, unchanged.
+struct LastRfc3339 {
+  std::string parsed_text;
+  std::optional<GpsTime> parsed;
+  GpsTime formatted_time{-1, -1.0};
+  int formatted_digits = -1;
+  char formatted[kRfc3339MaxChars] = {};
+  std::size_t formatted_size = 0;
+};
+
+/// formatRfc3339To without the memo.
+char* formatRfc3339Text(char* out, const GpsTime& t, int fraction_digits);
+
+LastRfc3339& lastRfc3339() {
+  thread_local LastRfc3339 last;
+  return last;
+}
+
+}  // namespace
+
+std::optional<GpsTime> parseRfc3339(std::string_view text) {
+  static constexpr std::size_t kLongestKept = 64;
+  LastRfc3339& last = lastRfc3339();
+  if (text == last.parsed_text && !text.empty()) return last.parsed;
+  const std::optional<GpsTime> t = parseRfc3339Text(text);
+  if (text.size() <= kLongestKept) {
+    last.parsed_text.assign(text);
+    last.parsed = t;
+  }
+  return t;
+}
+
 namespace {
 
 /// The general form (any year, any number of digits), with snprintf.
@@ -206,6 +242,24 @@ std::string formatRfc3339(const GpsTime& t, int fraction_digits) {
 }
 
 char* formatRfc3339To(char* out, const GpsTime& t, int fraction_digits) {
+  LastRfc3339& last = lastRfc3339();
+  if (t.week == last.formatted_time.week && t.sow == last.formatted_time.sow && fraction_digits == last.formatted_digits) {
+    std::memcpy(out, last.formatted, last.formatted_size);
+    return out + last.formatted_size;
+  }
+  char* end = formatRfc3339Text(out, t, fraction_digits);
+  if (end != nullptr) {
+    last.formatted_time = t;
+    last.formatted_digits = fraction_digits;
+    last.formatted_size = static_cast<std::size_t>(end - out);
+    std::memcpy(last.formatted, out, last.formatted_size);
+  }
+  return end;
+}
+
+namespace {
+
+char* formatRfc3339Text(char* out, const GpsTime& t, int fraction_digits) {
   // 0–6 digits for years 1–9998 by hand (the common case: snprintf's "%0*.*f" was a third of a
   // tracker fix event's time); anything else in the general form.
   if (fraction_digits < 0 || fraction_digits > 6) return nullptr;
@@ -243,6 +297,8 @@ char* formatRfc3339To(char* out, const GpsTime& t, int fraction_digits) {
   *p++ = 'Z';
   return p;
 }
+
+}  // namespace
 
 std::optional<double> parseDuration(const std::string& text) {
   if (text.empty()) return std::nullopt;

@@ -1,6 +1,7 @@
 #include "planner/tracking/track_event.hpp"
 
 #include "geofence/verdict_json.hpp"
+#include "maps/decimal_text.hpp"
 #include "maps/json_node.hpp"
 #include "maps/json_numbers.hpp"
 
@@ -197,12 +198,13 @@ void from_json(const json& j, TrackEvent& e) {
 
 namespace {
 
-/// A JSON writer for the fix event: members in nlohmann's (sorted) order, numbers shortest
-/// round-trip (std::to_chars), ±∞ and NaN as null, strings escaped per RFC 8259 §7.
+/// A JSON writer for the fix event: members in nlohmann's (sorted) order, numbers rounded
+/// (maps/json_numbers.hpp) and written shortest round-trip (std::to_chars' text,
+/// maps/decimal_text.hpp), ±∞ and NaN as null, strings escaped per RFC 8259 §7.
 class LineWriter {
  public:
   explicit LineWriter(std::string& out) : s_(out) {}
-  void key(const char* k) {
+  void key(std::string_view k) {
     if (need_comma_) s_ += ',';
     s_ += '"';
     s_ += k;
@@ -220,16 +222,6 @@ class LineWriter {
   void item() {
     if (need_comma_) s_ += ',';
     need_comma_ = false;
-  }
-  void number(double v) {
-    if (!std::isfinite(v)) {
-      s_ += "null";
-    } else {
-      char buf[32];
-      const auto r = std::to_chars(buf, buf + sizeof buf, v);
-      s_.append(buf, r.ptr);
-    }
-    need_comma_ = true;
   }
   void integer(long long v) {
     char buf[24];
@@ -263,7 +255,20 @@ class LineWriter {
     s_ += '"';
     need_comma_ = true;
   }
-  void metres(double v) { number(std::isfinite(v) ? roundToMm(v) : v); }
+  /// A value rounded to `decimals` places (roundToMm, roundToDeg8), as std::to_chars writes it.
+  void rounded(double v, int decimals) {
+    char buf[maps::kRoundedMaxChars];
+    s_.append(buf, maps::toCharsRounded(buf, v, decimals));
+    need_comma_ = true;
+  }
+  void metres(double v) {
+    if (std::isfinite(v)) {
+      rounded(roundToMm(v), 3);
+    } else {
+      null();
+    }
+  }
+  void degrees(double rad) { rounded(roundToDeg8(rad), 8); }
 
  private:
   std::string& s_;
@@ -402,7 +407,7 @@ void writeFixHead(LineWriter& w, const TrackEvent& e, const FixRecord& f) {
     w.string(e.flight);
   }
   w.key("h_ell_m");
-  w.number(roundToMm(f.h_ell_m));
+  w.metres(f.h_ell_m);
   w.key("hpl_m");
   w.metres(f.hpl_m);
   if (f.ins_degraded) {
@@ -410,7 +415,7 @@ void writeFixHead(LineWriter& w, const TrackEvent& e, const FixRecord& f) {
     w.boolean(*f.ins_degraded);
   }
   w.key("lat");
-  w.number(roundToDeg8(f.lat_rad));
+  w.degrees(f.lat_rad);
 }
 
 /// The members from "line" to "vpl_m".
@@ -418,7 +423,7 @@ void writeFixTail(LineWriter& w, const TrackEvent& e, const FixRecord& f) {
   w.key("line");
   w.integer(static_cast<long long>(f.line));
   w.key("lon");
-  w.number(roundToDeg8(f.lon_rad));
+  w.degrees(f.lon_rad);
   writeNear(w, f);
   if (!f.note.empty()) {
     w.key("note");
