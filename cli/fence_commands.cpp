@@ -15,6 +15,7 @@
 #include "maps/geoid.hpp"
 #include "maps/json_node.hpp"
 #include "maps/parse_error.hpp"
+#include "maps/plane_grid.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -42,8 +43,8 @@ struct FenceCheckOptions {
   std::string fixes;
 };
 
-json checkFix(const geofence::Fix& f, const geofence::Fence& fence, const maps::PlaneFrame& frame) {
-  const Eigen::Vector2d p = frame.toPlane(f.lat_rad, f.lon_rad);
+json checkFix(const geofence::Fix& f, const geofence::Fence& fence, const maps::PlaneGrid& projection) {
+  const Eigen::Vector2d p = projection.toPlane(f.lat_rad, f.lon_rad);
   const geofence::TimedVolume v{f.t0, f.t1, {Eigen::Vector3d(p.x(), p.y(), f.h_ell_m), f.hpl_m, f.vpl_m}};
   json out;
   if (!f.id.is_null()) out["id"] = f.id;
@@ -82,7 +83,7 @@ void runFenceCheck(const FenceCheckOptions& o) {
 
   if (!o.fix.empty()) {
     const json doc = maps::parseJsonLine(o.fix, "--fix");
-    json out = checkFix(geofence::parseFix(doc, "--fix"), fence, boxes.frame);
+    json out = checkFix(geofence::parseFix(doc, "--fix"), fence, maps::PlaneGrid(boxes.frame));
     if (!boxes.limits.warnings.empty()) out["warnings"] = boxes.limits.warnings;
     std::cout << out.dump(2) << "\n";
     return;
@@ -105,15 +106,15 @@ struct VerdictOut {
 /// per fix, geofence/fix_line.hpp), anything else through parseFix and nlohmann, which word the
 /// errors. Throws what parseFix or the fence throws.
 void checkLine(const std::string& text, std::size_t line, const std::string& fixes, const geofence::Fence& fence,
-               const maps::PlaneFrame& frame, const geofence::VerdictLineWriter& writer, VerdictOut& out) {
+               const maps::PlaneGrid& projection, const geofence::VerdictLineWriter& writer, VerdictOut& out) {
   geofence::PlainFix f;
   if (geofence::readPlainFixLine(text, f)) {
-    const Eigen::Vector2d p = frame.toPlane(f.lat_rad, f.lon_rad);
+    const Eigen::Vector2d p = projection.toPlane(f.lat_rad, f.lon_rad);
     const geofence::TimedVolume v{f.t0, f.t1, {Eigen::Vector3d(p.x(), p.y(), f.h_ell_m), f.hpl_m, f.vpl_m}};
     if (writer.append(out.buffer, f.id_json, f.t0, f.t1, line, fence.check(v))) return;
   }
   const std::string source = fixes + ":" + std::to_string(line);
-  json j = checkFix(geofence::parseFix(maps::parseJsonLine(text, source), source), fence, frame);
+  json j = checkFix(geofence::parseFix(maps::parseJsonLine(text, source), source), fence, projection);
   j["line"] = line;
   out.buffer += j.dump();
   out.buffer += '\n';
@@ -130,6 +131,7 @@ void checkStream(const FenceCheckOptions& o, const geofence::Fence& fence, const
   }
   std::istream& in = o.fixes == "-" ? std::cin : file;
   const geofence::VerdictLineWriter writer(fence);
+  const maps::PlaneGrid projection(frame);
   VerdictOut out;
   out.buffer.reserve(2 * VerdictOut::kFlushBytes);
   std::string text;
@@ -138,7 +140,7 @@ void checkStream(const FenceCheckOptions& o, const geofence::Fence& fence, const
     ++line;
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
     try {
-      checkLine(text, line, o.fixes, fence, frame, writer, out);
+      checkLine(text, line, o.fixes, fence, projection, writer, out);
       ++checked;
     } catch (const std::exception& e) {  // ParseError, or a fix the checker refuses
       ++rejected;

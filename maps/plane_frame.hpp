@@ -19,6 +19,8 @@ class PlaneFrame {
   [[nodiscard]] Eigen::Vector2d toPlane(double lat_rad, double lon_rad) const;
   /// \brief Plane [m] → (lat, lon) [rad].
   [[nodiscard]] Eigen::Vector2d toLatLon(const Eigen::Vector2d& p_xy) const;
+  /// \brief The origin (lat, lon) [deg].
+  [[nodiscard]] Eigen::Vector2d origin_deg() const { return {lat0_deg_, lon0_deg_}; }
 
  private:
   double lat0_deg_, lon0_deg_;

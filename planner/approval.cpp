@@ -382,6 +382,7 @@ void Approver::reloadZones() {
 Approver::~Approver() = default;
 const Mission& Approver::mission() const { return impl_->m; }
 const maps::PlaneFrame& Approver::frame() const { return impl_->frame; }
+const maps::PlaneGrid& Approver::fixProjection() const { return impl_->fix_projection; }
 const geofence::Obstructions& Approver::obstructions() const { return *impl_->obstructions; }
 const integrity::OrbitSource& Approver::orbits() const { return impl_->orbits; }
 

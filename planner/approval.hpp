@@ -45,6 +45,7 @@
 #include "geofence/fence.hpp"
 #include "integrity/gnss/orbit_source.hpp"
 #include "maps/plane_frame.hpp"
+#include "maps/plane_grid.hpp"
 
 #include <functional>
 #include <optional>
@@ -220,6 +221,9 @@ class Approver {
   [[nodiscard]] const Mission& mission() const;
   /// \brief The mission's map frame (origin at the start).
   [[nodiscard]] const maps::PlaneFrame& frame() const;
+  /// \brief The map frame's projection for a stream of fixes: interpolated, within 1e-8 m of
+  /// frame().toPlane and about twenty times faster (maps/plane_grid.hpp).
+  [[nodiscard]] const maps::PlaneGrid& fixProjection() const;
   /// \brief The mission's orbit files (for live PLs from raw pseudoranges).
   [[nodiscard]] const integrity::OrbitSource& orbits() const;
   /// \brief The zones and obstacles loaded from the mission's files.

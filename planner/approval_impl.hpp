@@ -132,6 +132,7 @@ struct Approver::Impl {
   Mission m;
   MissionRecord record;  ///< the mission's names and its inputs' digests when they were read
   maps::PlaneFrame frame;
+  maps::PlaneGrid fix_projection{frame};  ///< the frame's projection for live fixes (maps/plane_grid.hpp)
   maps::Terrain terrain;
   /// The map frame's inverse projection over the search box, built once (maps/map_ground_grid.hpp):
   /// the ground and (lat, lon) of a state without a geodesic per state. Empty until the box is known.

@@ -5,6 +5,7 @@
 #include "geofence/verdict_json.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/json_numbers.hpp"
+#include "maps/plane_grid.hpp"
 #include "planner/tracking/tracker.hpp"
 
 #include <algorithm>
@@ -60,7 +61,7 @@ TrackEvent monitoringRerunEvent(const std::string& id, const TrackFix& fix, cons
 }
 
 geofence::TimedVolume volumeAt(const TrackedFlight& f, const maps::GpsTime& t, const maps::Geodetic& g, double h, double v) {
-  const Eigen::Vector2d xy = f.approver->frame().toPlane(g.lat_rad, g.lon_rad);
+  const Eigen::Vector2d xy = f.approver->fixProjection().toPlane(g.lat_rad, g.lon_rad);
   return geofence::TimedVolume{t, t, {Eigen::Vector3d(xy.x(), xy.y(), g.h_ell_m), h, v}};
 }
 
