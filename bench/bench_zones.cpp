@@ -1,8 +1,12 @@
 // Zones: load, validate and decompose. Target (issue 4): 10,000 generated ED-269 zones
 // (polygons of 4–64 vertices) loaded from file, validated and cut into convex pieces ≤ 2 s.
+// And the map frame's projection of a fix, exact (PlaneFrame) and interpolated (PlaneGrid),
+// side by side over the same 100 km × 100 km of fixes.
 #include "airspace/validation.hpp"
 #include "airspace/zone_geometry.hpp"
 #include "maps/geodesy.hpp"
+#include "maps/plane_frame.hpp"
+#include "maps/plane_grid.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -12,6 +16,8 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace {
 
@@ -71,5 +77,32 @@ void BM_LoadValidateDecomposeZones(benchmark::State& state) {
   std::remove(path.c_str());
 }
 BENCHMARK(BM_LoadValidateDecomposeZones)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+/// 65,536 fixes spread over ±0.45° around the origin (47° N, 8° E), projected in turn.
+template <class Projection>
+void projectFixes(benchmark::State& state, const Projection& projection) {
+  std::mt19937_64 rng(22);
+  std::uniform_real_distribution<double> u(-0.45, 0.45);
+  std::vector<std::pair<double, double>> fixes(1 << 16);
+  for (auto& f : fixes) f = {maps::deg2rad(47.0 + u(rng)), maps::deg2rad(8.0 + u(rng))};
+  for (const auto& f : fixes) benchmark::DoNotOptimize(projection.toPlane(f.first, f.second));  // cells built
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const auto& f = fixes[k++ & (fixes.size() - 1)];
+    benchmark::DoNotOptimize(projection.toPlane(f.first, f.second));
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_ProjectFixExact(benchmark::State& state) {
+  projectFixes(state, maps::PlaneFrame(maps::deg2rad(47.0), maps::deg2rad(8.0)));
+}
+BENCHMARK(BM_ProjectFixExact)->Unit(benchmark::kNanosecond);
+
+void BM_ProjectFixGrid(benchmark::State& state) {
+  const maps::PlaneGrid grid(maps::PlaneFrame(maps::deg2rad(47.0), maps::deg2rad(8.0)));
+  projectFixes(state, grid);
+}
+BENCHMARK(BM_ProjectFixGrid)->Unit(benchmark::kNanosecond);
 
 }  // namespace

@@ -222,7 +222,7 @@ class Approver {
   /// \brief The mission's map frame (origin at the start).
   [[nodiscard]] const maps::PlaneFrame& frame() const;
   /// \brief The map frame's projection for a stream of fixes: interpolated, within 1e-8 m of
-  /// frame().toPlane and about twenty times faster (maps/plane_grid.hpp).
+  /// frame().toPlane and about ten times faster (maps/plane_grid.hpp).
   [[nodiscard]] const maps::PlaneGrid& fixProjection() const;
   /// \brief The mission's orbit files (for live PLs from raw pseudoranges).
   [[nodiscard]] const integrity::OrbitSource& orbits() const;
