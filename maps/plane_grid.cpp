@@ -91,17 +91,24 @@ Eigen::Vector2d evaluate(const PlaneGrid::Cell& c, double u, double v) {
 
 }  // namespace
 
-PlaneGrid::PlaneGrid(const PlaneFrame& frame)
-    : frame_(frame), origin_deg_(frame.origin_deg()), cells_(static_cast<std::size_t>(kCellsPerSide) * kCellsPerSide) {
-  for (auto& c : cells_) c.store(nullptr, std::memory_order_relaxed);
-}
+PlaneGrid::PlaneGrid(const PlaneFrame& frame) : frame_(frame), origin_deg_(frame.origin_deg()) {}
 
 PlaneGrid::~PlaneGrid() = default;
 
 const PlaneGrid::Cell* PlaneGrid::cellAt(int i, int j) const {
-  std::atomic<const Cell*>& slot = cells_[static_cast<std::size_t>(i) * kCellsPerSide + j];
-  if (const Cell* c = slot.load(std::memory_order_acquire)) return c;
+  const std::size_t k = static_cast<std::size_t>(i) * kCellsPerSide + j;
+  if (Slot* slots = slots_.load(std::memory_order_acquire)) {
+    if (const Cell* c = slots[k].load(std::memory_order_acquire)) return c;
+  }
   const std::lock_guard<std::mutex> lock(build_);
+  if (!slot_storage_) {
+    slot_storage_ = std::make_unique<Slot[]>(static_cast<std::size_t>(kCellsPerSide) * kCellsPerSide);
+    for (std::size_t n = 0; n < static_cast<std::size_t>(kCellsPerSide) * kCellsPerSide; ++n) {
+      slot_storage_[n].store(nullptr, std::memory_order_relaxed);
+    }
+    slots_.store(slot_storage_.get(), std::memory_order_release);
+  }
+  Slot& slot = slot_storage_[k];
   if (const Cell* c = slot.load(std::memory_order_relaxed)) return c;
   built_.push_back(std::make_unique<Cell>(fitCell(origin_deg_, origin_deg_.x() + (i - kHalf) * kCell_deg,
                                                   origin_deg_.y() + (j - kHalf) * kCell_deg)));

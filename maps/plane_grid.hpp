@@ -43,9 +43,14 @@ class PlaneGrid {
  private:
   [[nodiscard]] const Cell* cellAt(int i, int j) const;
 
+  using Slot = std::atomic<const Cell*>;
+
   PlaneFrame frame_;
   Eigen::Vector2d origin_deg_;
-  mutable std::vector<std::atomic<const Cell*>> cells_;
+  /// kCellsPerSide² slots, allocated with the first cell (a frame that projects no fix pays
+  /// nothing); a slot is set once, when its cell is built.
+  mutable std::atomic<Slot*> slots_{nullptr};
+  mutable std::unique_ptr<Slot[]> slot_storage_;
   mutable std::mutex build_;
   mutable std::vector<std::unique_ptr<Cell>> built_;
 };
