@@ -61,9 +61,11 @@ struct PieceAt {
   double floor_centre_m = 0.0, ceiling_centre_m = 0.0;
 };
 
-PieceAt pieceAt(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector2d& x, double reach_m) {
-  const Eigen::Vector2d d = (b - a).head<2>();
-  const double length_m = d.norm();
+PieceAt pieceAt(const detail::CorridorLeg& leg, const Eigen::Vector2d& x, double reach_m) {
+  const Eigen::Vector3d& a = leg.a;
+  const Eigen::Vector3d& b = leg.b;
+  const Eigen::Vector2d& d = leg.d;
+  const double length_m = leg.length_m;
   PieceAt p;
   if (length_m == 0.0) {
     p.distance_m = (x - a.head<2>()).norm();
@@ -130,14 +132,14 @@ double columnMargin(std::vector<PieceColumn> pieces, double bottom_m, double top
 /// The margins of one protection volume (height z ± vpl) against the corridor's pieces (alert
 /// limits hal, val), capped by the operating limits' margin.
 struct MarginField {
-  const std::vector<Eigen::Vector3d>& path;
+  const std::vector<detail::CorridorLeg>& legs;
   double z, vpl, hal, val;
   double operating_margin_m;
 
-  [[nodiscard]] std::size_t segmentCount() const { return path.size() - 1; }
+  [[nodiscard]] std::size_t segmentCount() const { return legs.size(); }
   /// Piece i over the disk of radius reach_m round x.
   [[nodiscard]] PieceAt piece(std::size_t i, const Eigen::Vector2d& x, double reach_m) const {
-    return pieceAt(path[i], path[i + 1], x, reach_m);
+    return pieceAt(legs[i], x, reach_m);
   }
   [[nodiscard]] std::pair<double, double> marginsOf(const PieceAt& p, double reach_m) const {
     auto [h, v] = pieceMargins(p, reach_m, z, vpl, hal, val);
@@ -173,10 +175,9 @@ constexpr double kOutOfPlaySlack_m = 1e-6;
 /// segment's bounding box: a lower bound on the piece's distance d, found without a square
 /// root or a division. Such a piece would change nothing in bestSinglePiece.
 bool outOfPlay(const MarginField& f, std::size_t i, const Eigen::Vector2d& c2, double hpl, double floor_m) {
-  const Eigen::Vector3d& a = f.path[i];
-  const Eigen::Vector3d& b = f.path[i + 1];
-  const double dx = std::max({0.0, std::min(a.x(), b.x()) - c2.x(), c2.x() - std::max(a.x(), b.x())});
-  const double dy = std::max({0.0, std::min(a.y(), b.y()) - c2.y(), c2.y() - std::max(a.y(), b.y())});
+  const detail::CorridorLeg& leg = f.legs[i];
+  const double dx = std::max({0.0, leg.box_lo.x() - c2.x(), c2.x() - leg.box_hi.x()});
+  const double dy = std::max({0.0, leg.box_lo.y() - c2.y(), c2.y() - leg.box_hi.y()});
   const double need_m = std::max(f.hal + hpl, f.hal - hpl - floor_m) + kOutOfPlaySlack_m;
   return dx * dx + dy * dy > need_m * need_m;
 }
@@ -318,6 +319,13 @@ Corridor::Corridor(std::vector<Eigen::Vector3d> path_map, AlertLimits limits, Op
       << operating_.ceiling_h_ell_m << " m";
     throw std::invalid_argument(s.str());
   }
+  legs_.reserve(path_.size() - 1);
+  for (std::size_t i = 0; i + 1 < path_.size(); ++i) {
+    const Eigen::Vector3d& a = path_[i];
+    const Eigen::Vector3d& b = path_[i + 1];
+    const Eigen::Vector2d d = (b - a).head<2>();
+    legs_.push_back({a, b, d, d.norm(), a.head<2>().cwiseMin(b.head<2>()), a.head<2>().cwiseMax(b.head<2>())});
+  }
 }
 
 std::array<Eigen::Vector3d, 8> Corridor::segmentBoxCorners(std::size_t segment) const {
@@ -351,7 +359,7 @@ Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_
   // The operating limits bound every piece.
   const double operating_margin_m =
       std::min(operating_.ceiling_h_ell_m - (c.z() + vpl), (c.z() - vpl) - operating_.floor_h_ell_m);
-  const MarginField field{path_, c.z(), vpl, hal, val, operating_margin_m};
+  const MarginField field{legs_, c.z(), vpl, hal, val, operating_margin_m};
   const Eigen::Vector2d c2 = c.head<2>();
 
   Containment out;

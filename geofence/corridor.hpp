@@ -121,6 +121,17 @@ struct OperatingLimits {
 /// the path's ends). A segment's **piece** is the set of points whose horizontal distance to
 /// the segment is ≤ HAL and whose height is within VAL of the centre line at the nearest
 /// point of the segment (the box plus the halves of the two end cylinders).
+namespace detail {
+/// \brief A segment as the margins read it, computed once: its ends, horizontal direction
+/// b − a and length, and its horizontal bounding box.
+struct CorridorLeg {
+  Eigen::Vector3d a, b;
+  Eigen::Vector2d d;
+  double length_m;
+  Eigen::Vector2d box_lo, box_hi;
+};
+}  // namespace detail
+
 class Corridor {
  public:
   /// \brief The path (map frame, ≥ 2 waypoints, finite), the limits and the operating limits.
@@ -149,6 +160,7 @@ class Corridor {
 
  private:
   std::vector<Eigen::Vector3d> path_;
+  std::vector<detail::CorridorLeg> legs_;  ///< one per segment
   AlertLimits limits_;
   OperatingLimits operating_;
 };
