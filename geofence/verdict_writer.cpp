@@ -1,8 +1,8 @@
 #include "geofence/verdict_writer.hpp"
 
+#include "maps/decimal_text.hpp"
 #include "maps/json_numbers.hpp"
 
-#include <nlohmann/json.hpp>
 
 #include <charconv>
 #include <cmath>
@@ -10,26 +10,14 @@
 namespace skylane::geofence {
 namespace {
 
-/// Bytes nlohmann's serializer uses for a double (to_chars writes at most 24 of them).
-constexpr std::size_t kNumberChars = 64;
-
-void appendDouble(std::string& out, double v) {
-  if (!std::isfinite(v)) {
-    out += "null";
-    return;
-  }
-  char buf[kNumberChars];
-  const char* end = nlohmann::detail::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, static_cast<std::size_t>(end - buf));
-}
-
 /// maps::metresOrNull as its JSON text.
 void appendMetres(std::string& out, double v) {
   if (!std::isfinite(v)) {
     out += "null";
     return;
   }
-  appendDouble(out, maps::roundToMm(v));
+  char buf[maps::kRoundedMaxChars];
+  out.append(buf, maps::jsonTextOfMillimetres(buf, maps::roundToMm(v)));
 }
 
 void appendUnsigned(std::string& out, std::size_t v) {

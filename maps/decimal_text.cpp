@@ -1,5 +1,7 @@
 #include "maps/decimal_text.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -22,11 +24,16 @@ char* writeDigits(char* p, std::uint64_t v) {
   return p;
 }
 
-/// count / 10^decimals as "[-]int[.frac]" without trailing zeros in the fraction.
-char* writeFixed(char* p, bool negative, std::uint64_t count, int decimals) {
+/// count / 10^decimals as "[-]int[.frac]" without trailing zeros in the fraction; an integer
+/// with ".0" after it when `point_zero` (as nlohmann writes one).
+char* writeFixed(char* p, bool negative, std::uint64_t count, int decimals, bool point_zero = false) {
   if (negative) *p++ = '-';
   p = writeDigits(p, count / kUnit[decimals]);
   std::uint64_t frac = count % kUnit[decimals];
+  if (frac == 0 && point_zero) {
+    *p++ = '.';
+    *p++ = '0';
+  }
   if (frac == 0) return p;
   int width = decimals;
   while (frac % 10 == 0) {
@@ -47,6 +54,15 @@ char* toCharsRounded(char* first, double v, int decimals) {
     if (count / kScale[decimals] == a) return writeFixed(first, v < 0, static_cast<std::uint64_t>(count), decimals);
   }
   return std::to_chars(first, first + kRoundedMaxChars, v).ptr;
+}
+
+char* jsonTextOfMillimetres(char* first, double v) {
+  const double a = std::fabs(v);
+  if (a >= 1e-3 && a < 1e5) {
+    const double count = std::round(a * 1e3);
+    if (count / 1e3 == a) return writeFixed(first, v < 0, static_cast<std::uint64_t>(count), 3, true);
+  }
+  return nlohmann::detail::to_chars(first, first + kRoundedMaxChars, v);
 }
 
 }  // namespace skylane::maps

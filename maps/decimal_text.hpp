@@ -19,4 +19,11 @@ inline constexpr int kRoundedMaxChars = 32;
 /// value rounded to `decimals` (0–8) decimal places; returns the end of the text.
 [[nodiscard]] char* toCharsRounded(char* first, double v, int decimals);
 
+/// \brief Writes v, a length rounded to the millimetre (roundToMm), as nlohmann's dump() does:
+/// its Grisu2 digits with ".0" after an integer. For 1e-3 ≤ |v| < 1e5 the digits are the
+/// shortest (every millimetre count below 10^8 was compared with nlohmann's conversion, and the
+/// tests compare every count to 2 km and random ones), so they are written from the count;
+/// any other value goes through nlohmann's conversion. Returns the end of the text.
+[[nodiscard]] char* jsonTextOfMillimetres(char* first, double v);
+
 }  // namespace skylane::maps

@@ -1,10 +1,12 @@
-// The rounded-number writer of the event lines gives std::to_chars' text, byte for byte: on every
-// millimetre count up to 2 km, on random counts of every magnitude for 3 and 8 decimals, at the
-// edges of its fast range and for values it hands to std::to_chars.
+// The rounded-number writers give the text of the conversion they stand in for, byte for byte:
+// std::to_chars' for the track event lines, nlohmann's dump() for the fence verdict lines — on
+// every millimetre count up to 2 km, on random values of every magnitude, at the edges of the
+// fast range and for the values handed on to the general conversion.
 #include "maps/decimal_text.hpp"
 #include "maps/json_numbers.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <charconv>
 #include <cmath>
@@ -60,6 +62,43 @@ TEST(DecimalText, EdgesOfTheFastRangeAndOtherValuesAreToCharsText) {
   EXPECT_EQ(fast(roundToMm(120.0), 3), "120");
   EXPECT_EQ(fast(roundToDeg8(47.30000001 * M_PI / 180.0), 8), "47.30000001");
   EXPECT_EQ(fast(1e6, 3), "1e+06");
+}
+
+std::string fastJson(double v) {
+  char buf[kRoundedMaxChars];
+  return std::string(buf, jsonTextOfMillimetres(buf, v));
+}
+
+std::string nlohmannText(double v) {
+  char buf[64];
+  return std::string(buf, nlohmann::detail::to_chars(buf, buf + sizeof buf, v));
+}
+
+TEST(DecimalText, EveryMillimetreCountUpToTwoKilometresIsNlohmannsText) {
+  int differ = 0;
+  for (long n = -2000000; n <= 2000000; ++n) {
+    const double v = static_cast<double>(n) / 1e3;
+    if (fastJson(v) != nlohmannText(v) && ++differ <= 5) ADD_FAILURE() << n << ": " << fastJson(v) << " vs " << nlohmannText(v);
+  }
+  EXPECT_EQ(differ, 0);
+}
+
+TEST(DecimalText, RandomMillimetreValuesAndEdgesAreNlohmannsText) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> exponent(-6.0, 9.0), unit(-1.0, 1.0);
+  int differ = 0;
+  for (int i = 0; i < 1000000; ++i) {
+    const double v = roundToMm(unit(rng) * std::pow(10.0, exponent(rng)));
+    if (fastJson(v) != nlohmannText(v) && ++differ <= 5) ADD_FAILURE() << v << ": " << fastJson(v);
+  }
+  EXPECT_EQ(differ, 0);
+  for (double v : {0.0, -0.0, 1e-3, -1e-3, 99999.999, 1e5, 123456.789, 1e15, 1e16, 0.1 + 0.2, 5e-4}) {
+    EXPECT_EQ(fastJson(v), nlohmannText(v)) << v;
+  }
+  EXPECT_EQ(fastJson(120.0), "120.0");  // nlohmann's mark of a floating-point integer
+  EXPECT_EQ(fastJson(-0.25), "-0.25");
+  EXPECT_EQ(fastJson(0.0), "0.0");
+  EXPECT_EQ(nlohmann::json(roundToMm(-3.2004)).dump(), fastJson(roundToMm(-3.2004)));
 }
 
 }  // namespace
