@@ -234,12 +234,17 @@ BENCHMARK(BM_TrackFixes)->Unit(benchmark::kMicrosecond)->MinTime(2.0);
 /// End to end per line: parse, read the fix, process, dump the events (as `skylane track` does).
 void BM_TrackJsonLine(benchmark::State& state) {
   std::size_t out_bytes = 0;
-  runTracking(state, [&out_bytes](planner::Tracker& t, const TrackCity& c, std::size_t k) {
+  std::string line;  // reused, as TrackingSession does
+  runTracking(state, [&out_bytes, &line](planner::Tracker& t, const TrackCity& c, std::size_t k) {
     const std::string source = "bench.jsonl:" + std::to_string(k + 1);
     planner::TrackFix fix = planner::parseTrackFixLine(c.lines[k], source);
     fix.line = k + 1;
     std::vector<planner::TrackEvent> ev = t.process(fix);
-    for (const planner::TrackEvent& e : ev) out_bytes += e.jsonLine().size();
+    for (const planner::TrackEvent& e : ev) {
+      line.clear();
+      e.appendJsonLine(line);
+      out_bytes += line.size();
+    }
     return ev;
   });
   const double lines = std::max<double>(1.0, static_cast<double>(state.iterations()));

@@ -456,21 +456,28 @@ void writeFixTail(LineWriter& w, const TrackEvent& e, const FixRecord& f) {
 }  // namespace
 
 std::string TrackEvent::jsonLine() const {
+  std::string out;
+  appendJsonLine(out);
+  return out;
+}
+
+void TrackEvent::appendJsonLine(std::string& out) const {
   const bool plain = fix && validUtf8(flight) && validUtf8(fix->note) &&
                      std::all_of(fix->verdict.checks.begin(), fix->verdict.checks.end(),
                                  [](const geofence::Check& c) {
                                    return validUtf8(c.subject) && validUtf8(c.name) && validUtf8(c.restriction);
                                  });
-  if (!plain) return toJson().dump(-1, ' ', false, json::error_handler_t::replace);
-  std::string out;
-  out.reserve(512);
+  if (!plain) {
+    out += toJson().dump(-1, ' ', false, json::error_handler_t::replace);
+    return;
+  }
+  out.reserve(out.size() + 512);
   LineWriter w(out);
   w.open('{');
   writeFixHead(w, *this, *fix);
   writeLevels(w, *fix);
   writeFixTail(w, *this, *fix);
   w.close('}');
-  return out;
 }
 
 }  // namespace skylane::planner

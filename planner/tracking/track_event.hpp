@@ -50,6 +50,9 @@ struct TrackEvent {
   /// \brief toJson() written on one line, without building the object for a `fix` event (the
   /// same members and numbers). Bytes that are not UTF-8 are replaced.
   [[nodiscard]] std::string jsonLine() const;
+  /// \brief jsonLine() appended to `out` (a buffer reused from event to event allocates only
+  /// when it grows).
+  void appendJsonLine(std::string& out) const;
 };
 
 /// \brief An event of `type` for `flight` at `t` with an empty body.

@@ -57,9 +57,10 @@ void TrackingSession::beginBatch() {
 void TrackingSession::emit(const std::vector<TrackEvent>& events) {
   for (const TrackEvent& e : events) {
     // Quoted input may hold bytes that are not UTF-8: they are replaced, not fatal.
-    const std::string line = e.jsonLine();
+    line_.clear();
+    e.appendJsonLine(line_);
     for (EventSink* sink : sinks_) {
-      sink->write(e, line);
+      sink->write(e, line_);
       // A closed output (the reader of a pipe went away): stop as on a stop request, the batch saved.
       if (sink->closed() && !summary_.output_closed) {
         summary_.output_closed = true;

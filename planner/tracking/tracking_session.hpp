@@ -109,6 +109,7 @@ class TrackingSession {
   std::vector<Ticker> tickers_;
   std::map<std::string, std::string> report_of_;  ///< flight id → approval report file
   std::set<std::string> touched_;                 ///< flights changed since the last checkpoint
+  std::string line_;                              ///< the event line being written (reused)
   std::map<std::string, std::uint64_t> dropped_;  ///< UDP input → kernel drops reported so far
   int pending_ = 0;
   FixSource* source_ = nullptr;  ///< the source being run (its checkpoint line)
