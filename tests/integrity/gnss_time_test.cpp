@@ -62,6 +62,25 @@ TEST(GnssTime, Rfc3339FractionsRoundOnceAndCarryIntoTheMinute) {
   EXPECT_EQ(formatRfc3339(parseRfc3339("2005-04-02T09:08:07.123456789Z").value(), 6), "2005-04-02T09:08:07.123457Z");
 }
 
+TEST(GnssTime, Rfc3339TextKeptFromTheLastCallIsTheAnswerOfItsOwnText) {
+  // The last text read and written is kept per thread: repeats, alternations and a bad text in
+  // between each get their own answer.
+  const char* a = "2026-11-23T14:00:00.250Z";
+  const char* b = "2026-11-23T14:00:01.250Z";
+  const GpsTime ta = parseRfc3339(a).value();
+  EXPECT_DOUBLE_EQ(parseRfc3339(b).value() - ta, 1.0);
+  EXPECT_FALSE(parseRfc3339("2026-11-23T14:00:01.250").has_value());
+  EXPECT_DOUBLE_EQ(parseRfc3339(a).value() - ta, 0.0);
+  EXPECT_DOUBLE_EQ(parseRfc3339(a).value() - ta, 0.0);
+  const GpsTime tb = ta.plus(1.0);
+  for (int round = 0; round < 2; ++round) {
+    EXPECT_EQ(formatRfc3339(ta, 3), a);
+    EXPECT_EQ(formatRfc3339(ta, 3), a);
+    EXPECT_EQ(formatRfc3339(ta, 0), "2026-11-23T14:00:00Z");
+    EXPECT_EQ(formatRfc3339(tb, 3), b);
+  }
+}
+
 TEST(GnssTime, DurationsParseUnits) {
   EXPECT_DOUBLE_EQ(parseDuration("24h").value(), 86400.0);
   EXPECT_DOUBLE_EQ(parseDuration("10m").value(), 600.0);
