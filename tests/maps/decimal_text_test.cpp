@@ -27,13 +27,20 @@ std::string reference(double v) {
   return std::string(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
 }
 
-TEST(DecimalText, EveryMillimetreCountUpToTwoKilometresIsToCharsText) {
+/// How many millimetre counts of ±2 km `writer` writes otherwise than `expected` (the first
+/// five reported).
+template <class Writer, class Expected>
+int differingMillimetreCounts(Writer writer, Expected expected) {
   int differ = 0;
   for (long n = -2000000; n <= 2000000; ++n) {
     const double v = static_cast<double>(n) / 1e3;
-    if (fast(v, 3) != reference(v) && ++differ <= 5) ADD_FAILURE() << n << ": " << fast(v, 3) << " vs " << reference(v);
+    if (writer(v) != expected(v) && ++differ <= 5) ADD_FAILURE() << n << ": " << writer(v) << " vs " << expected(v);
   }
-  EXPECT_EQ(differ, 0);
+  return differ;
+}
+
+TEST(DecimalText, EveryMillimetreCountUpToTwoKilometresIsToCharsText) {
+  EXPECT_EQ(differingMillimetreCounts([](double v) { return fast(v, 3); }, reference), 0);
 }
 
 TEST(DecimalText, RandomRoundedValuesOfEveryMagnitudeAreToCharsText) {
@@ -75,12 +82,7 @@ std::string nlohmannText(double v) {
 }
 
 TEST(DecimalText, EveryMillimetreCountUpToTwoKilometresIsNlohmannsText) {
-  int differ = 0;
-  for (long n = -2000000; n <= 2000000; ++n) {
-    const double v = static_cast<double>(n) / 1e3;
-    if (fastJson(v) != nlohmannText(v) && ++differ <= 5) ADD_FAILURE() << n << ": " << fastJson(v) << " vs " << nlohmannText(v);
-  }
-  EXPECT_EQ(differ, 0);
+  EXPECT_EQ(differingMillimetreCounts(fastJson, nlohmannText), 0);
 }
 
 TEST(DecimalText, RandomMillimetreValuesAndEdgesAreNlohmannsText) {
