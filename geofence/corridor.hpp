@@ -116,11 +116,6 @@ struct OperatingLimits {
   double ceiling_h_ell_m = std::numeric_limits<double>::infinity();
 };
 
-/// \brief Boxes along a path: one per segment, half-width HAL and half-height VAL round the
-/// centre line, and a vertical cylinder of radius HAL at each waypoint covering the joint (and
-/// the path's ends). A segment's **piece** is the set of points whose horizontal distance to
-/// the segment is ≤ HAL and whose height is within VAL of the centre line at the nearest
-/// point of the segment (the box plus the halves of the two end cylinders).
 namespace detail {
 /// \brief A segment as the margins read it, computed once: its ends, horizontal direction
 /// b − a and length, and its horizontal bounding box.
@@ -132,6 +127,11 @@ struct CorridorLeg {
 };
 }  // namespace detail
 
+/// \brief Boxes along a path: one per segment, half-width HAL and half-height VAL round the
+/// centre line, and a vertical cylinder of radius HAL at each waypoint covering the joint (and
+/// the path's ends). A segment's **piece** is the set of points whose horizontal distance to
+/// the segment is ≤ HAL and whose height is within VAL of the centre line at the nearest
+/// point of the segment (the box plus the halves of the two end cylinders).
 class Corridor {
  public:
   /// \brief The path (map frame, ≥ 2 waypoints, finite), the limits and the operating limits.
