@@ -148,6 +148,10 @@ TEST(ClutterPlanning, AWallAcrossTheFieldLeavesNoRouteAndTheLatticeSaysSo) {
   PathProblem p = clutterProblem(PlannerKind::kRrtStar);
   const auto cluttered = p.is_valid;
   p.is_valid = [cluttered](const Eigen::Vector3d& x) { return std::abs(x.x() - 600.0) > 20.0 && cluttered(x); };
+  // The searches end by exhaustion, not by the clock: ≈ 1.7 s in a release build, but over a
+  // minute under AddressSanitizer on a slow 2-vCPU VM, so the safety net is set well above that
+  // (and below ctest's 600 s).
+  p.time_limit_s = 300.0;
   const PathResult r = planPath(p);
   EXPECT_NE(r.status, PathStatus::kExact);
   EXPECT_TRUE(r.lattice_searched);
