@@ -16,17 +16,28 @@ PlaneFrame::PlaneFrame(double lat_rad, double lon_rad) : lat0_deg_(rad2deg(lat_r
   }
 }
 
+namespace {
+
+const GeographicLib::AzimuthalEquidistant& projection() {
+  static const GeographicLib::AzimuthalEquidistant p(GeographicLib::Geodesic::WGS84());
+  return p;
+}
+
+}  // namespace
+
 Eigen::Vector2d PlaneFrame::toPlane(double lat_rad, double lon_rad) const {
-  static const GeographicLib::AzimuthalEquidistant projection(GeographicLib::Geodesic::WGS84());
+  return toPlaneDeg(rad2deg(lat_rad), rad2deg(lon_rad));
+}
+
+Eigen::Vector2d PlaneFrame::toPlaneDeg(double lat_deg, double lon_deg) const {
   double x = 0, y = 0, azi = 0, rk = 0;
-  projection.Forward(lat0_deg_, lon0_deg_, rad2deg(lat_rad), rad2deg(lon_rad), x, y, azi, rk);
+  projection().Forward(lat0_deg_, lon0_deg_, lat_deg, lon_deg, x, y, azi, rk);
   return {x, y};
 }
 
 Eigen::Vector2d PlaneFrame::toLatLon(const Eigen::Vector2d& p_xy) const {
-  static const GeographicLib::AzimuthalEquidistant projection(GeographicLib::Geodesic::WGS84());
   double lat = 0, lon = 0, azi = 0, rk = 0;
-  projection.Reverse(lat0_deg_, lon0_deg_, p_xy.x(), p_xy.y(), lat, lon, azi, rk);
+  projection().Reverse(lat0_deg_, lon0_deg_, p_xy.x(), p_xy.y(), lat, lon, azi, rk);
   return {deg2rad(lat), deg2rad(lon)};
 }
 

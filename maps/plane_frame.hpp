@@ -17,6 +17,8 @@ class PlaneFrame {
   PlaneFrame(double lat_rad, double lon_rad);
   /// \brief (lat, lon) [rad] → plane (x east, y north) [m].
   [[nodiscard]] Eigen::Vector2d toPlane(double lat_rad, double lon_rad) const;
+  /// \brief The same from (lat, lon) [deg].
+  [[nodiscard]] Eigen::Vector2d toPlaneDeg(double lat_deg, double lon_deg) const;
   /// \brief Plane [m] → (lat, lon) [rad].
   [[nodiscard]] Eigen::Vector2d toLatLon(const Eigen::Vector2d& p_xy) const;
   /// \brief The origin (lat, lon) [deg].

@@ -2,8 +2,6 @@
 
 #include "maps/geodesy.hpp"
 
-#include <GeographicLib/AzimuthalEquidistant.hpp>
-#include <GeographicLib/Geodesic.hpp>
 #include <GeographicLib/Math.hpp>
 
 #include <cmath>
@@ -25,11 +23,6 @@ void chebyshevValues(double u, double (&t)[kN]) {
   for (int k = 2; k < kN; ++k) t[k] = 2.0 * u * t[k - 1] - t[k - 2];
 }
 
-const GeographicLib::AzimuthalEquidistant& projection() {
-  static const GeographicLib::AzimuthalEquidistant p(GeographicLib::Geodesic::WGS84());
-  return p;
-}
-
 }  // namespace
 
 /// The series of one cell: x = Σ cx[m][n] T_m(u) T_n(v), y likewise, with u and v the cell's
@@ -43,14 +36,15 @@ namespace {
 
 /// The series through the exact projection at the cell's nodes (the discrete Chebyshev
 /// transform, exact for polynomials of the degree).
-PlaneGrid::Cell fitCell(const Eigen::Vector2d& origin_deg, double lat_deg, double lon_deg) {
+PlaneGrid::Cell fitCell(const PlaneFrame& frame, double lat_deg, double lon_deg) {
   double fx[kN][kN], fy[kN][kN];
   for (int i = 0; i < kN; ++i) {
     for (int j = 0; j < kN; ++j) {
       const double lat = lat_deg + PlaneGrid::kCell_deg * (chebyshevNode(i) + 1.0) / 2.0;
       const double lon = lon_deg + PlaneGrid::kCell_deg * (chebyshevNode(j) + 1.0) / 2.0;
-      double azi = 0, rk = 0;
-      projection().Forward(origin_deg.x(), origin_deg.y(), lat, lon, fx[i][j], fy[i][j], azi, rk);
+      const Eigen::Vector2d xy = frame.toPlaneDeg(lat, lon);
+      fx[i][j] = xy.x();
+      fy[i][j] = xy.y();
     }
   }
   PlaneGrid::Cell c{};
@@ -110,7 +104,7 @@ const PlaneGrid::Cell* PlaneGrid::cellAt(int i, int j) const {
   }
   Slot& slot = slot_storage_[k];
   if (const Cell* c = slot.load(std::memory_order_relaxed)) return c;
-  built_.push_back(std::make_unique<Cell>(fitCell(origin_deg_, origin_deg_.x() + (i - kHalf) * kCell_deg,
+  built_.push_back(std::make_unique<Cell>(fitCell(frame_, origin_deg_.x() + (i - kHalf) * kCell_deg,
                                                   origin_deg_.y() + (j - kHalf) * kCell_deg)));
   slot.store(built_.back().get(), std::memory_order_release);
   return built_.back().get();

@@ -45,12 +45,15 @@
 #include "geofence/fence.hpp"
 #include "integrity/gnss/orbit_source.hpp"
 #include "maps/plane_frame.hpp"
-#include "maps/plane_grid.hpp"
 
 #include <functional>
 #include <optional>
 #include <string>
 #include <vector>
+
+namespace skylane::maps {
+class PlaneGrid;
+}  // namespace skylane::maps
 
 namespace skylane::planner {
 

@@ -16,6 +16,7 @@
 #include "maps/geodesy.hpp"
 #include "maps/sky_mask.hpp"
 #include "maps/map_ground_grid.hpp"
+#include "maps/plane_grid.hpp"
 #include "maps/terrain.hpp"
 #include "maps/time.hpp"
 
