@@ -70,9 +70,15 @@ BenchScene makeScene(int count, double area_m) {
   return s;
 }
 
-geofence::Fence makeFence(const BenchScene& s, double area_m) {
+/// The 20-waypoint corridor path across the area.
+std::vector<Eigen::Vector3d> benchPath(double area_m) {
   std::vector<Eigen::Vector3d> path;
   for (int i = 0; i < 20; ++i) path.emplace_back(area_m * i / 19.0, area_m * (0.5 + 0.3 * std::sin(i)), kGround_m + 100.0);
+  return path;
+}
+
+geofence::Fence makeFence(const BenchScene& s, double area_m) {
+  const std::vector<Eigen::Vector3d> path = benchPath(area_m);
   const geofence::LevelLimits limits = geofence::alertLimits({1.5, 1.2, 0.5}, {});
   return geofence::Fence(geofence::Corridor(path, limits.level1), geofence::Corridor(path, limits.level2), s.zones, {},
                          geofence::Scene(s.pieces));
@@ -137,6 +143,26 @@ void BM_FenceCheck10kZonesDense(benchmark::State& state) {
   static const geofence::Fence fence = makeFence(scene, kDenseArea_m);
   runChecks(state, scene, fence, kDenseArea_m, false);
 }
+/// One corridor's containment (the second-level box of the sparse scene) for volumes spread
+/// uniformly over the area: the part of a fence check that the corridors take.
+void BM_CorridorContains(benchmark::State& state) {
+  const geofence::Corridor corridor(benchPath(kArea_m), geofence::alertLimits({1.5, 1.2, 0.5}, {}).level2);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<geofence::ProtectionVolume> volumes;
+  for (int i = 0; i < 4096; ++i) {
+    volumes.push_back({Eigen::Vector3d(kArea_m * u(rng), kArea_m * u(rng), 380.0 + 420.0 * u(rng)), 2.0 + 48.0 * u(rng),
+                       2.0 + 48.0 * u(rng)});
+  }
+  std::size_t k = 0, inside = 0;
+  for (auto _ : state) {
+    inside += corridor.contains(volumes[k++ & 4095]).verdict == geofence::Verdict::kInside;
+  }
+  benchmark::DoNotOptimize(inside);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_CorridorContains);
+
 BENCHMARK(BM_FenceCheck10kZones)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_FenceCheck10kZonesNearZones)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_FenceCheck10kZonesDense)->Unit(benchmark::kMillisecond)->Iterations(1);

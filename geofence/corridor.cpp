@@ -170,25 +170,64 @@ struct BestPiece {
 /// Far above the rounding of a distance in the map frame (coordinates of up to 10⁷ m: 10⁻⁹ m).
 constexpr double kOutOfPlaySlack_m = 1e-6;
 
-/// Whether piece i can neither beat `floor_m` (its min(h, v) ≤ h = HAL − d − HPL lies below it)
-/// nor be reached by the volume (d > HAL + HPL), by the distance from the centre to the
-/// segment's bounding box: a lower bound on the piece's distance d, found without a square
-/// root or a division. Such a piece would change nothing in bestSinglePiece.
-bool outOfPlay(const MarginField& f, std::size_t i, const Eigen::Vector2d& c2, double hpl, double floor_m) {
-  const detail::CorridorLeg& leg = f.legs[i];
-  const double dx = std::max({0.0, leg.box_lo.x() - c2.x(), c2.x() - leg.box_hi.x()});
-  const double dy = std::max({0.0, leg.box_lo.y() - c2.y(), c2.y() - leg.box_hi.y()});
+/// A lower bound on the square of each leg's distance d from the centre, found without a square
+/// root or a division: the larger of the squared distances to the leg's bounding box and to its
+/// line (rounding: ≈ 10⁻⁹ m at 10⁷ m, far below kOutOfPlaySlack_m). Returns the leg with the
+/// smallest bound (the first of equals).
+std::size_t legDistanceBoundsSq(const MarginField& f, const Eigen::Vector2d& c2, std::vector<double>& out) {
+  out.resize(f.segmentCount());
+  std::size_t nearest = 0;
+  for (std::size_t i = 0; i < f.segmentCount(); ++i) {
+    const detail::CorridorLeg& leg = f.legs[i];
+    const double dx = std::max({0.0, leg.box_lo.x() - c2.x(), c2.x() - leg.box_hi.x()});
+    const double dy = std::max({0.0, leg.box_lo.y() - c2.y(), c2.y() - leg.box_hi.y()});
+    const double line = leg.normal.dot(c2) - leg.normal_offset_m;
+    out[i] = std::max(dx * dx + dy * dy, line * line);
+    if (out[i] < out[nearest]) nearest = i;
+  }
+  return nearest;
+}
+
+/// The square of the distance beyond which a piece can neither beat `floor_m` (its
+/// min(h, v) ≤ h = HAL − d − HPL would lie below it) nor be reached by the volume
+/// (d > HAL + HPL): a piece whose distance bound exceeds it changes nothing in bestSinglePiece.
+double outOfPlaySq(const MarginField& f, double hpl, double floor_m) {
   const double need_m = std::max(f.hal + hpl, f.hal - hpl - floor_m) + kOutOfPlaySlack_m;
-  return dx * dx + dy * dy > need_m * need_m;
+  return need_m * need_m;
+}
+
+/// The leg nearest by its distance bound (the seed; the first of equals) and its piece.
+struct SeedLeg {
+  std::size_t index;
+  PieceAt piece;
+};
+
+/// A floor below which no leg's min(h, v) can change bestSinglePiece's result: the seed's
+/// min(h, v), m_s, less (legs + 2) tolerances. Why a leg j below it (m_j < m_s − (N + 2)·tol,
+/// and out of reach) may be skipped although the scan is sequential and its ties (within tol,
+/// to the larger other margin) are not transitive: a selection lowers the best by at most tol.
+/// After s is scanned the best is ≥ m_s − tol, so it never falls to within tol of m_j in the at
+/// most N − 1 selections left: j is never selected after s. Before s, a scan that selects j and
+/// one that skips it hold bests that both lie within tol of m_j or below, and their larger rises
+/// by at most tol per leg while they differ: when s comes both lie more than tol below m_s, both
+/// select s, and from there on they agree.
+double seedFloor(const MarginField& f, const SeedLeg& seed, double hpl, double tolerance_m) {
+  const auto [h, v] = f.marginsOf(seed.piece, hpl);
+  return std::min(h, v) - (static_cast<double>(f.segmentCount()) + 2.0) * tolerance_m;
 }
 
 BestPiece bestSinglePiece(const MarginField& f, const Eigen::Vector2d& c2, double hpl, double tolerance_m, Containment& out) {
   BestPiece best;
   std::size_t segment = 0;
   double best_other_m = -std::numeric_limits<double>::infinity();
+  thread_local std::vector<double> bound_sq;  // per-thread scratch: no allocation once grown
+  const std::size_t nearest = legDistanceBoundsSq(f, c2, bound_sq);
+  const SeedLeg seed{nearest, f.piece(nearest, c2, hpl)};
+  const double seed_floor_m = seedFloor(f, seed, hpl, tolerance_m);
+  double out_of_play_sq = outOfPlaySq(f, hpl, seed_floor_m);
   for (std::size_t i = 0; i < f.segmentCount(); ++i) {
-    if (outOfPlay(f, i, c2, hpl, best.margin_m - tolerance_m)) continue;
-    const PieceAt p = f.piece(i, c2, hpl);
+    if (bound_sq[i] > out_of_play_sq) continue;
+    const PieceAt p = i == seed.index ? seed.piece : f.piece(i, c2, hpl);
     const auto [h, v] = f.marginsOf(p, hpl);
     // Pieces whose min(h, v) agree within the tolerance are tied (often the same quantity by
     // other sums: two level legs' shared vertical margin); the tie goes to the larger other
@@ -200,6 +239,7 @@ BestPiece bestSinglePiece(const MarginField& f, const Eigen::Vector2d& c2, doubl
       segment = i;
       out.margin_h_m = h;
       out.margin_v_m = v;
+      out_of_play_sq = outOfPlaySq(f, hpl, std::max(best.margin_m - tolerance_m, seed_floor_m));
     }
     if (p.distance_m <= f.hal + hpl) ++best.reached;
   }
@@ -324,7 +364,10 @@ Corridor::Corridor(std::vector<Eigen::Vector3d> path_map, AlertLimits limits, Op
     const Eigen::Vector3d& a = path_[i];
     const Eigen::Vector3d& b = path_[i + 1];
     const Eigen::Vector2d d = (b - a).head<2>();
-    legs_.push_back({a, b, d, d.norm(), a.head<2>().cwiseMin(b.head<2>()), a.head<2>().cwiseMax(b.head<2>())});
+    const double length_m = d.norm();
+    const Eigen::Vector2d normal = length_m > 0 ? Eigen::Vector2d(-d.y() / length_m, d.x() / length_m) : Eigen::Vector2d::Zero();
+    legs_.push_back({a, b, d, length_m, a.head<2>().cwiseMin(b.head<2>()), a.head<2>().cwiseMax(b.head<2>()), normal,
+                     normal.dot(a.head<2>())});
   }
 }
 

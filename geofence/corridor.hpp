@@ -118,12 +118,15 @@ struct OperatingLimits {
 
 namespace detail {
 /// \brief A segment as the margins read it, computed once: its ends, horizontal direction
-/// b − a and length, and its horizontal bounding box.
+/// b − a and length, its horizontal bounding box, and the unit normal n of its line with
+/// n·a (zero for a vertical segment), so that |n·x − n·a| is x's distance to the line.
 struct CorridorLeg {
   Eigen::Vector3d a, b;
   Eigen::Vector2d d;
   double length_m;
   Eigen::Vector2d box_lo, box_hi;
+  Eigen::Vector2d normal;
+  double normal_offset_m;
 };
 }  // namespace detail
 

@@ -519,6 +519,78 @@ TEST(Corridor, TheNearestLegDecidesALevelCorridorFromAnyDistance) {
   EXPECT_GT(far, 10000);
 }
 
+/// The best single piece as the specification scans it: every leg in order, each leg's margins
+/// from a corridor of that leg alone (the same piece), a leg taking over when its min(h, v)
+/// beats the best by more than the tolerance or ties it within the tolerance with a larger
+/// other margin.
+struct ScannedBest {
+  std::size_t segment = 0;
+  double h = 0, v = 0;
+};
+ScannedBest scanEveryLeg(const std::vector<Eigen::Vector3d>& path, const AlertLimits& limits, const OperatingLimits& operating,
+                         const ProtectionVolume& volume, double tolerance_m) {
+  ScannedBest best;
+  double best_m = -std::numeric_limits<double>::infinity(), best_other = best_m;
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    const Containment one = Corridor({path[i], path[i + 1]}, limits, operating).contains(volume, tolerance_m);
+    const double m = std::min(one.margin_h_m, one.margin_v_m), other = std::max(one.margin_h_m, one.margin_v_m);
+    if (m > best_m + tolerance_m || (m >= best_m - tolerance_m && other > best_other)) {
+      best_m = m;
+      best_other = other;
+      best = {i, one.margin_h_m, one.margin_v_m};
+    }
+  }
+  return best;
+}
+
+TEST(Corridor, SkippingFarLegsPicksTheSamePieceAsScanningEveryLeg) {
+  // GIVEN corridors made for ties: a path that runs back and forth over the same line, each pass
+  // a fraction of the tolerance higher (legs tied in h, and in v within the tolerance); passes
+  // whose offsets and heights differ by steps of 0.3 tolerances (ties that chain); and random
+  // zig-zags; tolerances from 0 to 1 m
+  std::mt19937 rng(2026);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const std::vector<double> tolerances{0.0, 1e-6, 1e-3, 0.05, 1.0};
+  int compared = 0, chosen_not_first = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const double tolerance_m = tolerances[static_cast<std::size_t>(trial) % tolerances.size()];
+    const AlertLimits limits{20.0 + 200.0 * u(rng), 10.0 + 40.0 * u(rng)};
+    const OperatingLimits operating{trial % 4 == 0 ? 90.0 : -std::numeric_limits<double>::infinity(),
+                                    trial % 4 == 0 ? 160.0 : std::numeric_limits<double>::infinity()};
+    std::vector<Eigen::Vector3d> path;
+    const int legs = 2 + static_cast<int>(rng() % 30);
+    for (int i = 0; i <= legs; ++i) {
+      if (trial % 3 == 0) {
+        path.emplace_back(i % 2 == 0 ? 0.0 : 1000.0, 0.0, 120.0 + 0.4 * tolerance_m * i);
+      } else if (trial % 3 == 1) {  // parallel passes, each nearer and higher: ties in a chain
+        path.emplace_back(i % 2 == 0 ? 0.0 : 1000.0, 100.0 + 0.3 * tolerance_m * static_cast<double>(rng() % 8),
+                          120.0 + 0.3 * tolerance_m * static_cast<double>(rng() % 8));
+      } else {
+        path.emplace_back(3000.0 * u(rng), 3000.0 * u(rng), 100.0 + 40.0 * u(rng));
+      }
+    }
+    const Corridor corridor(path, limits, operating);
+    for (int k = 0; k < 100; ++k) {
+      // WHEN a volume lies near the path or kilometres away
+      const double spread_m = k % 2 == 0 ? 2.0 * limits.hal_m : 20000.0;
+      const Eigen::Vector3d& a = path[rng() % path.size()];
+      const ProtectionVolume volume{{a.x() + spread_m * (u(rng) - 0.5), a.y() + spread_m * (u(rng) - 0.5), 100.0 + 60.0 * u(rng)},
+                                    0.5 + 0.5 * limits.hal_m * u(rng), 0.5 + 0.5 * limits.val_m * u(rng)};
+      const Containment in = corridor.contains(volume, tolerance_m);
+      if (in.across_joint) continue;
+      // THEN the piece and its margins are those of the scan over every leg, to the bit
+      const ScannedBest expected = scanEveryLeg(path, limits, operating, volume, tolerance_m);
+      ASSERT_EQ(in.segment, expected.segment) << "trial " << trial << ", volume " << k;
+      ASSERT_EQ(in.margin_h_m, expected.h) << "trial " << trial << ", volume " << k;
+      ASSERT_EQ(in.margin_v_m, expected.v) << "trial " << trial << ", volume " << k;
+      ++compared;
+      chosen_not_first += expected.segment != 0;
+    }
+  }
+  EXPECT_GT(compared, 20000);
+  EXPECT_GT(chosen_not_first, 10000);
+}
+
 TEST(Corridor, SegmentBoxCornersFollowTheClimb) {
   const Corridor c({{0, 0, 0}, {100, 0, 50}}, {6.0, 4.0});
   const auto k = c.segmentBoxCorners(0);
