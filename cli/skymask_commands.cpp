@@ -1,5 +1,6 @@
 #include "cli/skymask_commands.hpp"
 
+#include "cli/height_options.hpp"
 #include "cli/json_numbers.hpp"
 #include "cli/svg_plot.hpp"
 #include "maps/buildings.hpp"
@@ -22,7 +23,7 @@ using nlohmann::json;
 
 struct SkyMaskCliOptions {
   double lat_deg = NAN, lon_deg = NAN;
-  std::optional<double> alt_amsl_m, height_agl_m, h_ell_m;
+  HeightOptions height;
   std::string buildings;
   std::string terrain;
   std::optional<double> ground_amsl_m;
@@ -36,8 +37,6 @@ struct SkyMaskCliOptions {
 void runSkyMask(const SkyMaskCliOptions& o) {
   if (!(std::abs(o.lat_deg) <= 90.0)) throw ParseError("--lat", 0, "--lat", std::to_string(o.lat_deg), "a latitude in [-90, 90]");
   if (!(std::abs(o.lon_deg) <= 180.0)) throw ParseError("--lon", 0, "--lon", std::to_string(o.lon_deg), "a longitude in [-180, 180]");
-  const int given = (o.alt_amsl_m ? 1 : 0) + (o.height_agl_m ? 1 : 0) + (o.h_ell_m ? 1 : 0);
-  if (given != 1) throw ParseError("--alt-amsl", 0, "--alt-amsl|--height-agl|--h-ell", "", "exactly one height");
   if (o.buildings.empty() && o.terrain.empty() && !o.ground_amsl_m) {
     throw ParseError("--buildings", 0, "--buildings|--terrain|--ground-amsl", "", "something that blocks the sky");
   }
@@ -51,15 +50,7 @@ void runSkyMask(const SkyMaskCliOptions& o) {
   const maps::Terrain ground = groundModel(o.terrain, o.ground_amsl_m);
   const maps::Geoid& geoid = maps::Geoid::egm96();
   const double lat = maps::deg2rad(o.lat_deg), lon = maps::deg2rad(o.lon_deg);
-  double h_ell = 0.0;
-  if (o.h_ell_m) h_ell = *o.h_ell_m;
-  if (o.alt_amsl_m) h_ell = geoid.ellipsoidalFromAmsl_m(lat, lon, *o.alt_amsl_m);
-  if (o.height_agl_m) {
-    const auto g = ground.heightEllipsoid_m(lat, lon);
-    if (!g) throw ParseError(o.terrain, 0, "--height-agl", std::to_string(*o.height_agl_m), "a point the terrain model covers");
-    h_ell = *g + *o.height_agl_m;
-  }
-  if (!std::isfinite(h_ell)) throw ParseError("--h-ell", 0, "height", std::to_string(h_ell), "a finite height");
+  const double h_ell = ellipsoidalHeight(o.height, lat, lon, ground, o.terrain, geoid);
   maps::SkyMaskOptions opt;
   opt.bin_width_rad = maps::deg2rad(o.bin_deg);
   opt.terrain_max_range_m = o.terrain_range_m;
@@ -126,9 +117,7 @@ void addSkyMaskCommands(CLI::App& app) {
   CLI::App* c = app.add_subcommand("skymask", "the elevation blocked by buildings and terrain in every azimuth bin, as JSON");
   c->add_option("--lat", o->lat_deg, "latitude [deg]")->required();
   c->add_option("--lon", o->lon_deg, "longitude [deg]")->required();
-  c->add_option("--alt-amsl", o->alt_amsl_m, "altitude above mean sea level (EGM96) [m]");
-  c->add_option("--height-agl", o->height_agl_m, "height above the ground (--terrain / --ground-amsl) [m]");
-  c->add_option("--h-ell", o->h_ell_m, "WGS-84 ellipsoidal height [m]");
+  addHeightOptions(*c, o->height, "height above the ground (--terrain / --ground-amsl) [m]");
   c->add_option("--buildings", o->buildings, "GeoJSON buildings and obstacles (README: Buildings and obstacles)");
   c->add_option("--terrain", o->terrain, "terrain raster: ground under the buildings and the terrain horizon");
   c->add_option("--ground-amsl", o->ground_amsl_m, "flat ground at this altitude AMSL [m] (without --terrain; default 0, and then no terrain horizon)");

@@ -6,6 +6,7 @@
 #include "airspace/vertical.hpp"
 #include "airspace/zone_export.hpp"
 #include "airspace/zone_geometry.hpp"
+#include "cli/height_options.hpp"
 #include "cli/json_numbers.hpp"
 #include "maps/geodesy.hpp"
 #include "maps/geoid.hpp"
@@ -35,7 +36,7 @@ struct AtOptions {
   std::vector<std::string> files;
   std::string format = "auto";
   double lat_deg = NAN, lon_deg = NAN;
-  std::optional<double> alt_amsl_m, height_agl_m, h_ell_m;
+  HeightOptions height;
   std::string time;
   std::string terrain;
 };
@@ -101,22 +102,13 @@ void runValidate(const ValidateOptions& o) {
 void runAt(const AtOptions& o) {
   if (!(std::abs(o.lat_deg) <= 90.0)) throw ParseError("--lat", 0, "--lat", std::to_string(o.lat_deg), "a latitude in [-90, 90]");
   if (!(std::abs(o.lon_deg) <= 180.0)) throw ParseError("--lon", 0, "--lon", std::to_string(o.lon_deg), "a longitude in [-180, 180]");
-  const int given = (o.alt_amsl_m ? 1 : 0) + (o.height_agl_m ? 1 : 0) + (o.h_ell_m ? 1 : 0);
-  if (given != 1) throw ParseError("--alt-amsl", 0, "--alt-amsl|--height-agl|--h-ell", "", "exactly one height");
   const auto t = maps::parseRfc3339(o.time);
   if (!t) throw ParseError("--time", 0, "--time", o.time, "an RFC 3339 date-time such as 2026-11-23T14:00:00Z");
   const maps::Terrain terrain = loadTerrain(o.terrain);
   const maps::Geoid& geoid = maps::Geoid::egm96();
   const airspace::VerticalModel model{terrain, geoid};
   const airspace::LatLon p{maps::deg2rad(o.lat_deg), maps::deg2rad(o.lon_deg)};
-  double h_ell = 0.0;
-  if (o.h_ell_m) h_ell = *o.h_ell_m;
-  if (o.alt_amsl_m) h_ell = geoid.ellipsoidalFromAmsl_m(p.lat_rad, p.lon_rad, *o.alt_amsl_m);
-  if (o.height_agl_m) {
-    const auto ground = terrain.heightEllipsoid_m(p.lat_rad, p.lon_rad);
-    if (!ground) throw ParseError(o.terrain, 0, "--height-agl", std::to_string(*o.height_agl_m), "a point the terrain model covers");
-    h_ell = *ground + *o.height_agl_m;
-  }
+  const double h_ell = ellipsoidalHeight(o.height, p.lat_rad, p.lon_rad, terrain, o.terrain, geoid);
   json out;
   out["position"] = {{"lat_deg", o.lat_deg}, {"lon_deg", o.lon_deg}, {"h_ell_m", roundToMm(h_ell)},
                      {"alt_amsl_m", roundToMm(geoid.amslFromEllipsoidal_m(p.lat_rad, p.lon_rad, h_ell))}};
@@ -211,9 +203,7 @@ void addZonesCommands(CLI::App& app) {
   c->add_option("--format", at->format, "auto (default), ed269, ed318, geojson or qgc");
   c->add_option("--lat", at->lat_deg, "latitude [deg]")->required();
   c->add_option("--lon", at->lon_deg, "longitude [deg]")->required();
-  c->add_option("--alt-amsl", at->alt_amsl_m, "altitude above mean sea level (EGM96) [m]");
-  c->add_option("--height-agl", at->height_agl_m, "height above ground [m]");
-  c->add_option("--h-ell", at->h_ell_m, "WGS-84 ellipsoidal height [m]");
+  addHeightOptions(*c, at->height, "height above ground [m]");
   c->add_option("--time", at->time, "RFC 3339 time")->required();
   c->add_option("--terrain", at->terrain, "terrain raster (GeoTIFF, ESRI ASCII, SRTM HGT); default flat at 0 m AMSL");
   c->callback([at] { runAt(*at); });

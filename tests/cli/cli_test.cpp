@@ -364,6 +364,42 @@ TEST(Cli, ZonesAtSaysWhichZonesApplyAndWhy) {
   EXPECT_EQ(nlohmann::json::parse(high.out)["applies"].size(), 0u) << high.out;
 }
 
+TEST(Cli, PointQueriesTakeOnlyFiniteHeightsInTheModelledBand) {
+  // GIVEN the point queries that take one height (zones at, skymask) at 47.4° N 8.5° E, where
+  // the EGM96 geoid lies 47.403 m above the ellipsoid
+  const std::string che = test::dataPath("geozones/geo-awareness-che-1.json");
+  const std::vector<std::string> commands{"zones at " + che + " --lat 47.4 --lon 8.5 --time 2026-01-01T00:00:00Z",
+                                          "skymask --lat 47.4 --lon 8.5 --ground-amsl 400"};
+  struct Case {
+    std::string option, value, said;
+  };
+  const std::vector<Case> bad{
+      {"--alt-amsl", "1e308", "got '1e+308', expected a height whose ellipsoidal height lies within -2000 … 20000 m"},
+      {"--h-ell", "-1e308", "got '-1e+308', expected a height whose ellipsoidal height lies within -2000 … 20000 m"},
+      {"--height-agl", "1e300", "got '1e+300', expected a height whose ellipsoidal height lies within"},
+      {"--h-ell", "nan", "got 'nan', expected a finite height in metres"},
+      {"--h-ell", "inf", "got 'inf', expected a finite height in metres"},
+      // 19,960 m AMSL is 20,007.403 m above the ellipsoid here (N = 47.403 m): outside, and the
+      // message says so
+      {"--alt-amsl", "19960", "this one gives 20007.403 m"},
+      {"--h-ell", "20000.0004", "got '20000.0004'"}};
+  for (const std::string& command : commands) {
+    for (const Case& c : bad) {
+      // WHEN a height outside the band, or no number, is given
+      const RunResult r = run(command + " " + c.option + " " + c.value);
+      // THEN the command exits 2 naming the option, its value and what was expected
+      EXPECT_EQ(r.status, 2) << command << " " << c.option << " " << c.value << ": " << r.out;
+      EXPECT_NE(r.out.find("field '" + c.option + "'"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find(c.said), std::string::npos) << r.out;
+    }
+    // AND heights at the band's edges are taken
+    for (const char* ok : {"--h-ell 20000", "--h-ell -2000", "--alt-amsl 19900", "--height-agl 50"}) {
+      const RunResult r = run(command + " " + ok);
+      EXPECT_EQ(r.status, 0) << command << " " << ok << ": " << r.out;
+    }
+  }
+}
+
 TEST(Cli, ZonesAtResolvesAglLimitsOverSlopingTerrain) {
   // GIVEN terrain rising 20 m per 0.01° eastward (700 m AMSL at 7.1°E, 1100 m at 7.3°E) and a
   // prohibited zone from 0 to 120 m AGL over 7.05–7.45°E
