@@ -1,6 +1,7 @@
 #include "cli/height_options.hpp"
 
 #include "geofence/scene.hpp"
+#include "maps/json_numbers.hpp"
 #include "maps/parse_error.hpp"
 
 #include <charconv>
@@ -18,8 +19,8 @@ std::string valueText(double v) {
   return {text, end};
 }
 
-/// A derived height for a message: to the millimetre where that can be printed (|h| < 10¹² m).
-std::string heightText(double h) { return valueText(std::abs(h) < 1e12 ? std::round(h * 1000.0) / 1000.0 : h); }
+/// A derived height for a message: to the millimetre (roundToMm) where that stays finite.
+std::string heightText(double h) { return valueText(std::abs(h) < 1e12 ? maps::roundToMm(h) : h); }
 
 }  // namespace
 

@@ -196,14 +196,9 @@ double outOfPlaySq(const MarginField& f, double hpl, double floor_m) {
   return need_m * need_m;
 }
 
-/// The leg nearest by its distance bound (the seed; the first of equals) and its piece.
-struct SeedLeg {
-  std::size_t index;
-  PieceAt piece;
-};
-
-/// A floor below which no leg's min(h, v) can change bestSinglePiece's result: the seed's
-/// min(h, v), m_s, less (legs + 2) tolerances. Why a leg j below it (m_j < m_s − (N + 2)·tol,
+/// A floor below which no leg's min(h, v) can change bestSinglePiece's result: the min(h, v),
+/// m_s, of the seed (`seed`: the piece of the leg nearest by its distance bound), less
+/// (legs + 2) tolerances. Why a leg j below it (m_j < m_s − (N + 2)·tol,
 /// and out of reach) may be skipped although the scan is sequential and its ties (within tol,
 /// to the larger other margin) are not transitive: a selection lowers the best by at most tol.
 /// After s is scanned the best is ≥ m_s − tol, so it never falls to within tol of m_j in the at
@@ -211,8 +206,8 @@ struct SeedLeg {
 /// one that skips it hold bests that both lie within tol of m_j or below, and their larger rises
 /// by at most tol per leg while they differ: when s comes both lie more than tol below m_s, both
 /// select s, and from there on they agree.
-double seedFloor(const MarginField& f, const SeedLeg& seed, double hpl, double tolerance_m) {
-  const auto [h, v] = f.marginsOf(seed.piece, hpl);
+double seedFloor(const MarginField& f, const PieceAt& seed, double hpl, double tolerance_m) {
+  const auto [h, v] = f.marginsOf(seed, hpl);
   return std::min(h, v) - (static_cast<double>(f.segmentCount()) + 2.0) * tolerance_m;
 }
 
@@ -221,13 +216,13 @@ BestPiece bestSinglePiece(const MarginField& f, const Eigen::Vector2d& c2, doubl
   std::size_t segment = 0;
   double best_other_m = -std::numeric_limits<double>::infinity();
   thread_local std::vector<double> bound_sq;  // per-thread scratch: no allocation once grown
-  const std::size_t nearest = legDistanceBoundsSq(f, c2, bound_sq);
-  const SeedLeg seed{nearest, f.piece(nearest, c2, hpl)};
-  const double seed_floor_m = seedFloor(f, seed, hpl, tolerance_m);
+  const std::size_t seed = legDistanceBoundsSq(f, c2, bound_sq);
+  const PieceAt seed_piece = f.piece(seed, c2, hpl);
+  const double seed_floor_m = seedFloor(f, seed_piece, hpl, tolerance_m);
   double out_of_play_sq = outOfPlaySq(f, hpl, seed_floor_m);
   for (std::size_t i = 0; i < f.segmentCount(); ++i) {
     if (bound_sq[i] > out_of_play_sq) continue;
-    const PieceAt p = i == seed.index ? seed.piece : f.piece(i, c2, hpl);
+    const PieceAt p = i == seed ? seed_piece : f.piece(i, c2, hpl);
     const auto [h, v] = f.marginsOf(p, hpl);
     // Pieces whose min(h, v) agree within the tolerance are tied (often the same quantity by
     // other sums: two level legs' shared vertical margin); the tie goes to the larger other
