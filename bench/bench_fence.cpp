@@ -163,6 +163,37 @@ void BM_CorridorContains(benchmark::State& state) {
 }
 BENCHMARK(BM_CorridorContains);
 
+/// One zone's narrow phase: a scene of one piece 150 m tall — a disk of radius 50 m (an FCL
+/// cylinder) or an octagon of circumradius 60 m (an FCL convex prism) — and volumes (HPL, VPL
+/// 0.5–3 m) 5–150 m outside it at heights within its band, horizon 200 m: each query measures
+/// one FCL GJK distance (the part of a fence check that grows with the zones reported).
+void runOneZoneQueries(benchmark::State& state, bool disk) {
+  airspace::PlanarPrism piece;
+  piece.floor_h_ell_m = 400.0;
+  piece.ceiling_h_ell_m = 550.0;
+  const double radius_m = disk ? 50.0 : 60.0;
+  if (disk) piece.radius_m = radius_m;
+  for (int k = 0; !disk && k < 8; ++k) piece.ring.emplace_back(radius_m * std::cos(k * M_PI / 4), radius_m * std::sin(k * M_PI / 4));
+  const geofence::Scene scene({{piece, geofence::PieceOwner::kZone, 0}});
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<geofence::ProtectionVolume> volumes;
+  for (int i = 0; i < 4096; ++i) {
+    const double a = 2 * M_PI * u(rng), r = radius_m + 5.0 + 145.0 * u(rng);
+    volumes.push_back({Eigen::Vector3d(r * std::cos(a), r * std::sin(a), 410.0 + 130.0 * u(rng)), 0.5 + 2.5 * u(rng),
+                       0.5 + 2.5 * u(rng)});
+  }
+  const auto all = [](geofence::PieceOwner, std::size_t) { return true; };
+  std::size_t k = 0, hits = 0;
+  for (auto _ : state) hits += scene.query(volumes[k++ & 4095], 200.0, all).size();
+  if (hits != static_cast<std::size_t>(state.iterations())) state.SkipWithError("a volume was not within the horizon");
+  state.SetItemsProcessed(state.iterations());
+}
+void BM_OneZoneDisk(benchmark::State& state) { runOneZoneQueries(state, true); }
+void BM_OneZonePrism(benchmark::State& state) { runOneZoneQueries(state, false); }
+BENCHMARK(BM_OneZoneDisk);
+BENCHMARK(BM_OneZonePrism);
+
 BENCHMARK(BM_FenceCheck10kZones)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_FenceCheck10kZonesNearZones)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_FenceCheck10kZonesDense)->Unit(benchmark::kMillisecond)->Iterations(1);

@@ -7,8 +7,10 @@
 #include <fcl/geometry/shape/convex.h>
 #include <fcl/geometry/shape/cylinder.h>
 #include <fcl/narrowphase/collision_object.h>
+#include <fcl/narrowphase/detail/gjk_solver_indep.h>
 #include <fcl/narrowphase/distance.h>
 
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -72,10 +74,11 @@ class Pieces final : public FclPieces {
     objects_.push_back(fclObject(piece, z_lo, z_hi));
     objects_.back()->computeAABB();
     const fcl::CollisionObjectd& o = *objects_.back();
-    Hot h{&o, o.collisionGeometry().get(), nullptr, 0};
-    if (const auto* convex = dynamic_cast<const fcl::Convexd*>(h.shape)) {
-      h.vertices = reinterpret_cast<const char*>(convex->getVertices().data());
-      h.vertex_bytes = convex->getVertices().size() * sizeof(fcl::Vector3d);
+    Hot h{&o, o.collisionGeometry().get(), dynamic_cast<const fcl::Cylinderd*>(o.collisionGeometry().get()),
+          dynamic_cast<const fcl::Convexd*>(o.collisionGeometry().get()), nullptr, 0};
+    if (h.convex != nullptr) {
+      h.vertices = reinterpret_cast<const char*>(h.convex->getVertices().data());
+      h.vertex_bytes = h.convex->getVertices().size() * sizeof(fcl::Vector3d);
     }
     hot_.push_back(h);
     return boxOf(o);
@@ -89,9 +92,10 @@ class Pieces final : public FclPieces {
     q.object.computeAABB();
     return boxOf(q.object);
   }
-  double distance(std::size_t i, GjkSolver solver) const override {
+  double distance(std::size_t i, GjkSolver solver, const Eigen::Vector3d& toward_piece) const override {
+    if (solver == GjkSolver::kIndep) return startedIndepDistance(hot_[i], toward_piece);
     fcl::DistanceRequestd request;
-    request.gjk_solver_type = solver == GjkSolver::kLibccd ? fcl::GST_LIBCCD : fcl::GST_INDEP;
+    request.gjk_solver_type = fcl::GST_LIBCCD;
     fcl::DistanceResultd result;
     fcl::distance(&queryCylinder().object, objects_[i].get(), request, result);
     return result.min_distance;
@@ -104,13 +108,37 @@ class Pieces final : public FclPieces {
   }
 
  private:
-  /// Where distance(i, …) reads: the object, its shape and a convex shape's vertices.
+  /// Where distance(i, …) reads: the object, its shape (as a cylinder or as a convex prism, one of
+  /// them null) and a convex shape's vertices.
   struct Hot {
     const fcl::CollisionObjectd* object;
     const fcl::CollisionGeometryd* shape;
+    const fcl::Cylinderd* cylinder;
+    const fcl::Convexd* convex;
     const char* vertices;
     std::size_t vertex_bytes;
   };
+
+  /// FCL's own GJK between this thread's query cylinder and the piece, as fcl::distance runs it
+  /// for GST_INDEP (the solver's shapeDistance at the request's default tolerance; −1 in contact
+  /// or when it fails), but with its search started along `toward_piece` (FCL's cached guess:
+  /// the first support direction) instead of FCL's fixed +x.
+  static double startedIndepDistance(const Hot& h, const Eigen::Vector3d& toward_piece) {
+    fcl::detail::GJKSolver_indep<double> solver;
+    solver.gjk_tolerance = fcl::DistanceRequestd().distance_tolerance;
+    if (toward_piece.squaredNorm() > 0.0) {
+      solver.enable_cached_guess = true;
+      solver.cached_guess = toward_piece;
+    }
+    const QueryCylinder& q = queryCylinder();
+    double d = std::numeric_limits<double>::max();
+    if (h.cylinder != nullptr) {
+      solver.shapeDistance(*q.shape, q.object.getTransform(), *h.cylinder, h.object->getTransform(), &d, nullptr, nullptr);
+    } else {
+      solver.shapeDistance(*q.shape, q.object.getTransform(), *h.convex, h.object->getTransform(), &d, nullptr, nullptr);
+    }
+    return d;
+  }
   std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects_;
   std::vector<Hot> hot_;
 };
@@ -121,7 +149,7 @@ std::unique_ptr<FclPieces> makePieces() { return std::make_unique<Pieces>(); }
 }  // namespace skylane::geofence::detail
 
 /// The module's one exported symbol (its name carries kFclModuleAbi).
-extern "C" __attribute__((visibility("default"))) const skylane::geofence::detail::FclModule* skylane_fcl_module_v2() {
+extern "C" __attribute__((visibility("default"))) const skylane::geofence::detail::FclModule* skylane_fcl_module_v3() {
   static const skylane::geofence::detail::FclModule module{&skylane::geofence::detail::makePieces};
   return &module;
 }

@@ -44,8 +44,11 @@ class FclPieces {
   /// \brief Places this thread's query cylinder (centre p, radius, half height) and returns its AABB.
   virtual FclBox placeCylinder(const Eigen::Vector3d& p, double radius_m, double half_m) const = 0;
   /// \brief FCL's distance from this thread's query cylinder to piece i with the given solver
-  /// (≤ 0 in contact). Throws what FCL throws.
-  [[nodiscard]] virtual double distance(std::size_t i, GjkSolver solver) const = 0;
+  /// (≤ 0 in contact). FCL's own GJK starts its search along `toward_piece` (a direction from the
+  /// volume toward the piece; zero for FCL's default start): where it starts changes how many
+  /// iterations it takes, not what it converges to. libccd's takes no start. Throws what FCL
+  /// throws.
+  [[nodiscard]] virtual double distance(std::size_t i, GjkSolver solver, const Eigen::Vector3d& toward_piece) const = 0;
   /// \brief Asks the processor for what distance(i, …) will read (the object, its shape and its
   /// vertices), so that the scene can ask for several pieces before measuring the first.
   virtual void prefetch(std::size_t i) const = 0;
@@ -57,7 +60,7 @@ struct FclModule {
 };
 
 /// \brief The interface version the module and skylane agree on (in the entry point's name).
-inline constexpr int kFclModuleAbi = 2;
+inline constexpr int kFclModuleAbi = 3;
 /// \brief File name of the module.
 inline constexpr const char* kFclModuleFile = "libskylane_fcl.so";
 

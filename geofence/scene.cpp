@@ -292,10 +292,10 @@ FclBox cylinderBox(const Eigen::Vector3d& p, double radius_m, double half_m) {
 
 const FclModule& fclModule() {
   static const FclModule& module = []() -> const FclModule& {
-    const maps::detail::ModuleSpec spec{kFclModuleFile, "SKYLANE_FCL_MODULE", "skylane_fcl_module_v2",
+    const maps::detail::ModuleSpec spec{kFclModuleFile, "SKYLANE_FCL_MODULE", "skylane_fcl_module_v3",
                                         SKYLANE_FCL_MODULE_BUILD_PATH, SKYLANE_FCL_MODULE_INSTALL_PATH,
                                         "checking protection volumes against zones and obstacles"};
-    static_assert(kFclModuleAbi == 2, "rename the entry point with the ABI version");
+    static_assert(kFclModuleAbi == 3, "rename the entry point with the ABI version");
     return maps::detail::moduleTable<FclModule>(spec);
   }();
   return module;
@@ -345,6 +345,9 @@ class ShapeTable {
   void add(const airspace::PlanarPrism& p);
   /// separationMargins(volume, piece i).
   [[nodiscard]] Separation margins(const ProtectionVolume& volume, std::size_t i) const;
+  /// The vector from `centre` to the nearest point of piece i (zero when the centre lies in it):
+  /// where FCL's own GJK starts its search (FclPieces::distance).
+  [[nodiscard]] Eigen::Vector3d towardPiece(const Eigen::Vector3d& centre, std::size_t i) const;
   /// Asks the processor for piece i's record, then (once it is there) for its edges: a query's
   /// pieces lie far apart in memory, and reading them one after the other waited on each.
   void prefetchShape(std::size_t i) const { __builtin_prefetch(&shapes_[i]); }
@@ -389,6 +392,31 @@ Separation ShapeTable::margins(const ProtectionVolume& volume, std::size_t i) co
     horizontal = d.value();
   }
   return fromMargins(horizontal - volume.hpl_m, signedVerticalDistance(p.floor, p.ceiling, volume.p_map.z()) - volume.vpl_m);
+}
+
+Eigen::Vector3d ShapeTable::towardPiece(const Eigen::Vector3d& centre, std::size_t i) const {
+  const Shape& p = shapes_[i];
+  Eigen::Vector2d to_shape = Eigen::Vector2d::Zero();
+  if (p.count == 0) {
+    const Eigen::Vector2d out = centre.head<2>() - p.centre;
+    const double r = out.norm();
+    if (r > p.radius) to_shape = -out * ((r - p.radius) / r);
+  } else {
+    bool inside = true;
+    double nearest2 = kInf;
+    for (const RingEdge* e = edges_.data() + p.first, *end = e + p.count; e != end; ++e) {
+      const double ax = centre.x() - e->ax, ay = centre.y() - e->ay;
+      if (e->ex * ay - e->ey * ax < 0) inside = false;
+      const double t = std::clamp((ax * e->ex + ay * e->ey) / e->length2, 0.0, 1.0);
+      const double dx = t * e->ex - ax, dy = t * e->ey - ay;
+      if (dx * dx + dy * dy < nearest2) {
+        nearest2 = dx * dx + dy * dy;
+        to_shape = {dx, dy};
+      }
+    }
+    if (inside) to_shape.setZero();
+  }
+  return {to_shape.x(), to_shape.y(), std::clamp(centre.z(), p.floor, p.ceiling) - centre.z()};
 }
 
 }  // namespace
@@ -469,20 +497,23 @@ Separation Scene::Impl::settle(std::size_t i, NarrowQuery& query, Separation s) 
   }
   // FCL 0.7.0's two GJK solvers each stop metres off on some elongated pairs: libccd (its
   // default) beside a piece kilometres tall (an unlimited ceiling), its own (GST_INDEP) for a
-  // thin tall volume (HPL ≪ VPL) — cases kept in tests/geofence/scene_test.cpp. So libccd
-  // goes first and the other is a second opinion; FCL's answer counts only where it agrees
-  // with the closed form, and the exact predicate settles the rest.
-  static const std::array<detail::GjkSolver, 2> kSolvers{detail::GjkSolver::kLibccd, detail::GjkSolver::kIndep};
+  // thin tall volume (HPL ≪ VPL) — cases kept in tests/geofence/scene_test.cpp. So each is the
+  // other's second opinion; FCL's answer counts where either agrees with the closed form, and
+  // the exact predicate settles the rest. FCL's own goes first, its search started toward the
+  // piece's nearest point: against a curved side (a disk's cylinder) a search from FCL's fixed
+  // start creeps up on the distance, one started there converges in a few steps.
+  static const std::array<detail::GjkSolver, 2> kSolvers{detail::GjkSolver::kIndep, detail::GjkSolver::kLibccd};
   const airspace::PlanarPrism& prism = pieces[i].prism;
   // FCL decides when its distance agrees with the closed form (Separation) to kExactBand_m and
   // both are clear of contact by more than the band, or when it reports contact and the
   // margins put the volume deep inside; anything else — contact, a near miss, a disagreement,
   // a failure — goes to the exact predicate. The clearance reported is the closed form.
   const double deciding_m = std::max(s.margin_h_m, s.margin_v_m);
+  const Eigen::Vector3d toward_piece = shapes.towardPiece(volume.p_map, i);
   for (const detail::GjkSolver solver : kSolvers) {
     double d = 0.0;
     try {
-      d = fcl->distance(i, solver);  // from this thread's query cylinder, the volume (query())
+      d = fcl->distance(i, solver, toward_piece);  // from this thread's query cylinder, the volume (query())
     } catch (const std::exception&) {
       s.fcl_failed = true;  // FCL's GJK/EPA can throw near contact
       continue;
