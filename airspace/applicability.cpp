@@ -78,6 +78,12 @@ bool isActiveDuring(const Zone& z, const maps::GpsTime& t0, const maps::GpsTime&
                      [&](const Applicability& a) { return isActiveDuring(a, t0, t1); });
 }
 
+bool isAlwaysActive(const Zone& z) {
+  return z.applicability.empty() || std::any_of(z.applicability.begin(), z.applicability.end(), [](const Applicability& a) {
+           return a.permanent && a.schedule.empty();
+         });
+}
+
 std::optional<double> parseTimeOfDay(const std::string& text) {
   const auto two = [&](std::size_t pos, int& out) {
     if (pos + 2 > text.size() || !std::isdigit(static_cast<unsigned char>(text[pos])) ||

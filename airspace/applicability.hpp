@@ -27,6 +27,11 @@ namespace skylane::airspace {
 /// \brief True when the zone applies at some instant of [t0, t1) (at t0 when t1 ≤ t0).
 [[nodiscard]] bool isActiveDuring(const Zone& z, const maps::GpsTime& t0, const maps::GpsTime& t1);
 
+/// \brief True when the zone applies at every instant: it has no entry, or an entry that is
+/// permanent (no date range) with no schedule. Then isActive and isActiveDuring are true at any
+/// time, so a checker may skip asking them.
+[[nodiscard]] bool isAlwaysActive(const Zone& z);
+
 /// \brief Parses a time of day "HH:MM[:SS[.fff]]" followed by "Z" or "±HH:MM" into seconds
 /// after the local midnight expressed in UTC (so "01:00+02:00" → −3600). "24:00" is the end of
 /// the day. nullopt when the text is not such a time.

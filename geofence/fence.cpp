@@ -159,7 +159,7 @@ Obstructions::Obstructions(std::vector<airspace::Zone> zones, std::vector<maps::
   always_active_.reserve(zones_.size());
   for (const airspace::Zone& z : zones_) {
     zone_counts_.push_back(counts(z, policy_));
-    always_active_.push_back(z.applicability.empty());
+    always_active_.push_back(airspace::isAlwaysActive(z));
   }
   for (const ScenePiece& p : scene_.pieces()) {
     pieces_in_band_ = pieces_in_band_ && p.prism.floor_h_ell_m >= kSceneFloor_h_ell_m &&

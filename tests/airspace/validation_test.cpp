@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 #include <algorithm>
+#include <cmath>
+#include <random>
 #include <nlohmann/json.hpp>
 
 namespace skylane::airspace {
@@ -167,6 +169,40 @@ TEST(ZoneApplicability, ScheduleEdgesMidnightAndWeekdays) {
   EXPECT_TRUE(isActive(reichenbach, utc("2022-06-15T09:00:00Z")));
   EXPECT_FALSE(isActive(reichenbach, utc("2023-06-15T09:00:00Z")));
   EXPECT_TRUE(isActive(che[2], utc("1999-01-01T00:00:00Z")));  // permanent
+}
+
+TEST(ZoneApplicability, AZoneIsAlwaysActiveOnlyWhenSomeEntryHasNeitherDatesNorSchedule) {
+  // GIVEN the CHE file's zones (a scheduled one, a dated one, a permanent one) and the GeoJSON
+  // file's market (scheduled), and made-up zones: no entry; a dated entry beside a permanent one
+  const auto che = loadZones(test::dataPath("geozones/geo-awareness-che-1.json"));
+  const auto plain = loadZones(test::dataPath("geozones/plain_zones.geojson"));
+  Zone none;
+  Zone dated_and_permanent = che[1];
+  dated_and_permanent.applicability.push_back(Applicability{});
+  Zone permanent_with_schedule = che[2];
+  ASSERT_FALSE(permanent_with_schedule.applicability.empty());
+  permanent_with_schedule.applicability[0].schedule = che[0].applicability[0].schedule;
+  // THEN only those with an entry that is permanent and unscheduled (or no entry) always apply
+  EXPECT_FALSE(isAlwaysActive(che[0]));
+  EXPECT_FALSE(isAlwaysActive(che[1]));
+  EXPECT_TRUE(isAlwaysActive(che[2]));
+  EXPECT_FALSE(isAlwaysActive(plain[1]));
+  EXPECT_TRUE(isAlwaysActive(none));
+  EXPECT_TRUE(isAlwaysActive(dated_and_permanent));
+  EXPECT_FALSE(isAlwaysActive(permanent_with_schedule));
+  // AND an always-active zone is active at and over any time the rules evaluate: instants and
+  // intervals from 1980 to 2100, of zero length up to years, and reversed
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double span_s = 120.0 * 365.25 * 86400.0;
+  for (int i = 0; i < 2000; ++i) {
+    const maps::GpsTime t0 = maps::GpsTime::fromTotalSeconds(span_s * u(rng));
+    const maps::GpsTime t1 = maps::GpsTime::fromTotalSeconds(t0.totalSeconds() + (u(rng) - 0.1) * 86400.0 * std::pow(10.0, 4.0 * u(rng)));
+    for (const Zone* z : std::initializer_list<const Zone*>{&che[2], &none, &dated_and_permanent}) {
+      ASSERT_TRUE(isActive(*z, t0)) << t0.totalSeconds();
+      ASSERT_TRUE(isActiveDuring(*z, t0, t1)) << t0.totalSeconds() << " " << t1.totalSeconds();
+    }
+  }
 }
 
 TEST(ZoneApplicability, TimeOfDayParsing) {
