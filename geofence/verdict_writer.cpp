@@ -42,37 +42,48 @@ std::size_t utf8Length(std::string_view s, std::size_t i) {
   return 0;
 }
 
-/// A JSON string as nlohmann's dump(-1) writes it (ensure_ascii off: UTF-8 as it is; \b \t \n
-/// \f \r \" \\ and \u00xx for the other control characters); false on invalid UTF-8.
-bool appendString(std::string& out, std::string_view s) {
+/// Whether c goes into a JSON string as it is (printable ASCII other than '"' and '\\').
+bool plainAscii(unsigned char c) { return c >= 0x20 && c < 0x80 && c != '"' && c != '\\'; }
+
+/// Appends the escaped form of c (a control character, '"' or '\\'), as nlohmann writes it.
+void appendEscape(std::string& out, unsigned char c) {
   static constexpr char kHex[] = "0123456789abcdef";
+  switch (c) {
+    case '\b': out += "\\b"; return;
+    case '\t': out += "\\t"; return;
+    case '\n': out += "\\n"; return;
+    case '\f': out += "\\f"; return;
+    case '\r': out += "\\r"; return;
+    case '"': out += "\\\""; return;
+    case '\\': out += "\\\\"; return;
+    default: {
+      const char esc[] = {'\\', 'u', '0', '0', kHex[c >> 4], kHex[c & 15]};
+      out.append(esc, sizeof esc);
+    }
+  }
+}
+
+/// A JSON string as nlohmann's dump(-1) writes it (ensure_ascii off: UTF-8 as it is; \b \t \n
+/// \f \r \" \\ and \u00xx for the other control characters); false on invalid UTF-8. Runs of
+/// plain characters are appended whole.
+bool appendString(std::string& out, std::string_view s) {
   out += '"';
   for (std::size_t i = 0; i < s.size();) {
+    std::size_t run = i;
+    while (run < s.size() && plainAscii(static_cast<unsigned char>(s[run]))) ++run;
+    out.append(s.data() + i, run - i);
+    if (run == s.size()) break;
+    i = run;
     const auto c = static_cast<unsigned char>(s[i]);
-    if (c >= 0x80) {
-      const std::size_t n = utf8Length(s, i);
-      if (n == 0) return false;
-      out.append(s.data() + i, n);
-      i += n;
+    if (c < 0x80) {
+      appendEscape(out, c);
+      ++i;
       continue;
     }
-    switch (c) {
-      case '\b': out += "\\b"; break;
-      case '\t': out += "\\t"; break;
-      case '\n': out += "\\n"; break;
-      case '\f': out += "\\f"; break;
-      case '\r': out += "\\r"; break;
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      default:
-        if (c < 0x20) {
-          const char esc[] = {'\\', 'u', '0', '0', kHex[c >> 4], kHex[c & 15]};
-          out.append(esc, sizeof esc);
-        } else {
-          out += static_cast<char>(c);
-        }
-    }
-    ++i;
+    const std::size_t n = utf8Length(s, i);
+    if (n == 0) return false;
+    out.append(s.data() + i, n);
+    i += n;
   }
   out += '"';
   return true;
