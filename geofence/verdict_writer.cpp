@@ -3,27 +3,56 @@
 #include "maps/decimal_text.hpp"
 #include "maps/json_numbers.hpp"
 
-
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <optional>
 
 namespace skylane::geofence {
+
+namespace detail {
+
+/// Writes into space sized beforehand (VerdictLineWriter::append sizes it): one pointer moves
+/// on, with no capacity check per piece of text.
+class TextCursor {
+ public:
+  explicit TextCursor(char* at) : at_(at) {}
+  template <std::size_t N>
+  void literal(const char (&text)[N]) {
+    std::memcpy(at_, text, N - 1);
+    at_ += N - 1;
+  }
+  void text(std::string_view t) {
+    std::memcpy(at_, t.data(), t.size());
+    at_ += t.size();
+  }
+  void put(char c) { *at_++ = c; }
+  /// Where the next byte goes; advance(end) after writing there.
+  [[nodiscard]] char* at() const { return at_; }
+  void advance(char* end) { at_ = end; }
+
+ private:
+  char* at_;
+};
+
+}  // namespace detail
+
 namespace {
 
-/// maps::metresOrNull as its JSON text.
-void appendMetres(std::string& out, double v) {
+using Cursor = detail::TextCursor;
+
+/// maps::metresOrNull as its JSON text (at most maps::kRoundedMaxChars).
+void putMetres(Cursor& out, double v) {
   if (!std::isfinite(v)) {
-    out += "null";
+    out.literal("null");
     return;
   }
-  char buf[maps::kRoundedMaxChars];
-  out.append(buf, maps::jsonTextOfMillimetres(buf, maps::roundToMm(v)));
+  out.advance(maps::jsonTextOfMillimetres(out.at(), maps::roundToMm(v)));
 }
 
-void appendUnsigned(std::string& out, std::size_t v) {
-  char buf[24];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, static_cast<std::size_t>(r.ptr - buf));
+void putUnsigned(Cursor& out, std::size_t v) {
+  out.advance(std::to_chars(out.at(), out.at() + 24, v).ptr);
 }
 
 /// Length of the UTF-8 sequence starting at s[i] (Unicode 15 §3.9, Table 3-7: no overlong
@@ -45,165 +74,207 @@ std::size_t utf8Length(std::string_view s, std::size_t i) {
 /// Whether c goes into a JSON string as it is (printable ASCII other than '"' and '\\').
 bool plainAscii(unsigned char c) { return c >= 0x20 && c < 0x80 && c != '"' && c != '\\'; }
 
-/// Appends the escaped form of c (a control character, '"' or '\\'), as nlohmann writes it.
-void appendEscape(std::string& out, unsigned char c) {
+/// Writes the escaped form of c (a control character, '"' or '\\'), as nlohmann writes it: at most
+/// 6 bytes.
+void putEscape(Cursor& out, unsigned char c) {
   static constexpr char kHex[] = "0123456789abcdef";
   switch (c) {
-    case '\b': out += "\\b"; return;
-    case '\t': out += "\\t"; return;
-    case '\n': out += "\\n"; return;
-    case '\f': out += "\\f"; return;
-    case '\r': out += "\\r"; return;
-    case '"': out += "\\\""; return;
-    case '\\': out += "\\\\"; return;
+    case '\b': out.literal("\\b"); return;
+    case '\t': out.literal("\\t"); return;
+    case '\n': out.literal("\\n"); return;
+    case '\f': out.literal("\\f"); return;
+    case '\r': out.literal("\\r"); return;
+    case '"': out.literal("\\\""); return;
+    case '\\': out.literal("\\\\"); return;
     default: {
       const char esc[] = {'\\', 'u', '0', '0', kHex[c >> 4], kHex[c & 15]};
-      out.append(esc, sizeof esc);
+      out.text({esc, sizeof esc});
     }
   }
 }
 
 /// A JSON string as nlohmann's dump(-1) writes it (ensure_ascii off: UTF-8 as it is; \b \t \n
-/// \f \r \" \\ and \u00xx for the other control characters); false on invalid UTF-8. Runs of
-/// plain characters are appended whole.
-bool appendString(std::string& out, std::string_view s) {
-  out += '"';
+/// \f \r \" \\ and \u00xx for the other control characters), at most 6 bytes per byte of s
+/// and 2 quotes; false on invalid UTF-8. Runs of plain characters are copied whole.
+bool putString(Cursor& out, std::string_view s) {
+  out.put('"');
   for (std::size_t i = 0; i < s.size();) {
     std::size_t run = i;
     while (run < s.size() && plainAscii(static_cast<unsigned char>(s[run]))) ++run;
-    out.append(s.data() + i, run - i);
+    out.text(s.substr(i, run - i));
     if (run == s.size()) break;
     i = run;
     const auto c = static_cast<unsigned char>(s[i]);
     if (c < 0x80) {
-      appendEscape(out, c);
+      putEscape(out, c);
       ++i;
       continue;
     }
     const std::size_t n = utf8Length(s, i);
     if (n == 0) return false;
-    out.append(s.data() + i, n);
+    out.text(s.substr(i, n));
     i += n;
   }
-  out += '"';
+  out.put('"');
   return true;
 }
 
-/// `"key":` (keys are plain ASCII).
-void appendKey(std::string& out, std::string_view key) {
-  out += '"';
-  out += key;
-  out += "\":";
-}
+/// Most bytes putString writes for s.
+std::size_t stringBound(std::string_view s) { return 6 * s.size() + 2; }
 
-void appendTime(std::string& out, const maps::GpsTime& t) {
-  char buf[maps::kRfc3339MaxChars];
-  out += '"';
-  if (const char* end = maps::formatRfc3339To(buf, t, 3)) {
-    out.append(buf, static_cast<std::size_t>(end - buf));
-  } else {
-    out += maps::formatRfc3339(t, 3);
+/// A time as the line writes it: formatRfc3339To's text, or formatRfc3339's for the times it
+/// leaves to it.
+class TimeText {
+ public:
+  explicit TimeText(const maps::GpsTime& t) {
+    if (const char* end = maps::formatRfc3339To(buf_, t, 3)) {
+      view_ = {buf_, static_cast<std::size_t>(end - buf_)};
+    } else {
+      slow_ = maps::formatRfc3339(t, 3);
+      view_ = slow_;
+    }
   }
-  out += '"';
+  [[nodiscard]] std::string_view view() const { return view_; }
+
+ private:
+  char buf_[maps::kRfc3339MaxChars];
+  std::string slow_;
+  std::string_view view_;
+};
+
+/// Bytes of a check's text other than its strings, millimetre numbers and file: its keys,
+/// punctuation, level and verdict words and segment number come to at most ≈ 190 (a box check:
+/// 20 digits of segment, "indeterminate").
+constexpr std::size_t kCheckFixedBytes = 256;
+/// Bytes of a line other than its checks, id and times: at most ≈ 130 (20 digits of line
+/// number, "indeterminate", "keep_in").
+constexpr std::size_t kLineFixedBytes = 256;
+
+/// Text made once (the constructor's): written into a string with room for it.
+template <typename Write>
+std::string textOf(std::size_t bound, Write write) {
+  std::string text(bound, '\0');
+  Cursor out(text.data());
+  write(out);
+  text.resize(static_cast<std::size_t>(out.at() - text.data()));
+  return text;
 }
 
 }  // namespace
 
 VerdictLineWriter::VerdictLineWriter(const Fence& fence) {
   for (const Corridor* level : {&fence.level1(), &fence.level2()}) {
-    std::string hal, val;
-    appendMetres(hal, level->limits().hal_m);
-    appendMetres(val, level->limits().val_m);
-    limits_text_.push_back({hal, val});
+    const auto metres = [](double v) { return textOf(maps::kRoundedMaxChars, [&](Cursor& out) { putMetres(out, v); }); };
+    limits_text_.push_back({metres(level->limits().hal_m), metres(level->limits().val_m)});
   }
   for (const airspace::Zone& z : fence.zones()) {
-    std::string file;
-    zone_file_ok_.push_back(appendString(file, z.source));
-    zone_files_.push_back(file);
+    bool ok = true;
+    zone_files_.push_back(textOf(stringBound(z.source), [&](Cursor& out) { ok = putString(out, z.source); }));
+    zone_file_ok_.push_back(ok);
   }
 }
 
-bool VerdictLineWriter::appendCheck(std::string& out, const Check& c) const {
+std::size_t VerdictLineWriter::checkBound(const Check& c) const {
+  const bool zone = c.level == Level::kZone || c.level == Level::kKeepIn;
+  return kCheckFixedBytes + 5 * maps::kRoundedMaxChars + stringBound(c.subject) + stringBound(c.name) +
+         stringBound(c.restriction) + (zone ? zone_files_[c.index].size() : 0);
+}
+
+bool VerdictLineWriter::writeCheck(Cursor& out, const Check& c) const {
   const bool box = c.level == Level::kCorridor || c.level == Level::kAirspace;
   const bool zone = c.level == Level::kZone || c.level == Level::kKeepIn;
-  out += '{';
+  out.put('{');
   if (box) {
-    out += c.across_joint ? "\"across_joint\":true," : "\"across_joint\":false,";
-    appendKey(out, "hal_m");
-    out += limits_text_[c.level == Level::kCorridor ? 0 : 1].first;
-    out += ',';
+    if (c.across_joint) out.literal("\"across_joint\":true,\"hal_m\":"); else out.literal("\"across_joint\":false,\"hal_m\":");
+    out.text(limits_text_[c.level == Level::kCorridor ? 0 : 1].first);
+    out.put(',');
   } else if (c.level != Level::kKeepIn) {
-    appendKey(out, "clearance_m");
-    if (c.clearance_m) appendMetres(out, *c.clearance_m); else out += "null";
-    out += c.exact ? ",\"exact\":true," : ",\"exact\":false,";
+    out.literal("\"clearance_m\":");
+    if (c.clearance_m) putMetres(out, *c.clearance_m); else out.literal("null");
+    if (c.exact) out.literal(",\"exact\":true,"); else out.literal(",\"exact\":false,");
   }
   if (zone) {
     if (!zone_file_ok_[c.index]) return false;
-    appendKey(out, "file");
-    out += zone_files_[c.index];
-    out += ',';
+    out.literal("\"file\":");
+    out.text(zone_files_[c.index]);
+    out.put(',');
   }
-  appendKey(out, "level");
-  appendString(out, levelName(c.level));
-  out += ",\"margin_h_m\":";
-  appendMetres(out, c.margin_h_m);
-  out += ",\"margin_v_m\":";
-  appendMetres(out, c.margin_v_m);
-  out += ',';
+  out.literal("\"level\":");
+  (void)putString(out, levelName(c.level));
+  out.literal(",\"margin_h_m\":");
+  putMetres(out, c.margin_h_m);
+  out.literal(",\"margin_v_m\":");
+  putMetres(out, c.margin_v_m);
+  out.put(',');
   if (zone) {
-    appendKey(out, "name");
-    if (!appendString(out, c.name)) return false;
-    out += ",\"restriction\":";
-    if (!appendString(out, c.restriction)) return false;
-    out += ',';
+    out.literal("\"name\":");
+    if (!putString(out, c.name)) return false;
+    out.literal(",\"restriction\":");
+    if (!putString(out, c.restriction)) return false;
+    out.put(',');
   }
   if (box) {
-    appendKey(out, "segment");
-    appendUnsigned(out, c.index);
-    out += ',';
+    out.literal("\"segment\":");
+    putUnsigned(out, c.index);
+    out.put(',');
   }
-  appendKey(out, "subject");
-  if (!appendString(out, c.subject)) return false;
+  out.literal("\"subject\":");
+  if (!putString(out, c.subject)) return false;
   if (box) {
-    out += ",\"val_m\":";
-    out += limits_text_[c.level == Level::kCorridor ? 0 : 1].second;
+    out.literal(",\"val_m\":");
+    out.text(limits_text_[c.level == Level::kCorridor ? 0 : 1].second);
   }
-  out += ",\"verdict\":";
-  appendString(out, verdictWord(c.level, c.verdict));
-  out += '}';
+  out.literal(",\"verdict\":");
+  (void)putString(out, verdictWord(c.level, c.verdict));
+  out.put('}');
   return true;
 }
 
 bool VerdictLineWriter::append(std::string& out, std::string_view id_json, const maps::GpsTime& t0,
                                const maps::GpsTime& t1, std::size_t line, const FenceVerdict& v) const {
+  const TimeText from(t0);
+  const std::optional<TimeText> until = t1 - t0 > 0 ? std::optional<TimeText>(t1) : std::nullopt;
+  std::size_t bound = kLineFixedBytes + id_json.size() + from.view().size() + (until ? until->view().size() : 0);
+  for (const Check& c : v.checks) bound += checkBound(c) + 1;
   const std::size_t start = out.size();
-  out += "{\"checks\":[";
+  out.resize(start + bound);
+  Cursor text(out.data() + start);
+  if (!writeLine(text, id_json, from.view(), until ? until->view() : std::string_view(), line, v)) {
+    out.resize(start);
+    return false;
+  }
+  const auto used = static_cast<std::size_t>(text.at() - out.data());
+  if (used > start + bound) std::abort();  // the bounds above are wrong: memory is already overwritten
+  out.resize(used);
+  return true;
+}
+
+bool VerdictLineWriter::writeLine(Cursor& out, std::string_view id_json, std::string_view from, std::string_view until,
+                                  std::size_t line, const FenceVerdict& v) const {
+  out.literal("{\"checks\":[");
   for (std::size_t i = 0; i < v.checks.size(); ++i) {
-    if (i > 0) out += ',';
-    if (!appendCheck(out, v.checks[i])) {
-      out.resize(start);
-      return false;
-    }
+    if (i > 0) out.put(',');
+    if (!writeCheck(out, v.checks[i])) return false;
   }
-  out += "],";
+  out.literal("],");
   if (!id_json.empty()) {
-    appendKey(out, "id");
-    out += id_json;
-    out += ',';
+    out.literal("\"id\":");
+    out.text(id_json);
+    out.put(',');
   }
-  appendKey(out, "line");
-  appendUnsigned(out, line);
-  out += ",\"time\":";
-  appendTime(out, t0);
-  if (t1 - t0 > 0) {
-    out += ",\"until\":";
-    appendTime(out, t1);
+  out.literal("\"line\":");
+  putUnsigned(out, line);
+  out.literal(",\"time\":\"");
+  out.text(from);
+  if (!until.empty()) {
+    out.literal("\",\"until\":\"");
+    out.text(until);
   }
-  out += ",\"verdict\":";
-  appendString(out, verdictName(v.verdict));
-  out += ",\"violated\":";
-  if (v.violated) appendString(out, levelName(*v.violated)); else out += "null";
-  out += "}\n";
+  out.literal("\",\"verdict\":");
+  (void)putString(out, verdictName(v.verdict));
+  out.literal(",\"violated\":");
+  if (v.violated) (void)putString(out, levelName(*v.violated)); else out.literal("null");
+  out.literal("}\n");
   return true;
 }
 

@@ -17,6 +17,10 @@
 
 namespace skylane::geofence {
 
+namespace detail {
+class TextCursor;  ///< verdict_writer.cpp: writes into space sized beforehand
+}  // namespace detail
+
 /// \brief Writes verdict lines for one fence (holds references to nothing: what it needs of the
 /// fence is copied at construction).
 class VerdictLineWriter {
@@ -30,7 +34,13 @@ class VerdictLineWriter {
                             std::size_t line, const FenceVerdict& v) const;
 
  private:
-  bool appendCheck(std::string& out, const Check& c) const;
+  using Cursor = detail::TextCursor;
+  /// Most bytes writeCheck writes for c.
+  [[nodiscard]] std::size_t checkBound(const Check& c) const;
+  [[nodiscard]] bool writeCheck(Cursor& out, const Check& c) const;
+  /// The line, its times already as text (until empty: none).
+  [[nodiscard]] bool writeLine(Cursor& out, std::string_view id_json, std::string_view from, std::string_view until,
+                               std::size_t line, const FenceVerdict& v) const;
 
   std::vector<std::pair<std::string, std::string>> limits_text_;  ///< level 1, level 2: (HAL, VAL) as JSON
   std::vector<std::string> zone_files_;         ///< per zone: its file as a JSON string
