@@ -6,6 +6,7 @@
 #include "maps/geodesy.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -20,6 +21,20 @@ constexpr double kLeastRadiusOfCurvature_m = 6378137.0 * (1.0 - 0.00669437999014
 
 /// The worse of two verdicts: outside over indeterminate over inside.
 int severity(Verdict v) { return v == Verdict::kOutside ? 2 : (v == Verdict::kIndeterminate ? 1 : 0); }
+
+/// std::stable_sort's order (equal elements keep theirs), by insertion for a few checks (a check
+/// usually reports a handful of zones, and std::stable_sort allocates a buffer for every call).
+template <class Less>
+void stableSortByInsertion(std::vector<Check>& checks, Less less) {
+  constexpr std::size_t kInsertionMax = 32;
+  if (checks.size() > kInsertionMax) {
+    std::stable_sort(checks.begin(), checks.end(), less);
+    return;
+  }
+  for (auto i = checks.begin(); i != checks.end(); ++i) {
+    std::rotate(std::upper_bound(checks.begin(), i, *i, less), i, std::next(i));
+  }
+}
 
 Check boxCheck(Level level, const Corridor& box, const ProtectionVolume& v, double tolerance_m) {
   const Containment c = box.contains(v, tolerance_m);
@@ -222,7 +237,7 @@ std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) c
                         : (deciding_m <= options_.tolerance_m ? Verdict::kIndeterminate : Verdict::kInside);
     near.push_back(std::move(c));
   }
-  std::stable_sort(near.begin(), near.end(), [](const Check& a, const Check& b) {
+  stableSortByInsertion(near, [](const Check& a, const Check& b) {
     if (a.level != b.level) return a.level < b.level;
     if (severity(a.verdict) != severity(b.verdict)) return severity(a.verdict) > severity(b.verdict);
     return *a.clearance_m < *b.clearance_m;

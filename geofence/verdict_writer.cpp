@@ -119,6 +119,13 @@ bool putString(Cursor& out, std::string_view s) {
   return true;
 }
 
+/// A word of the format (a level, a verdict: plain lower-case ASCII) as a JSON string.
+void putWord(Cursor& out, std::string_view word) {
+  out.put('"');
+  out.text(word);
+  out.put('"');
+}
+
 /// Most bytes putString writes for s.
 std::size_t stringBound(std::string_view s) { return 6 * s.size() + 2; }
 
@@ -200,7 +207,7 @@ bool VerdictLineWriter::writeCheck(Cursor& out, const Check& c) const {
     out.put(',');
   }
   out.literal("\"level\":");
-  (void)putString(out, levelName(c.level));
+  putWord(out, levelName(c.level));
   out.literal(",\"margin_h_m\":");
   putMetres(out, c.margin_h_m);
   out.literal(",\"margin_v_m\":");
@@ -225,7 +232,7 @@ bool VerdictLineWriter::writeCheck(Cursor& out, const Check& c) const {
     out.text(limits_text_[c.level == Level::kCorridor ? 0 : 1].second);
   }
   out.literal(",\"verdict\":");
-  (void)putString(out, verdictWord(c.level, c.verdict));
+  putWord(out, verdictWord(c.level, c.verdict));
   out.put('}');
   return true;
 }
@@ -271,9 +278,9 @@ bool VerdictLineWriter::writeLine(Cursor& out, std::string_view id_json, std::st
     out.text(until);
   }
   out.literal("\",\"verdict\":");
-  (void)putString(out, verdictName(v.verdict));
+  putWord(out, verdictName(v.verdict));
   out.literal(",\"violated\":");
-  if (v.violated) (void)putString(out, levelName(*v.violated)); else out.literal("null");
+  if (v.violated) putWord(out, levelName(*v.violated)); else out.literal("null");
   out.literal("}\n");
   return true;
 }
