@@ -163,6 +163,38 @@ void BM_CorridorContains(benchmark::State& state) {
 }
 BENCHMARK(BM_CorridorContains);
 
+/// A fence's two levels on the sparse scene's path (1.2 × and 300 × the vehicle), volumes as in
+/// BM_CorridorContains: each level's contains() alone, or both through containsWith (the legs'
+/// distance bounds computed once for the shared path).
+void runTwoLevels(benchmark::State& state, bool together) {
+  const std::vector<Eigen::Vector3d> path = benchPath(kArea_m);
+  const geofence::LevelLimits limits = geofence::alertLimits({1.5, 1.2, 0.5}, {});
+  const geofence::Corridor level1(path, limits.level1), level2(path, limits.level2);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<geofence::ProtectionVolume> volumes;
+  for (int i = 0; i < 4096; ++i) {
+    volumes.push_back({Eigen::Vector3d(kArea_m * u(rng), kArea_m * u(rng), 380.0 + 420.0 * u(rng)), 2.0 + 48.0 * u(rng),
+                       2.0 + 48.0 * u(rng)});
+  }
+  std::size_t k = 0, inside = 0;
+  for (auto _ : state) {
+    const geofence::ProtectionVolume& v = volumes[k++ & 4095];
+    if (together) {
+      const auto [in1, in2] = level1.containsWith(level2, v);
+      inside += (in1.verdict == geofence::Verdict::kInside) + (in2.verdict == geofence::Verdict::kInside);
+    } else {
+      inside += (level1.contains(v).verdict == geofence::Verdict::kInside) + (level2.contains(v).verdict == geofence::Verdict::kInside);
+    }
+  }
+  benchmark::DoNotOptimize(inside);
+  state.SetItemsProcessed(state.iterations());
+}
+void BM_TwoLevelsEachAlone(benchmark::State& state) { runTwoLevels(state, false); }
+void BM_TwoLevelsTogether(benchmark::State& state) { runTwoLevels(state, true); }
+BENCHMARK(BM_TwoLevelsEachAlone);
+BENCHMARK(BM_TwoLevelsTogether);
+
 /// One zone's narrow phase: a scene of one piece 150 m tall — a disk of radius 50 m (an FCL
 /// cylinder) or an octagon of circumradius 60 m (an FCL convex prism) — and volumes (HPL, VPL
 /// 0.5–3 m) 5–150 m outside it at heights within its band, horizon 200 m: each query measures

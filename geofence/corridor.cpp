@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <queue>
 #include <limits>
 #include <utility>
@@ -9,6 +10,13 @@
 #include <stdexcept>
 
 namespace skylane::geofence {
+
+/// legDistanceBoundsSq's bounds for one centre, and the leg nearest by them.
+struct detail::LegBounds {
+  std::vector<double> sq;
+  std::size_t nearest = 0;
+};
+
 namespace {
 
 double dimension(const Vehicle& v, Dimension d) {
@@ -188,6 +196,8 @@ std::size_t legDistanceBoundsSq(const MarginField& f, const Eigen::Vector2d& c2,
   return nearest;
 }
 
+using detail::LegBounds;
+
 /// The square of the distance beyond which a piece can neither beat `floor_m` (its
 /// min(h, v) ≤ h = HAL − d − HPL would lie below it) nor be reached by the volume
 /// (d > HAL + HPL): a piece whose distance bound exceeds it changes nothing in bestSinglePiece.
@@ -211,12 +221,13 @@ double seedFloor(const MarginField& f, const PieceAt& seed, double hpl, double t
   return std::min(h, v) - (static_cast<double>(f.segmentCount()) + 2.0) * tolerance_m;
 }
 
-BestPiece bestSinglePiece(const MarginField& f, const Eigen::Vector2d& c2, double hpl, double tolerance_m, Containment& out) {
+BestPiece bestSinglePiece(const MarginField& f, const Eigen::Vector2d& c2, double hpl, double tolerance_m,
+                          const LegBounds& bounds, Containment& out) {
   BestPiece best;
   std::size_t segment = 0;
   double best_other_m = -std::numeric_limits<double>::infinity();
-  thread_local std::vector<double> bound_sq;  // per-thread scratch: no allocation once grown
-  const std::size_t seed = legDistanceBoundsSq(f, c2, bound_sq);
+  const std::vector<double>& bound_sq = bounds.sq;
+  const std::size_t seed = bounds.nearest;
   const PieceAt seed_piece = f.piece(seed, c2, hpl);
   const double seed_floor_m = seedFloor(f, seed_piece, hpl, tolerance_m);
   double out_of_play_sq = outOfPlaySq(f, hpl, seed_floor_m);
@@ -388,6 +399,21 @@ std::array<Eigen::Vector3d, 8> Corridor::segmentBoxCorners(std::size_t segment) 
 }
 
 Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_m) const {
+  thread_local LegBounds bounds;  // per-thread scratch: no allocation once grown
+  return containsWithBounds(volume, tolerance_m, bounds, false);
+}
+
+std::pair<Containment, Containment> Corridor::containsWith(const Corridor& other, const ProtectionVolume& volume,
+                                                           double tolerance_m) const {
+  thread_local LegBounds bounds;
+  const bool same_path = path_.size() == other.path_.size() &&
+                         std::memcmp(path_.data(), other.path_.data(), path_.size() * sizeof(Eigen::Vector3d)) == 0;
+  Containment mine = containsWithBounds(volume, tolerance_m, bounds, false);
+  return {mine, other.containsWithBounds(volume, tolerance_m, bounds, same_path)};
+}
+
+Containment Corridor::containsWithBounds(const ProtectionVolume& volume, double tolerance_m, LegBounds& bounds,
+                                         bool bounds_known) const {
   requireValid(volume);
   if (!(tolerance_m >= 0.0 && std::isfinite(tolerance_m))) {  // the legs' skipping relies on it too
     throw std::invalid_argument("corridor containment tolerance must be finite and ≥ 0, got " + std::to_string(tolerance_m));
@@ -401,7 +427,8 @@ Containment Corridor::contains(const ProtectionVolume& volume, double tolerance_
   const Eigen::Vector2d c2 = c.head<2>();
 
   Containment out;
-  const BestPiece best = bestSinglePiece(field, c2, hpl, tolerance_m, out);
+  if (!bounds_known) bounds.nearest = legDistanceBoundsSq(field, c2, bounds.sq);
+  const BestPiece best = bestSinglePiece(field, c2, hpl, tolerance_m, bounds, out);
   if (best.margin_m < tolerance_m && best.reached >= 2) {
     const UnionMargin u = unionMargin(field, c2, hpl, std::max(tolerance_m, 1e-3 * hal), best.margin_m + tolerance_m);
     // lower ≤ the union margin ≤ upper (a point of the volume has margin `upper`); report the

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <utility>
 #include <cstddef>
 #include <limits>
 #include <string>
@@ -117,6 +118,7 @@ struct OperatingLimits {
 };
 
 namespace detail {
+struct LegBounds;  ///< corridor.cpp: bounds on a point's distance to each leg
 /// \brief A segment as the margins read it, computed once: its ends, horizontal direction
 /// b − a and length, its horizontal bounding box, and the unit normal n of its line with
 /// n·a (zero for a vertical segment), so that |n·x − n·a| is x's distance to the line.
@@ -160,8 +162,18 @@ class Corridor {
   /// \throws std::invalid_argument for a non-finite position, a negative/non-finite PL or a
   /// negative/non-finite tolerance.
   [[nodiscard]] Containment contains(const ProtectionVolume& volume, double tolerance_m = 1e-6) const;
+  /// \brief {contains(volume, tolerance_m), other.contains(volume, tolerance_m)}, the same
+  /// answers; when both corridors lie on the same path (the same waypoints, bit for bit: a fence's
+  /// two levels) the bounds on the centre's distance to each leg are computed once for both.
+  [[nodiscard]] std::pair<Containment, Containment> containsWith(const Corridor& other, const ProtectionVolume& volume,
+                                                                 double tolerance_m = 1e-6) const;
 
  private:
+  /// contains(), with the legs' distance bounds for the volume's centre in `bounds`: computed
+  /// there unless `bounds_known` (another corridor on the same path computed them for it).
+  [[nodiscard]] Containment containsWithBounds(const ProtectionVolume& volume, double tolerance_m, detail::LegBounds& bounds,
+                                               bool bounds_known) const;
+
   std::vector<Eigen::Vector3d> path_;
   std::vector<detail::CorridorLeg> legs_;  ///< one per segment
   AlertLimits limits_;

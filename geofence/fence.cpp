@@ -36,8 +36,7 @@ void stableSortByInsertion(std::vector<Check>& checks, Less less) {
   }
 }
 
-Check boxCheck(Level level, const Corridor& box, const ProtectionVolume& v, double tolerance_m) {
-  const Containment c = box.contains(v, tolerance_m);
+Check boxCheck(Level level, const Containment& c) {
   Check out;
   out.level = level;
   out.verdict = c.verdict;
@@ -324,8 +323,9 @@ FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const O
   std::optional<Check> keep_in = obstructions.keepIn(v);
   std::vector<Check> near = obstructions.check(v, horizon_m);
   out.checks.reserve(2 + (keep_in ? 1 : 0) + near.size());  // one allocation, no check moved twice
-  out.checks.push_back(boxCheck(Level::kCorridor, level1, v.volume, tol));
-  out.checks.push_back(boxCheck(Level::kAirspace, level2, v.volume, tol));
+  const auto [in1, in2] = level1.containsWith(level2, v.volume, tol);
+  out.checks.push_back(boxCheck(Level::kCorridor, in1));
+  out.checks.push_back(boxCheck(Level::kAirspace, in2));
   if (keep_in) out.checks.push_back(std::move(*keep_in));
   out.checks.insert(out.checks.end(), std::make_move_iterator(near.begin()), std::make_move_iterator(near.end()));
 

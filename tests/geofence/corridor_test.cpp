@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <cstring>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -589,6 +590,51 @@ TEST(Corridor, SkippingFarLegsPicksTheSamePieceAsScanningEveryLeg) {
   }
   EXPECT_GT(compared, 20000);
   EXPECT_GT(chosen_not_first, 10000);
+}
+
+/// Every field of two containments, to the bit.
+::testing::AssertionResult sameContainment(const Containment& a, const Containment& b) {
+  if (a.verdict == b.verdict && a.segment == b.segment && a.across_joint == b.across_joint &&
+      std::memcmp(&a.margin_h_m, &b.margin_h_m, sizeof(double)) == 0 &&
+      std::memcmp(&a.margin_v_m, &b.margin_v_m, sizeof(double)) == 0) {
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure() << "segment " << a.segment << " vs " << b.segment << ", margins (" << a.margin_h_m
+                                       << ", " << a.margin_v_m << ") vs (" << b.margin_h_m << ", " << b.margin_v_m << ")";
+}
+
+TEST(Corridor, TwoLevelsOnOnePathAnswerAsEachAlone) {
+  // GIVEN a fence's two levels on one random path (first level 1.2 × a vehicle, second 300 ×),
+  // and a corridor on a path as long, 300 m east
+  std::mt19937 rng(22);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int compared = 0, across_joint = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    std::vector<Eigen::Vector3d> path;
+    const int legs = 1 + static_cast<int>(rng() % 20);
+    for (int i = 0; i <= legs; ++i) path.emplace_back(3000.0 * u(rng), 3000.0 * u(rng), 100.0 + 40.0 * u(rng));
+    std::vector<Eigen::Vector3d> moved = path;
+    for (Eigen::Vector3d& p : moved) p.x() += 300.0;  // the same size, every waypoint elsewhere
+    const Corridor level1(path, {1.8, 0.6}), level2(path, {450.0, 150.0}), elsewhere(moved, {450.0, 150.0});
+    for (int k = 0; k < 500; ++k) {
+      // WHEN a volume lies near the path, near a waypoint, or far away
+      const Eigen::Vector3d& a = path[rng() % path.size()];
+      const double spread_m = k % 3 == 0 ? 4.0 : (k % 3 == 1 ? 900.0 : 20000.0);
+      const ProtectionVolume volume{{a.x() + spread_m * (u(rng) - 0.5), a.y() + spread_m * (u(rng) - 0.5), 90.0 + 60.0 * u(rng)},
+                                    0.1 + 3.0 * u(rng), 0.1 + 3.0 * u(rng)};
+      // THEN the pair's answers are each corridor's own, to the bit, on one path or two
+      const auto [in1, in2] = level1.containsWith(level2, volume);
+      ASSERT_TRUE(sameContainment(in1, level1.contains(volume))) << "trial " << trial << ", volume " << k;
+      ASSERT_TRUE(sameContainment(in2, level2.contains(volume))) << "trial " << trial << ", volume " << k;
+      const auto [again1, other] = level1.containsWith(elsewhere, volume);
+      ASSERT_TRUE(sameContainment(again1, in1));
+      ASSERT_TRUE(sameContainment(other, elsewhere.contains(volume))) << "trial " << trial << ", volume " << k;
+      ++compared;
+      across_joint += in1.across_joint || in2.across_joint;
+    }
+  }
+  EXPECT_EQ(compared, 20000);
+  EXPECT_GT(across_joint, 100) << "the joints' union search runs on shared bounds too";
 }
 
 TEST(Corridor, SegmentBoxCornersFollowTheClimb) {
