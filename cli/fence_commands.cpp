@@ -17,11 +17,17 @@
 #include "maps/parse_error.hpp"
 #include "maps/plane_grid.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <deque>
 #include <fstream>
+#include <future>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <thread>
+#include <utility>
+#include <vector>
 
 namespace skylane::cli {
 namespace {
@@ -41,6 +47,7 @@ struct FenceCheckOptions {
   double tolerance_m = 1e-6;
   std::string fix;
   std::string fixes;
+  unsigned threads = 0;  ///< 0: one per processor for a file, one for stdin
 };
 
 json checkFix(const geofence::Fix& f, const geofence::Fence& fence, const maps::PlaneGrid& projection) {
@@ -102,59 +109,162 @@ struct VerdictOut {
   }
 };
 
-/// One line of the stream: the plain form through the fast reader and writer (no allocation
-/// per fix, geofence/fix_line.hpp), anything else through parseFix and nlohmann, which word the
-/// errors. Throws what parseFix or the fence throws.
-void checkLine(const std::string& text, std::size_t line, const std::string& fixes, const geofence::Fence& fence,
-               const maps::PlaneGrid& projection, const geofence::VerdictLineWriter& writer, VerdictOut& out) {
+/// What the stream needs to check a line: the file's name (for messages), the fence, the
+/// projection of fixes and the verdict writer. All are safe to share between threads.
+struct StreamContext {
+  const std::string& fixes;
+  const geofence::Fence& fence;
+  const maps::PlaneGrid& projection;
+  const geofence::VerdictLineWriter& writer;
+};
+
+/// One line of the stream appended to `out`: the plain form through the fast reader and writer
+/// (no allocation per fix, geofence/fix_line.hpp), anything else through parseFix and nlohmann,
+/// which word the errors. Throws what parseFix or the fence throws.
+void checkLine(const std::string& text, std::size_t line, const StreamContext& c, std::string& out) {
   geofence::PlainFix f;
   if (geofence::readPlainFixLine(text, f)) {
-    const Eigen::Vector2d p = projection.toPlane(f.lat_rad, f.lon_rad);
+    const Eigen::Vector2d p = c.projection.toPlane(f.lat_rad, f.lon_rad);
     const geofence::TimedVolume v{f.t0, f.t1, {Eigen::Vector3d(p.x(), p.y(), f.h_ell_m), f.hpl_m, f.vpl_m}};
-    if (writer.append(out.buffer, f.id_json, f.t0, f.t1, line, fence.check(v))) return;
+    if (c.writer.append(out, f.id_json, f.t0, f.t1, line, c.fence.check(v))) return;
   }
-  const std::string source = fixes + ":" + std::to_string(line);
-  json j = checkFix(geofence::parseFix(maps::parseJsonLine(text, source), source), fence, projection);
+  const std::string source = c.fixes + ":" + std::to_string(line);
+  json j = checkFix(geofence::parseFix(maps::parseJsonLine(text, source), source), c.fence, c.projection);
   j["line"] = line;
-  out.buffer += j.dump();
-  out.buffer += '\n';
+  out += j.dump();
+  out += '\n';
 }
 
-void checkStream(const FenceCheckOptions& o, const geofence::Fence& fence, const maps::PlaneFrame& frame) {
-  // A stream: one verdict line per fix; a bad line is reported (stdout and stderr), skipped,
-  // and the stream goes on.
-  std::ifstream file;
-  if (o.fixes != "-") {
-    maps::requireNotAFolder(o.fixes, "--fixes");
-    file.open(o.fixes);
-    if (!file) throw ParseError(o.fixes, 0, "--fixes", o.fixes, "a readable JSON-lines file");
-  }
-  std::istream& in = o.fixes == "-" ? std::cin : file;
-  const geofence::VerdictLineWriter writer(fence);
-  const maps::PlaneGrid projection(frame);
+/// The event line for a line the stream skips. The message quotes the line, which may hold bytes
+/// that are not UTF-8: replaced, not fatal.
+std::string rejectedLine(std::size_t line, const std::exception& e) {
+  return json{{"event", "rejected_input"}, {"line", line}, {"error", e.what()}}.dump(-1, ' ', false, json::error_handler_t::replace) +
+         "\n";
+}
+
+/// Lines checked and skipped.
+struct StreamCount {
+  std::size_t checked = 0, rejected = 0;
+};
+
+/// Opens --fixes (a file, or - for stdin).
+std::istream& openFixes(const std::string& fixes, std::ifstream& file) {
+  if (fixes == "-") return std::cin;
+  maps::requireNotAFolder(fixes, "--fixes");
+  file.open(fixes);
+  if (!file) throw ParseError(fixes, 0, "--fixes", fixes, "a readable JSON-lines file");
+  return file;
+}
+
+/// The stream on one thread: each verdict written as its line is read (stdout in 64 kB blocks).
+StreamCount checkSequentially(std::istream& in, const StreamContext& c) {
   VerdictOut out;
   out.buffer.reserve(2 * VerdictOut::kFlushBytes);
+  StreamCount count;
   std::string text;
-  std::size_t line = 0, checked = 0, rejected = 0;
-  while (std::getline(in, text)) {
-    ++line;
+  for (std::size_t line = 1; std::getline(in, text); ++line) {
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
     try {
-      checkLine(text, line, o.fixes, fence, projection, writer, out);
-      ++checked;
+      checkLine(text, line, c, out.buffer);
+      ++count.checked;
     } catch (const std::exception& e) {  // ParseError, or a fix the checker refuses
-      ++rejected;
-      // The message quotes the line, which may hold bytes that are not UTF-8: replaced, not fatal.
-      out.buffer += json{{"event", "rejected_input"}, {"line", line}, {"error", e.what()}}.dump(-1, ' ', false, json::error_handler_t::replace);
-      out.buffer += '\n';
+      ++count.rejected;
+      out.buffer += rejectedLine(line, e);
       out.flush();
       std::cerr << "skylane: skipped: " << e.what() << "\n";
     }
     if (out.buffer.size() >= VerdictOut::kFlushBytes) out.flush();
   }
   out.flush();
-  std::cerr << "skylane: fence check: " << checked << " fix" << (checked == 1 ? "" : "es") << " checked, " << rejected
-            << " rejected\n";
+  return count;
+}
+
+/// A block of the stream's lines (blank lines left out), with their numbers in the file.
+struct LineBlock {
+  static constexpr std::size_t kLines = 1024;
+  std::vector<std::string> lines;
+  std::vector<std::size_t> numbers;
+};
+
+/// A block's verdict lines, and the messages of the lines it skipped, each with the length of
+/// `out` written before it.
+struct CheckedBlock {
+  std::string out;
+  std::vector<std::pair<std::size_t, std::string>> messages;
+  StreamCount count;
+};
+
+CheckedBlock checkBlock(const LineBlock& block, const StreamContext& c) {
+  CheckedBlock done;
+  done.out.reserve(block.lines.size() * 1024);
+  for (std::size_t k = 0; k < block.lines.size(); ++k) {
+    try {
+      checkLine(block.lines[k], block.numbers[k], c, done.out);
+      ++done.count.checked;
+    } catch (const std::exception& e) {
+      ++done.count.rejected;
+      done.out += rejectedLine(block.numbers[k], e);
+      done.messages.emplace_back(done.out.size(), e.what());
+    }
+  }
+  return done;
+}
+
+/// Writes a checked block as checkSequentially would have: stdout up to each skipped line's
+/// event, then its message on stderr.
+void writeBlock(const CheckedBlock& b, StreamCount& total) {
+  std::size_t written = 0;
+  for (const auto& [end, message] : b.messages) {
+    std::cout.write(b.out.data() + written, static_cast<std::streamsize>(end - written));
+    std::cout.flush();
+    std::cerr << "skylane: skipped: " << message << "\n";
+    written = end;
+  }
+  std::cout.write(b.out.data() + written, static_cast<std::streamsize>(b.out.size() - written));
+  total.checked += b.count.checked;
+  total.rejected += b.count.rejected;
+}
+
+/// The stream on `threads` threads: blocks of lines checked in parallel, written in order (the
+/// same bytes as checkSequentially).
+StreamCount checkInParallel(std::istream& in, const StreamContext& c, unsigned threads) {
+  std::deque<std::future<CheckedBlock>> running;
+  StreamCount total;
+  LineBlock block;
+  const auto launch = [&] {
+    running.push_back(std::async(std::launch::async, [&c, b = std::move(block)] { return checkBlock(b, c); }));
+    block = LineBlock{};
+    while (running.size() >= threads) {
+      writeBlock(running.front().get(), total);
+      running.pop_front();
+    }
+  };
+  std::string text;
+  for (std::size_t line = 1; std::getline(in, text); ++line) {
+    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
+    block.lines.push_back(std::move(text));
+    block.numbers.push_back(line);
+    if (block.lines.size() == LineBlock::kLines) launch();
+  }
+  if (!block.lines.empty()) launch();
+  for (; !running.empty(); running.pop_front()) writeBlock(running.front().get(), total);
+  std::cout.flush();
+  return total;
+}
+
+void checkStream(const FenceCheckOptions& o, const geofence::Fence& fence, const maps::PlaneFrame& frame) {
+  // A stream: one verdict line per fix; a bad line is reported (stdout and stderr), skipped,
+  // and the stream goes on.
+  std::ifstream file;
+  std::istream& in = openFixes(o.fixes, file);
+  const geofence::VerdictLineWriter writer(fence);
+  const maps::PlaneGrid projection(frame);
+  const StreamContext context{o.fixes, fence, projection, writer};
+  // A live feed on stdin is answered line by line; a file on every processor unless told.
+  const unsigned threads = o.threads > 0 ? o.threads : (o.fixes == "-" ? 1u : std::max(1u, std::thread::hardware_concurrency()));
+  const StreamCount count = threads == 1 ? checkSequentially(in, context) : checkInParallel(in, context, threads);
+  std::cerr << "skylane: fence check: " << count.checked << " fix" << (count.checked == 1 ? "" : "es") << " checked, "
+            << count.rejected << " rejected\n";
 }
 
 }  // namespace
@@ -176,6 +286,10 @@ void addFenceCommands(CLI::App& app) {
   check->add_option("--tolerance", o->tolerance_m, "Margins within this of 0 are indeterminate [m]");
   check->add_option("--fix", o->fix, R"(One fix: {"time":"...Z","lat":..,"lon":..,"h_ell_m":..,"hpl_m":..,"vpl_m":..})");
   check->add_option("--fixes", o->fixes, "JSON-lines file of fixes, or - for stdin");
+  check->add_option("--threads", o->threads,
+                    "Threads checking a --fixes file, in blocks of 1,024 lines written in order (default: one per "
+                    "processor for a file, one for stdin)")
+      ->check(CLI::Range(1u, 256u));
   check->callback([o] { runFenceCheck(*o); });
 }
 

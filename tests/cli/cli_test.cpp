@@ -10,6 +10,8 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <random>
+#include <algorithm>
 #include <iterator>
 #include <cstdio>
 #include <sstream>
@@ -509,6 +511,39 @@ TEST(Cli, FenceCheckStreamsVerdictsAndSkipsBadLines) {
   for (const auto& c : lines[3]["checks"]) in_event = in_event || (c["subject"] == "EX-ZH-EVENT" && c["verdict"] == "met");
   EXPECT_TRUE(in_event) << lines[3].dump();
   for (const auto& c : lines[4]["checks"]) EXPECT_NE(c["subject"], "EX-ZH-EVENT");
+}
+
+TEST(Cli, FenceCheckOnSeveralThreadsWritesTheBytesOfOneThread) {
+  // GIVEN 3,500 fixes over the example's corridor, zones and buildings (three blocks and a
+  // half), with bad lines and blank lines in every block, at a block's first and last line too
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::ostringstream text;
+  for (int k = 1; k <= 3500; ++k) {
+    if (k % 997 == 0 || k == 1026 || k == 1027) {  // 1026, 1027: the 1,024th and 1,025th non-blank lines
+      text << (k % 2 == 0 ? "not json" : R"({"time":"2026-11-23T12:00:00Z","lat":47.3763,"lon":8.5405,"h_ell_m":515,"hpl_m":-1,"vpl_m":1})") << "\n";
+    } else if (k % 501 == 0) {
+      text << "  \n";
+    } else {
+      char line[256];
+      std::snprintf(line, sizeof line, R"({"id":%d,"time":"2026-11-23T12:%02d:%02dZ","lat":%.7f,"lon":%.7f,"h_ell_m":%.2f,"hpl_m":%.2f,"vpl_m":%.2f})",
+                    k, k / 60 % 60, k % 60, 47.3745 + 0.0045 * u(rng), 8.5385 + 0.0065 * u(rng), 480.0 + 80.0 * u(rng),
+                    0.5 + 20.0 * u(rng), 0.5 + 10.0 * u(rng));
+      text << line << "\n";
+    }
+  }
+  const std::string fixes = writeTemp("threads.jsonl", text.str());
+  // WHEN it is checked on one thread and on three (stdout and stderr together, in their order)
+  const RunResult one = run(fenceArgs() + " --fixes " + fixes + " --threads 1");
+  const RunResult three = run(fenceArgs() + " --fixes " + fixes + " --threads 3");
+  // THEN both say the same, byte for byte, with every line answered and the bad ones skipped
+  ASSERT_EQ(one.status, 0) << one.out.substr(0, 2000);
+  ASSERT_EQ(three.status, 0);
+  EXPECT_TRUE(one.out == three.out) << "the outputs differ (" << one.out.size() << " and " << three.out.size() << " bytes)";
+  EXPECT_NE(one.out.find("skylane: fence check: 3489 fixes checked, 5 rejected"), std::string::npos) << one.out.substr(one.out.size() - 300);
+  EXPECT_EQ(std::count(one.out.begin(), one.out.end(), '\n'), 3489 + 2 * 5 + 1);  // verdicts, events and messages, the summary
+  // AND a thread count of 0 is refused with exit 2
+  EXPECT_EQ(run(fenceArgs() + " --fixes " + fixes + " --threads 0").status, 2);
 }
 
 TEST(Cli, FenceCheckRefusesABadCorridorFileWithExitTwo) {
