@@ -143,10 +143,9 @@ void BM_FenceCheck10kZonesDense(benchmark::State& state) {
   static const geofence::Fence fence = makeFence(scene, kDenseArea_m);
   runChecks(state, scene, fence, kDenseArea_m, false);
 }
-/// One corridor's containment (the second-level box of the sparse scene) for volumes spread
-/// uniformly over the area: the part of a fence check that the corridors take.
-void BM_CorridorContains(benchmark::State& state) {
-  const geofence::Corridor corridor(benchPath(kArea_m), geofence::alertLimits({1.5, 1.2, 0.5}, {}).level2);
+/// 4,096 volumes spread uniformly over the sparse scene (positions, heights and PLs as in
+/// runChecks).
+std::vector<geofence::ProtectionVolume> uniformVolumes() {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<geofence::ProtectionVolume> volumes;
@@ -154,6 +153,14 @@ void BM_CorridorContains(benchmark::State& state) {
     volumes.push_back({Eigen::Vector3d(kArea_m * u(rng), kArea_m * u(rng), 380.0 + 420.0 * u(rng)), 2.0 + 48.0 * u(rng),
                        2.0 + 48.0 * u(rng)});
   }
+  return volumes;
+}
+
+/// One corridor's containment (the second-level box of the sparse scene) for volumes spread
+/// uniformly over the area: the part of a fence check that the corridors take.
+void BM_CorridorContains(benchmark::State& state) {
+  const geofence::Corridor corridor(benchPath(kArea_m), geofence::alertLimits({1.5, 1.2, 0.5}, {}).level2);
+  const std::vector<geofence::ProtectionVolume> volumes = uniformVolumes();
   std::size_t k = 0, inside = 0;
   for (auto _ : state) {
     inside += corridor.contains(volumes[k++ & 4095]).verdict == geofence::Verdict::kInside;
@@ -170,13 +177,7 @@ void runTwoLevels(benchmark::State& state, bool together) {
   const std::vector<Eigen::Vector3d> path = benchPath(kArea_m);
   const geofence::LevelLimits limits = geofence::alertLimits({1.5, 1.2, 0.5}, {});
   const geofence::Corridor level1(path, limits.level1), level2(path, limits.level2);
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<geofence::ProtectionVolume> volumes;
-  for (int i = 0; i < 4096; ++i) {
-    volumes.push_back({Eigen::Vector3d(kArea_m * u(rng), kArea_m * u(rng), 380.0 + 420.0 * u(rng)), 2.0 + 48.0 * u(rng),
-                       2.0 + 48.0 * u(rng)});
-  }
+  const std::vector<geofence::ProtectionVolume> volumes = uniformVolumes();
   std::size_t k = 0, inside = 0;
   for (auto _ : state) {
     const geofence::ProtectionVolume& v = volumes[k++ & 4095];
