@@ -197,16 +197,18 @@ BENCHMARK(BM_TwoLevelsEachAlone);
 BENCHMARK(BM_TwoLevelsTogether);
 
 /// One zone's narrow phase: a scene of one piece 150 m tall — a disk of radius 50 m (an FCL
-/// cylinder) or an octagon of circumradius 60 m (an FCL convex prism) — and volumes (HPL, VPL
-/// 0.5–3 m) 5–150 m outside it at heights within its band, horizon 200 m: each query measures
-/// one FCL GJK distance (the part of a fence check that grows with the zones reported).
-void runOneZoneQueries(benchmark::State& state, bool disk) {
+/// cylinder; argument 0) or a regular prism of that many sides and circumradius 60 m (an FCL
+/// convex) — and volumes (HPL, VPL 0.5–3 m) 5–150 m outside it at heights within its band,
+/// horizon 200 m: each query measures one FCL GJK distance (the part of a fence check that grows
+/// with the zones reported).
+void BM_OneZone(benchmark::State& state) {
+  const auto sides = static_cast<int>(state.range(0));
   airspace::PlanarPrism piece;
   piece.floor_h_ell_m = 400.0;
   piece.ceiling_h_ell_m = 550.0;
-  const double radius_m = disk ? 50.0 : 60.0;
-  if (disk) piece.radius_m = radius_m;
-  for (int k = 0; !disk && k < 8; ++k) piece.ring.emplace_back(radius_m * std::cos(k * M_PI / 4), radius_m * std::sin(k * M_PI / 4));
+  const double radius_m = sides == 0 ? 50.0 : 60.0;
+  if (sides == 0) piece.radius_m = radius_m;
+  for (int k = 0; k < sides; ++k) piece.ring.emplace_back(radius_m * std::cos(2 * M_PI * k / sides), radius_m * std::sin(2 * M_PI * k / sides));
   const geofence::Scene scene({{piece, geofence::PieceOwner::kZone, 0}});
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -222,10 +224,7 @@ void runOneZoneQueries(benchmark::State& state, bool disk) {
   if (hits != static_cast<std::size_t>(state.iterations())) state.SkipWithError("a volume was not within the horizon");
   state.SetItemsProcessed(state.iterations());
 }
-void BM_OneZoneDisk(benchmark::State& state) { runOneZoneQueries(state, true); }
-void BM_OneZonePrism(benchmark::State& state) { runOneZoneQueries(state, false); }
-BENCHMARK(BM_OneZoneDisk);
-BENCHMARK(BM_OneZonePrism);
+BENCHMARK(BM_OneZone)->Arg(0)->Arg(4)->Arg(8)->Arg(16)->Arg(64);
 
 BENCHMARK(BM_FenceCheck10kZones)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_FenceCheck10kZonesNearZones)->Unit(benchmark::kMillisecond)->Iterations(1);
