@@ -121,7 +121,7 @@ struct StreamContext {
 /// One line of the stream appended to `out`: the plain form through the fast reader and writer
 /// (no allocation per fix, geofence/fix_line.hpp), anything else through parseFix and nlohmann,
 /// which word the errors. Throws what parseFix or the fence throws.
-void checkLine(const std::string& text, std::size_t line, const StreamContext& c, std::string& out) {
+void checkLine(std::string_view text, std::size_t line, const StreamContext& c, std::string& out) {
   geofence::PlainFix f;
   if (geofence::readPlainFixLine(text, f)) {
     const Eigen::Vector2d p = c.projection.toPlane(f.lat_rad, f.lon_rad);
@@ -129,7 +129,7 @@ void checkLine(const std::string& text, std::size_t line, const StreamContext& c
     if (c.writer.append(out, f.id_json, f.t0, f.t1, line, c.fence.check(v))) return;
   }
   const std::string source = c.fixes + ":" + std::to_string(line);
-  json j = checkFix(geofence::parseFix(maps::parseJsonLine(text, source), source), c.fence, c.projection);
+  json j = checkFix(geofence::parseFix(maps::parseJsonLine(std::string(text), source), source), c.fence, c.projection);
   j["line"] = line;
   out += j.dump();
   out += '\n';
@@ -179,11 +179,23 @@ StreamCount checkSequentially(std::istream& in, const StreamContext& c) {
   return count;
 }
 
-/// A block of the stream's lines (blank lines left out), with their numbers in the file.
+/// A block of the stream's lines (blank lines left out) one after the other in one string, with
+/// where each ends and its number in the file.
 struct LineBlock {
   static constexpr std::size_t kLines = 1024;
-  std::vector<std::string> lines;
+  std::string text;
+  std::vector<std::size_t> ends;
   std::vector<std::size_t> numbers;
+  void add(const std::string& line, std::size_t number) {
+    text += line;
+    ends.push_back(text.size());
+    numbers.push_back(number);
+  }
+  [[nodiscard]] std::size_t size() const { return ends.size(); }
+  [[nodiscard]] std::string_view line(std::size_t k) const {
+    const std::size_t begin = k == 0 ? 0 : ends[k - 1];
+    return std::string_view(text).substr(begin, ends[k] - begin);
+  }
 };
 
 /// A block's verdict lines, and the messages of the lines it skipped, each with the length of
@@ -196,10 +208,10 @@ struct CheckedBlock {
 
 CheckedBlock checkBlock(const LineBlock& block, const StreamContext& c) {
   CheckedBlock done;
-  done.out.reserve(block.lines.size() * 1024);
-  for (std::size_t k = 0; k < block.lines.size(); ++k) {
+  done.out.reserve(block.size() * 1024);
+  for (std::size_t k = 0; k < block.size(); ++k) {
     try {
-      checkLine(block.lines[k], block.numbers[k], c, done.out);
+      checkLine(block.line(k), block.numbers[k], c, done.out);
       ++done.count.checked;
     } catch (const std::exception& e) {
       ++done.count.rejected;
@@ -242,11 +254,10 @@ StreamCount checkInParallel(std::istream& in, const StreamContext& c, unsigned t
   std::string text;
   for (std::size_t line = 1; std::getline(in, text); ++line) {
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-    block.lines.push_back(std::move(text));
-    block.numbers.push_back(line);
-    if (block.lines.size() == LineBlock::kLines) launch();
+    block.add(text, line);
+    if (block.size() == LineBlock::kLines) launch();
   }
-  if (!block.lines.empty()) launch();
+  if (block.size() > 0) launch();
   for (; !running.empty(); running.pop_front()) writeBlock(running.front().get(), total);
   std::cout.flush();
   return total;
