@@ -147,6 +147,21 @@ struct StreamCount {
   std::size_t checked = 0, rejected = 0;
 };
 
+/// Appends the line's verdict to `out`, or — when the line is refused (a ParseError, or a fix the
+/// checker refuses) — its rejected_input event, and returns the refusal's message then.
+std::optional<std::string> answerLine(std::string_view text, std::size_t line, const StreamContext& c, std::string& out,
+                                      StreamCount& count) {
+  try {
+    checkLine(text, line, c, out);
+    ++count.checked;
+    return std::nullopt;
+  } catch (const std::exception& e) {
+    ++count.rejected;
+    out += rejectedLine(line, e);
+    return std::string(e.what());
+  }
+}
+
 /// Opens --fixes (a file, or - for stdin).
 std::istream& openFixes(const std::string& fixes, std::ifstream& file) {
   if (fixes == "-") return std::cin;
@@ -164,14 +179,9 @@ StreamCount checkSequentially(std::istream& in, const StreamContext& c) {
   std::string text;
   for (std::size_t line = 1; std::getline(in, text); ++line) {
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
-    try {
-      checkLine(text, line, c, out.buffer);
-      ++count.checked;
-    } catch (const std::exception& e) {  // ParseError, or a fix the checker refuses
-      ++count.rejected;
-      out.buffer += rejectedLine(line, e);
+    if (const std::optional<std::string> message = answerLine(text, line, c, out.buffer, count)) {
       out.flush();
-      std::cerr << "skylane: skipped: " << e.what() << "\n";
+      std::cerr << "skylane: skipped: " << *message << "\n";
     }
     if (out.buffer.size() >= VerdictOut::kFlushBytes) out.flush();
   }
@@ -210,13 +220,8 @@ CheckedBlock checkBlock(const LineBlock& block, const StreamContext& c) {
   CheckedBlock done;
   done.out.reserve(block.size() * 1024);
   for (std::size_t k = 0; k < block.size(); ++k) {
-    try {
-      checkLine(block.line(k), block.numbers[k], c, done.out);
-      ++done.count.checked;
-    } catch (const std::exception& e) {
-      ++done.count.rejected;
-      done.out += rejectedLine(block.numbers[k], e);
-      done.messages.emplace_back(done.out.size(), e.what());
+    if (std::optional<std::string> message = answerLine(block.line(k), block.numbers[k], c, done.out, done.count)) {
+      done.messages.emplace_back(done.out.size(), std::move(*message));
     }
   }
   return done;

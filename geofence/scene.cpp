@@ -51,6 +51,18 @@ std::optional<RingEdge> ringEdge(const Eigen::Vector2d& a, const Eigen::Vector2d
   return RingEdge{a.x(), a.y(), e.x(), e.y(), length, length * length};
 }
 
+/// A point x seen from a ring's edge: `cross` > 0 when x lies left of it (the inside side of a
+/// counter-clockwise ring), and (dx, dy) = x − the edge's point nearest to x.
+struct EdgeView {
+  double cross, dx, dy;
+};
+
+EdgeView viewFromEdge(const RingEdge& e, const Eigen::Vector2d& x) {
+  const double ax = x.x() - e.ax, ay = x.y() - e.ay;
+  const double t = std::clamp((ax * e.ex + ay * e.ey) / e.length2, 0.0, 1.0);
+  return {e.ex * ay - e.ey * ax, ax - t * e.ex, ay - t * e.ey};
+}
+
 /// Signed horizontal distance from a point to a convex counter-clockwise ring, edge by edge:
 /// positive outside (the distance to the ring), negative inside (minus the distance to its
 /// boundary: the least distance to its edges' lines).
@@ -58,13 +70,10 @@ class SignedRingDistance {
  public:
   explicit SignedRingDistance(const Eigen::Vector2d& x) : x_(x) {}
   void add(const RingEdge& e) {
-    const double ax = x_.x() - e.ax, ay = x_.y() - e.ay;
-    const double cross = e.ex * ay - e.ey * ax;  // > 0: x left of the edge (inside side)
-    if (cross < 0) is_inside_ = false;
-    inside_ = std::min(inside_, cross / e.length);
-    const double t = std::clamp((ax * e.ex + ay * e.ey) / e.length2, 0.0, 1.0);
-    const double dx = ax - t * e.ex, dy = ay - t * e.ey;
-    outside2_ = std::min(outside2_, dx * dx + dy * dy);  // the root of the least is the least root
+    const EdgeView v = viewFromEdge(e, x_);
+    if (v.cross < 0) is_inside_ = false;
+    inside_ = std::min(inside_, v.cross / e.length);
+    outside2_ = std::min(outside2_, v.dx * v.dx + v.dy * v.dy);  // the root of the least is the least root
   }
   [[nodiscard]] double value() const { return is_inside_ ? -inside_ : std::sqrt(outside2_); }
 
@@ -410,13 +419,11 @@ Eigen::Vector3d ShapeTable::towardPiece(const Eigen::Vector3d& centre, std::size
     bool inside = true;
     double nearest2 = kInf;
     for (const RingEdge* e = edges_.data() + p.first, *end = e + p.count; e != end; ++e) {
-      const double ax = centre.x() - e->ax, ay = centre.y() - e->ay;
-      if (e->ex * ay - e->ey * ax < 0) inside = false;
-      const double t = std::clamp((ax * e->ex + ay * e->ey) / e->length2, 0.0, 1.0);
-      const double dx = t * e->ex - ax, dy = t * e->ey - ay;
-      if (dx * dx + dy * dy < nearest2) {
-        nearest2 = dx * dx + dy * dy;
-        to_shape = {dx, dy};
+      const EdgeView v = viewFromEdge(*e, centre.head<2>());
+      if (v.cross < 0) inside = false;
+      if (v.dx * v.dx + v.dy * v.dy < nearest2) {
+        nearest2 = v.dx * v.dx + v.dy * v.dy;
+        to_shape = {-v.dx, -v.dy};
       }
     }
     if (inside) to_shape.setZero();
@@ -518,11 +525,13 @@ Separation Scene::Impl::settle(std::size_t i, NarrowQuery& query, Separation s) 
   // margins put the volume deep inside; anything else — contact, a near miss, a disagreement,
   // a failure — goes to the exact predicate. The clearance reported is the closed form.
   const double deciding_m = std::max(s.margin_h_m, s.margin_v_m);
-  const Eigen::Vector3d toward_piece = shapes.towardPiece(volume.p_map, i);
   for (const detail::GjkSolver solver : solvers) {
     double d = 0.0;
     try {
-      d = fcl->distance(i, solver, toward_piece);  // from this thread's query cylinder, the volume (query())
+      // From this thread's query cylinder, the volume (query()); only FCL's own GJK takes a start.
+      const Eigen::Vector3d toward_piece =
+          solver == detail::GjkSolver::kIndep ? shapes.towardPiece(volume.p_map, i) : Eigen::Vector3d::Zero();
+      d = fcl->distance(i, solver, toward_piece);
     } catch (const std::exception&) {
       s.fcl_failed = true;  // FCL's GJK/EPA can throw near contact
       continue;
