@@ -224,9 +224,11 @@ std::vector<std::string> handoffStates(const std::vector<json>& events, const st
 }
 
 TEST_F(TrackCli, AReplanIsUploadedToTheVehicleWhichJoinsTheNewCorridorWithOneReplan) {
-  // GIVEN a vehicle (node-mavlink) pushed 8 m aside by a 14 s gust, flying at 5 × real time
+  // GIVEN a vehicle (node-mavlink) pushed 8 m aside by a 14 s gust, flying at 5 × real time for
+  // 80 s. The upload's round trips run in wall time: under ASan the vehicle rejoined at fix 197
+  // to 254, and a 70 s flight left 97–154 fixes after it, against the 100 asked below.
   const std::string plans = *dir_ + "/handoff_plans";
-  const MavlinkRun r = flyMavlinkVehicle(*dir_, "handoff", "--seconds 70 --pace-ms 40 --gust-from 20 --gust-until 34 --gust-m 8",
+  const MavlinkRun r = flyMavlinkVehicle(*dir_, "handoff", "--seconds 80 --pace-ms 40 --gust-from 20 --gust-until 34 --gust-m 8",
                                          "--plans " + plans);
   ASSERT_NE(r.out.find("status=0"), std::string::npos) << r.out;
   ASSERT_EQ(r.out.find("vehicle-failed"), std::string::npos) << r.out;
