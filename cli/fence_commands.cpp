@@ -126,7 +126,9 @@ void checkLine(std::string_view text, std::size_t line, const StreamContext& c, 
   if (geofence::readPlainFixLine(text, f)) {
     const Eigen::Vector2d p = c.projection.toPlane(f.lat_rad, f.lon_rad);
     const geofence::TimedVolume v{f.t0, f.t1, {Eigen::Vector3d(p.x(), p.y(), f.h_ell_m), f.hpl_m, f.vpl_m}};
-    if (c.writer.append(out, f.id_json, f.t0, f.t1, line, c.fence.check(v))) return;
+    thread_local geofence::FenceVerdict verdict;  // this thread's, its storage reused fix after fix
+    c.fence.check(v, verdict);
+    if (c.writer.append(out, f.id_json, f.t0, f.t1, line, verdict)) return;
   }
   const std::string source = c.fixes + ":" + std::to_string(line);
   json j = checkFix(geofence::parseFix(maps::parseJsonLine(std::string(text), source), source), c.fence, c.projection);

@@ -22,18 +22,17 @@ constexpr double kLeastRadiusOfCurvature_m = 6378137.0 * (1.0 - 0.00669437999014
 /// The worse of two verdicts: outside over indeterminate over inside.
 int severity(Verdict v) { return v == Verdict::kOutside ? 2 : (v == Verdict::kIndeterminate ? 1 : 0); }
 
-/// std::stable_sort's order (equal elements keep theirs), by insertion for a few checks (a check
-/// usually reports a handful of zones, and std::stable_sort allocates a buffer for every call).
-template <class Less>
-void stableSortByInsertion(std::vector<Check>& checks, Less less) {
-  constexpr std::size_t kInsertionMax = 32;
-  if (checks.size() > kInsertionMax) {
-    std::stable_sort(checks.begin(), checks.end(), less);
+/// std::stable_sort's order (equal elements keep theirs) over [first, last), by insertion for a
+/// few checks (a check usually reports a handful of zones, and std::stable_sort allocates a
+/// buffer for every call).
+template <class Iterator, class Less>
+void stableSortByInsertion(Iterator first, Iterator last, Less less) {
+  constexpr std::ptrdiff_t kInsertionMax = 32;
+  if (last - first > kInsertionMax) {
+    std::stable_sort(first, last, less);
     return;
   }
-  for (auto i = checks.begin(); i != checks.end(); ++i) {
-    std::rotate(std::upper_bound(checks.begin(), i, *i, less), i, std::next(i));
-  }
+  for (Iterator i = first; i != last; ++i) std::rotate(std::upper_bound(first, i, *i, less), i, std::next(i));
 }
 
 Check boxCheck(Level level, const Containment& c) {
@@ -204,43 +203,48 @@ std::optional<ProtectionVolume> Obstructions::sceneVolume(const ProtectionVolume
   return volume;
 }
 
-std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) const {
-  const std::optional<ProtectionVolume> volume = sceneVolume(v.volume);
-  if (!volume) return {};
-  const std::vector<SceneHit> hits =
-      scene_.query(*volume, horizon_m, [&](PieceOwner owner, std::size_t i) { return takes(owner, i, v); });
-
-  // One check per zone or obstacle, from the piece that decides it.
-  std::vector<Check> near;
-  near.reserve(hits.size());
-  for (const SceneHit& h : hits) {
-    const Separation& s = h.separation;
-    Check c;
-    c.level = h.owner == PieceOwner::kZone ? Level::kZone : Level::kObstacle;
-    c.index = h.owner_index;
-    if (c.level == Level::kZone) {
-      const airspace::Zone& z = zones_[h.owner_index];
-      c.subject = z.identifier;
-      c.name = z.name;
-      c.restriction = std::string(airspace::restrictionLabel(z));
-    } else {
-      c.subject = buildings_[h.owner_index].feature;
-    }
-    c.margin_h_m = s.margin_h_m;
-    c.margin_v_m = s.margin_v_m;
-    c.clearance_m = s.clearance_m;
-    c.exact = s.exact;
-    // The narrow phase has the last word on meeting; the margin says how close it is.
-    const double deciding_m = std::max(s.margin_h_m, s.margin_v_m);
-    c.verdict = s.meets ? (deciding_m >= -options_.tolerance_m ? Verdict::kIndeterminate : Verdict::kOutside)
-                        : (deciding_m <= options_.tolerance_m ? Verdict::kIndeterminate : Verdict::kInside);
-    near.push_back(std::move(c));
+Check Obstructions::hitCheck(const SceneHit& h) const {
+  const Separation& s = h.separation;
+  Check c;
+  c.level = h.owner == PieceOwner::kZone ? Level::kZone : Level::kObstacle;
+  c.index = h.owner_index;
+  if (c.level == Level::kZone) {
+    const airspace::Zone& z = zones_[h.owner_index];
+    c.subject = z.identifier;
+    c.name = z.name;
+    c.restriction = airspace::restrictionLabel(z);
+  } else {
+    c.subject = buildings_[h.owner_index].feature;
   }
-  stableSortByInsertion(near, [](const Check& a, const Check& b) {
+  c.margin_h_m = s.margin_h_m;
+  c.margin_v_m = s.margin_v_m;
+  c.clearance_m = s.clearance_m;
+  c.exact = s.exact;
+  // The narrow phase has the last word on meeting; the margin says how close it is.
+  const double deciding_m = std::max(s.margin_h_m, s.margin_v_m);
+  c.verdict = s.meets ? (deciding_m >= -options_.tolerance_m ? Verdict::kIndeterminate : Verdict::kOutside)
+                      : (deciding_m <= options_.tolerance_m ? Verdict::kIndeterminate : Verdict::kInside);
+  return c;
+}
+
+void Obstructions::appendChecks(const TimedVolume& v, double horizon_m, std::vector<Check>& out) const {
+  const std::optional<ProtectionVolume> volume = sceneVolume(v.volume);
+  if (!volume) return;
+  thread_local std::vector<SceneHit> hits;  // this thread's scratch: no allocation once grown
+  scene_.query(*volume, horizon_m, [&](PieceOwner owner, std::size_t i) { return takes(owner, i, v); }, hits);
+  // One check per zone or obstacle, from the piece that decides it.
+  const std::size_t first = out.size();
+  for (const SceneHit& h : hits) out.push_back(hitCheck(h));
+  stableSortByInsertion(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(), [](const Check& a, const Check& b) {
     if (a.level != b.level) return a.level < b.level;
     if (severity(a.verdict) != severity(b.verdict)) return severity(a.verdict) > severity(b.verdict);
     return *a.clearance_m < *b.clearance_m;
   });
+}
+
+std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) const {
+  std::vector<Check> near;
+  appendChecks(v, horizon_m, near);
   return near;
 }
 
@@ -265,7 +269,7 @@ Verdict Obstructions::keepInVerdict(const KeepInMargins& m) const {
 }
 
 std::optional<Check> Obstructions::keepIn(const TimedVolume& v) const {
-  std::vector<const KeepInVolume*> active;
+  thread_local std::vector<const KeepInVolume*> active;  // this thread's scratch
   const std::optional<KeepInMargins> m = keepInMarginsAt(v, active);
   if (!m) return std::nullopt;
   const airspace::Zone& z = zones_[active[m->nearest]->zone];
@@ -319,15 +323,23 @@ FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const O
 FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions,
                          const TimedVolume& v, double horizon_m) {
   FenceVerdict out;
+  checkVolume(level1, level2, obstructions, v, horizon_m, out);
+  return out;
+}
+
+void checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions, const TimedVolume& v,
+                 double horizon_m, FenceVerdict& out) {
   const double tol = obstructions.options().tolerance_m;
   std::optional<Check> keep_in = obstructions.keepIn(v);
-  std::vector<Check> near = obstructions.check(v, horizon_m);
-  out.checks.reserve(2 + (keep_in ? 1 : 0) + near.size());  // one allocation, no check moved twice
+  out.checks.clear();  // the storage stays: no allocation per check once it has grown
+  out.verdict = Verdict::kInside;
+  out.violated.reset();
+  out.deciding.reset();
   const auto [in1, in2] = level1.containsWith(level2, v.volume, tol);
   out.checks.push_back(boxCheck(Level::kCorridor, in1));
   out.checks.push_back(boxCheck(Level::kAirspace, in2));
   if (keep_in) out.checks.push_back(std::move(*keep_in));
-  out.checks.insert(out.checks.end(), std::make_move_iterator(near.begin()), std::make_move_iterator(near.end()));
+  obstructions.appendChecks(v, horizon_m, out.checks);
 
   for (int wanted : {2, 1}) {
     for (std::size_t i = 0; i < out.checks.size() && !out.deciding; ++i) {
@@ -338,10 +350,13 @@ FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const O
     out.verdict = out.checks[*out.deciding].verdict;
     out.violated = out.checks[*out.deciding].level;
   }
-  return out;
 }
 
 FenceVerdict Fence::check(const TimedVolume& v) const { return checkVolume(level1_, level2_, obstructions_, v); }
+
+void Fence::check(const TimedVolume& v, FenceVerdict& out) const {
+  checkVolume(level1_, level2_, obstructions_, v, obstructions_.options().horizon_m, out);
+}
 
 std::vector<FenceVerdict> Fence::check(const std::vector<TimedVolume>& samples) const {
   std::vector<FenceVerdict> out;

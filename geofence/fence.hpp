@@ -138,6 +138,9 @@ class Obstructions {
   [[nodiscard]] std::vector<Check> check(const TimedVolume& v) const;
   /// \brief The same within `horizon_m`.
   [[nodiscard]] std::vector<Check> check(const TimedVolume& v, double horizon_m) const;
+  /// \brief The same appended to `out` (what checkVolume fills a verdict with): no allocation
+  /// once `out` has grown, but for a name or identifier longer than std::string keeps inline.
+  void appendChecks(const TimedVolume& v, double horizon_m, std::vector<Check>& out) const;
   /// \brief The keep-in check: the volume against the union of the keep-in zones active at some
   /// instant of [t0, t1); none when no keep-in zone is active then.
   [[nodiscard]] std::optional<Check> keepIn(const TimedVolume& v) const;
@@ -158,6 +161,8 @@ class Obstructions {
   [[nodiscard]] bool zoneCounts(std::size_t i) const { return zone_counts_.at(i); }
 
  private:
+  /// The check of one scene hit (its zone's or obstacle's names, the verdict of its separation).
+  [[nodiscard]] Check hitCheck(const SceneHit& h) const;
   /// Whether the zone or obstacle counts for a check over [v.t0, v.t1).
   [[nodiscard]] bool takes(PieceOwner owner, std::size_t i, const TimedVolume& v) const;
   /// The keep-in zones active in [v.t0, v.t1) (into `active`) and the volume's margins in their
@@ -189,6 +194,10 @@ class Obstructions {
 /// \brief The same, reporting zones and obstacles within `horizon_m` (a met one always).
 [[nodiscard]] FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions,
                                        const TimedVolume& v, double horizon_m);
+/// \brief The same into `out`, whose storage is reused: a caller that keeps one verdict makes no
+/// allocation per check once it has grown (but for names longer than std::string keeps inline).
+void checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions, const TimedVolume& v,
+                 double horizon_m, FenceVerdict& out);
 
 /// \brief Both box levels, the zones and the obstacles, checked together.
 class Fence {
@@ -203,6 +212,8 @@ class Fence {
   /// \brief Checks one volume against every level; zones count when active at some instant of
   /// [t0, t1) (at t0 when t1 ≤ t0) and counted by the policy.
   [[nodiscard]] FenceVerdict check(const TimedVolume& v) const;
+  /// \brief The same into `out`, its storage reused (checkVolume): for a stream of fixes.
+  void check(const TimedVolume& v, FenceVerdict& out) const;
   /// \brief Checks each sample of a trajectory (predicted or flown).
   [[nodiscard]] std::vector<FenceVerdict> check(const std::vector<TimedVolume>& samples) const;
 

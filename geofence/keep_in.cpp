@@ -134,12 +134,14 @@ KeepInMargins keepInMargins(const ProtectionVolume& volume, const std::vector<co
   const Eigen::Vector2d p = volume.p_map.head<2>();
   const double lo = volume.p_map.z() - volume.vpl_m;
   const double hi = volume.p_map.z() + volume.vpl_m;
-  std::vector<const KeepInVolume*> holding;
+  thread_local std::vector<const KeepInVolume*> holding;  // this thread's scratch
+  thread_local std::vector<const airspace::PlanarRing*> rings;
+  holding.clear();
+  rings.clear();
   for (const KeepInVolume* k : active) {
     if (bandRoom(*k, lo, hi) >= 0) holding.push_back(k);
   }
   const std::vector<const KeepInVolume*>& used = holding.empty() ? active : holding;
-  std::vector<const airspace::PlanarRing*> rings;
   for (const KeepInVolume* k : used) rings.push_back(&k->ring);
 
   KeepInMargins m;

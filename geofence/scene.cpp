@@ -634,6 +634,14 @@ const std::vector<ScenePiece>& Scene::pieces() const { return impl_->pieces; }
 
 std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizon_m,
                                    const std::function<bool(PieceOwner, std::size_t)>& accept) const {
+  std::vector<SceneHit> hits;
+  query(volume, horizon_m, accept, hits);
+  return hits;
+}
+
+void Scene::query(const ProtectionVolume& volume, double horizon_m, const std::function<bool(PieceOwner, std::size_t)>& accept,
+                  std::vector<SceneHit>& hits) const {
+  hits.clear();
   checkQuery(volume, horizon_m);
   // Broad phase: the AABB of the volume's cylinder grown by the horizon, against the grid.
   // The narrow phase's distances are from this thread's FCL query cylinder, placed as the
@@ -658,12 +666,10 @@ std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizo
     owners.push_back({kind, index, from, group.size()});
     return false;
   });
-  std::vector<SceneHit> hits;
   for (const Impl::OwnerGroup& owner : owners) {
     const std::optional<SceneHit> hit = impl_->ownerHit(owner, group, narrow, horizon_m);
     if (hit && (hit->separation.meets || hit->separation.clearance_m <= horizon_m)) hits.push_back(*hit);
   }
-  return hits;
 }
 
 bool Scene::reachesAny(const ProtectionVolume& volume, const std::function<bool(PieceOwner, std::size_t)>& accept) const {
