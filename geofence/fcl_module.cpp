@@ -119,23 +119,29 @@ class Pieces final : public FclPieces {
     std::size_t vertex_bytes;
   };
 
-  /// FCL's own GJK between this thread's query cylinder and the piece, as fcl::distance runs it
+  /// FCL's own GJK between the piece and this thread's query cylinder, as fcl::distance runs it
   /// for GST_INDEP (the solver's shapeDistance at the request's default tolerance; −1 in contact
-  /// or when it fails), but with its search started along `toward_piece` (FCL's cached guess:
-  /// the first support direction) instead of FCL's fixed +x.
+  /// or when it fails), but with its search started toward the query (FCL's cached guess: the
+  /// first support direction, here −toward_piece) instead of FCL's fixed +x.
+  ///
+  /// The piece is the solver's first shape. FCL takes the first shape's support in its own frame
+  /// and the second's through the pair's rotation, and (as Debian builds libfcl) the convex
+  /// support then multiplies the rotation into the direction again for every vertex: a 64-sided
+  /// prism second cost 6.6 µs a distance, first 2.7 µs (libccd 3.7 µs). The distance is the
+  /// same either way (GJK on B − A is GJK on A − B mirrored, the start mirrored with it).
   static double startedIndepDistance(const Hot& h, const Eigen::Vector3d& toward_piece) {
     fcl::detail::GJKSolver_indep<double> solver;
     solver.gjk_tolerance = fcl::DistanceRequestd().distance_tolerance;
     if (toward_piece.squaredNorm() > 0.0) {
       solver.enable_cached_guess = true;
-      solver.cached_guess = toward_piece;
+      solver.cached_guess = -toward_piece;
     }
     const QueryCylinder& q = queryCylinder();
     double d = std::numeric_limits<double>::max();
     if (h.cylinder != nullptr) {
-      solver.shapeDistance(*q.shape, q.object.getTransform(), *h.cylinder, h.object->getTransform(), &d, nullptr, nullptr);
+      solver.shapeDistance(*h.cylinder, h.object->getTransform(), *q.shape, q.object.getTransform(), &d, nullptr, nullptr);
     } else {
-      solver.shapeDistance(*q.shape, q.object.getTransform(), *h.convex, h.object->getTransform(), &d, nullptr, nullptr);
+      solver.shapeDistance(*h.convex, h.object->getTransform(), *q.shape, q.object.getTransform(), &d, nullptr, nullptr);
     }
     return d;
   }

@@ -32,12 +32,6 @@ constexpr double kFclMinSize_m = 1e-3;
 /// airspace::convexPieces are rounded to doubles, which can bend a straight run by an ulp. FCL
 /// works on the vertices' hull, which then holds the piece (the safe side).
 constexpr double kConvexityTolerance = 1e-9;
-/// A ring of this many vertices or more is measured by libccd's GJK first, a smaller one (or a
-/// disk) by FCL's own, started toward the piece: measured stand-alone (a 3 m cylinder against regular prisms, 100,000 poses),
-/// FCL's own took 1.4 / 1.7 / 1.8 / 2.2 / 3.2 / 9.3 µs at 6 / 8 / 10 / 12 / 14 / 64 vertices,
-/// libccd 2.0 / 1.9 / 2.5 / 2.3 / 2.3 / 4.2 µs.
-constexpr std::size_t kLibccdFirstFromVertices = 13;
-
 /// A ring's edge as the distance below takes it: its start, its vector, length and squared length.
 struct RingEdge {
   double ax, ay, ex, ey, length, length2;
@@ -513,19 +507,17 @@ Separation Scene::Impl::settle(std::size_t i, NarrowQuery& query, Separation s) 
   // other's second opinion; FCL's answer counts where either agrees with the closed form, and
   // the exact predicate settles the rest. FCL's own goes first, its search started toward the
   // piece's nearest point: against a curved side (a disk's cylinder) a search from FCL's fixed
-  // start creeps up on the distance, one started there converges in a few steps. But its
-  // support search costs more per vertex than libccd's: from a ring of kLibccdFirstFromVertices
-  // up, libccd goes first.
-  static const std::array<detail::GjkSolver, 2> kIndepFirst{detail::GjkSolver::kIndep, detail::GjkSolver::kLibccd};
-  static const std::array<detail::GjkSolver, 2> kLibccdFirst{detail::GjkSolver::kLibccd, detail::GjkSolver::kIndep};
+  // start creeps up on the distance, one started there converges in a few steps; with the piece
+  // as its first shape it is also the quicker per vertex (fcl_module.cpp), at every ring size
+  // measured (BM_OneZone: 4 to 64 sides).
+  static constexpr std::array<detail::GjkSolver, 2> kSolvers{detail::GjkSolver::kIndep, detail::GjkSolver::kLibccd};
   const airspace::PlanarPrism& prism = pieces[i].prism;
-  const auto& solvers = prism.ring.size() < kLibccdFirstFromVertices ? kIndepFirst : kLibccdFirst;
   // FCL decides when its distance agrees with the closed form (Separation) to kExactBand_m and
   // both are clear of contact by more than the band, or when it reports contact and the
   // margins put the volume deep inside; anything else — contact, a near miss, a disagreement,
   // a failure — goes to the exact predicate. The clearance reported is the closed form.
   const double deciding_m = std::max(s.margin_h_m, s.margin_v_m);
-  for (const detail::GjkSolver solver : solvers) {
+  for (const detail::GjkSolver solver : kSolvers) {
     double d = 0.0;
     try {
       // From this thread's query cylinder, the volume (query()); only FCL's own GJK takes a start.
