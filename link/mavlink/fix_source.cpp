@@ -19,6 +19,8 @@ constexpr double kGpsEpochUnix_s = 315964800.0;
 constexpr double kWeek_s = 604800.0;
 /// Mission-protocol frames kept for the hand-off between two ticks.
 constexpr std::size_t kMaxOtherFrames = 256;
+/// Records read ahead of the session at most (a live link's backlog beyond stays in the kernel).
+constexpr std::size_t kMaxReady = 4096;
 
 /// The GPS time of a UTC instant given in microseconds since the UNIX epoch (leap seconds applied).
 maps::GpsTime gpsFromUnix(std::uint64_t time_usec) {
@@ -120,31 +122,55 @@ std::optional<planner::SourceRecord> MavlinkFixSource::handle(const Frame& fr) {
   }
 }
 
+void MavlinkFixSource::parseReady() {
+  while (ready_.size() < kMaxReady) {
+    const std::optional<Frame> fr = parser_.next();
+    if (!fr) return;
+    // Garbage the parser skipped before this frame is reported first, numbered as the frame.
+    if (auto trouble = parserTrouble()) ready_.push_back({std::move(*trouble), frame_});
+    if (auto record = handle(*fr)) ready_.push_back({std::move(*record), frame_});
+  }
+}
+
+void MavlinkFixSource::readAhead() {
+  parseReady();
+  while (!ended_ && ready_.size() < kMaxReady) {
+    bytes_.clear();
+    const ByteLink::Status s = link_->read(bytes_, 0);
+    if (s == ByteLink::Status::kTimeout) return;
+    if (s == ByteLink::Status::kEnd) ended_ = true;
+    parser_.push(bytes_.data(), bytes_.size());
+    parseReady();
+  }
+}
+
+planner::SourceRecord MavlinkFixSource::takeReady() {
+  Ready r = std::move(ready_.front());
+  ready_.pop_front();
+  returned_frame_ = r.frame;
+  return std::move(r.record);
+}
+
+std::size_t MavlinkFixSource::checkpointLine() const { return ready_.empty() ? frame_ : returned_frame_; }
+
 planner::SourceRecord MavlinkFixSource::next(int timeout_ms) {
   for (;;) {
-    if (held_) {  // a frame read after garbage that was reported first
-      const Frame fr = *held_;
-      held_.reset();
-      if (auto record = handle(fr)) return *record;
-    }
-    while (const std::optional<Frame> fr = parser_.next()) {
-      if (auto trouble = parserTrouble()) {
-        held_ = *fr;
-        return *trouble;
-      }
-      if (auto record = handle(*fr)) return *record;
-    }
+    // A live link is read ahead: the mission protocol's frames behind a backlog of telemetry
+    // reach the hand-off at its next tick, not after every fix before them has been tracked.
+    if (link_->live()) readAhead();
+    if (!ready_.empty()) return takeReady();
     if (auto trouble = parserTrouble()) return *trouble;
     if (ended_) return endOfInput();
-    std::vector<std::uint8_t> bytes;
-    const ByteLink::Status s = link_->read(bytes, timeout_ms);
+    bytes_.clear();
+    const ByteLink::Status s = link_->read(bytes_, timeout_ms);
     if (s == ByteLink::Status::kTimeout) {
       planner::SourceRecord idle;
       idle.kind = planner::SourceRecord::Kind::kIdle;
       return idle;
     }
     if (s == ByteLink::Status::kEnd) ended_ = true;
-    parser_.push(bytes.data(), bytes.size());
+    parser_.push(bytes_.data(), bytes_.size());
+    parseReady();
   }
 }
 

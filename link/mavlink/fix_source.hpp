@@ -14,6 +14,11 @@
 /// checksums are reported as bad records with their counts, and the stream goes on.
 ///
 /// Records are numbered by the frames read (1, 2, …): a file can be resumed after a frame.
+///
+/// A live link is read ahead of the tracking: every frame that has arrived is parsed at once
+/// (up to 4,096 records waiting), so that the vehicle's mission-protocol replies reach the
+/// hand-off at its next tick even when the tracker is behind on telemetry. The checkpoint is the
+/// frame of the last record handed out, so a restart reads the waiting ones again.
 
 #include "link/byte_link.hpp"
 #include "link/mavlink/wire.hpp"
@@ -23,6 +28,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace skylane::link::mavlink {
 
@@ -47,8 +53,8 @@ class MavlinkFixSource final : public planner::FixSource {
   [[nodiscard]] const std::string& name() const override { return link_->name(); }
   [[nodiscard]] bool live() const override { return link_->live(); }
   [[nodiscard]] bool rereadable() const override { return link_->rereadable(); }
-  void resumeAfter(std::size_t line) override { resume_frame_ = line; }
-  [[nodiscard]] std::size_t checkpointLine() const override { return frame_; }
+  void resumeAfter(std::size_t line) override { resume_frame_ = returned_frame_ = line; }
+  [[nodiscard]] std::size_t checkpointLine() const override;
   [[nodiscard]] std::optional<std::uint64_t> droppedDatagrams() const override { return link_->droppedDatagrams(); }
 
   [[nodiscard]] const VehicleState& vehicle() const { return vehicle_; }
@@ -59,6 +65,17 @@ class MavlinkFixSource final : public planner::FixSource {
   [[nodiscard]] std::deque<Frame> takeOtherFrames();
 
  private:
+  /// A record made, and the frame count when it was made (the checkpoint once it is handed out).
+  struct Ready {
+    planner::SourceRecord record;
+    std::size_t frame;
+  };
+  /// Parses the whole frames the parser holds into ready_ (mission frames to other_).
+  void parseReady();
+  /// parseReady, then what the link has now (no waiting), until ready_ is full.
+  void readAhead();
+  /// The first waiting record.
+  planner::SourceRecord takeReady();
   /// The record a frame makes, if any.
   std::optional<planner::SourceRecord> handle(const Frame& fr);
   /// A bad record for the garbage and bad checksums counted since the last one, if any.
@@ -75,7 +92,9 @@ class MavlinkFixSource final : public planner::FixSource {
   std::deque<Frame> other_;
   std::size_t frame_ = 0, resume_frame_ = 0;
   ParserStats reported_;
-  std::optional<Frame> held_;
+  std::deque<Ready> ready_;
+  std::size_t returned_frame_ = 0;
+  std::vector<std::uint8_t> bytes_;  ///< the last read, reused
   bool ended_ = false, truncation_reported_ = false;
 };
 

@@ -8,7 +8,9 @@
 //    node-mavlink with the same values;
 //  * garbage, truncated frames, bad checksums and unknown message ids are counted and skipped.
 #include "link/mavlink/wire.hpp"
+#include "link/mavlink/fix_source.hpp"
 #include "link/mavlink/mission_upload.hpp"
+#include "maps/geodesy.hpp"
 
 #include "tests/test_util.hpp"
 
@@ -245,6 +247,117 @@ TEST(MissionUpload, SendsEachRequestedItemAndEndsOnTheVehiclesAcknowledgement) {
                    0.4, seq);
   EXPECT_EQ(up.state(), MissionUpload::State::kRefused);
   EXPECT_EQ(missionResultName(up.result()), "MAV_MISSION_DENIED");
+}
+
+}  // namespace
+}  // namespace skylane::link::mavlink
+
+// The MAVLink fix source reads a live link ahead of the tracking: the vehicle's mission-protocol
+// replies behind a backlog of telemetry reach the hand-off at once, the fixes still come in
+// order, and the checkpoint is the frame of the last fix handed out.
+namespace skylane::link::mavlink {
+namespace {
+
+/// A link that hands out prepared chunks of bytes, one per read, then is quiet (or ends).
+class ChunkLink final : public ByteLink {
+ public:
+  ChunkLink(std::vector<std::vector<std::uint8_t>> chunks, bool live) : chunks_(std::move(chunks)), live_(live) {}
+  Status read(std::vector<std::uint8_t>& out, int /*timeout_ms*/) override {
+    if (next_ == chunks_.size()) return live_ ? Status::kTimeout : Status::kEnd;
+    out.insert(out.end(), chunks_[next_].begin(), chunks_[next_].end());
+    ++next_;
+    return Status::kData;
+  }
+  bool write(const std::uint8_t*, std::size_t) override { return false; }
+  [[nodiscard]] bool live() const override { return live_; }
+  [[nodiscard]] bool rereadable() const override { return !live_; }
+  [[nodiscard]] const std::string& name() const override { return name_; }
+
+ private:
+  std::vector<std::vector<std::uint8_t>> chunks_;
+  std::size_t next_ = 0;
+  bool live_;
+  std::string name_ = "chunks";
+};
+
+/// GPS_RAW_INT number k: a 3-D fix at 2026-11-23T12:00:00Z + k s (time_usec since the UNIX epoch).
+std::vector<std::uint8_t> gpsFrame(int k) {
+  PayloadWriter w(*findMessage(kGpsRawInt));
+  w.set<std::uint64_t>("time_usec", (1795435200ULL + static_cast<std::uint64_t>(k)) * 1000000ULL)
+      .set<std::uint8_t>("fix_type", 3)
+      .set<std::int32_t>("lat", 473000000 + k)
+      .set<std::int32_t>("lon", 84500000)
+      .set<std::int32_t>("alt_ellipsoid", 520000)
+      .set<std::uint32_t>("h_acc", 800)
+      .set<std::uint32_t>("v_acc", 1200);
+  return encodeFrame(w.def(), w.data(), static_cast<std::uint8_t>(k), 1, 1);
+}
+
+std::vector<std::uint8_t> missionRequestFrame() {
+  PayloadWriter w(*findMessage(kMissionRequestInt));
+  w.set<std::uint8_t>("target_system", 255).set<std::uint8_t>("target_component", 190).set<std::uint16_t>("seq", 0);
+  return encodeFrame(w.def(), w.data(), 0, 1, 1);
+}
+
+/// Chunk one: `backlog` GPS frames; chunk two: a MISSION_REQUEST_INT and 5 more GPS frames.
+std::vector<std::vector<std::uint8_t>> backlogThenRequest(int backlog) {
+  std::vector<std::vector<std::uint8_t>> chunks(2);
+  for (int k = 1; k <= backlog; ++k) {
+    const std::vector<std::uint8_t> f = gpsFrame(k);
+    chunks[0].insert(chunks[0].end(), f.begin(), f.end());
+  }
+  const std::vector<std::uint8_t> request = missionRequestFrame();
+  chunks[1] = request;
+  for (int k = backlog + 1; k <= backlog + 5; ++k) {
+    const std::vector<std::uint8_t> f = gpsFrame(k);
+    chunks[1].insert(chunks[1].end(), f.begin(), f.end());
+  }
+  return chunks;
+}
+
+TEST(MavlinkFixSource, ALiveLinkIsReadAheadSoAMissionRequestBehindABacklogIsAnsweredAtOnce) {
+  constexpr int kBacklog = 300;
+  MavlinkFixSource source(std::make_shared<ChunkLink>(backlogThenRequest(kBacklog), true), "F");
+  planner::SourceRecord first = source.next(0);
+  ASSERT_EQ(first.kind, planner::SourceRecord::Kind::kFix);
+  EXPECT_EQ(first.line, 1u);
+  EXPECT_EQ(source.checkpointLine(), 1u);  // not the frames read ahead
+  const std::deque<Frame> other = source.takeOtherFrames();
+  ASSERT_EQ(other.size(), 1u);  // the request, 300 frames ahead of the tracking
+  EXPECT_EQ(other.front().msgid, kMissionRequestInt);
+
+  // The fixes still come one by one, in order, each the checkpoint once handed out; the request
+  // was frame 301.
+  std::size_t expected = 1;
+  for (int k = 2; k <= kBacklog + 5; ++k) {
+    const planner::SourceRecord r = source.next(0);
+    ASSERT_EQ(r.kind, planner::SourceRecord::Kind::kFix) << "record " << k;
+    expected += expected == static_cast<std::size_t>(kBacklog) ? 2 : 1;
+    EXPECT_EQ(r.line, expected);
+    EXPECT_EQ(source.checkpointLine(), expected);
+    EXPECT_NEAR(r.fix.lat_rad, maps::deg2rad((473000000 + k) * 1e-7), 1e-15);
+  }
+  EXPECT_EQ(source.next(0).kind, planner::SourceRecord::Kind::kIdle);
+  EXPECT_EQ(source.checkpointLine(), static_cast<std::size_t>(kBacklog + 6));
+}
+
+TEST(MavlinkFixSource, AFileIsReadAsItComesAndResumesAfterAFrame) {
+  // A recording (not live) gives the same fixes in the same order; resumed after frame 150, the
+  // first fix is frame 151 and the checkpoint, once a fix is handed out, never goes back before it.
+  MavlinkFixSource source(std::make_shared<ChunkLink>(backlogThenRequest(300), false), "F");
+  source.resumeAfter(150);
+  std::vector<std::size_t> lines;
+  for (planner::SourceRecord r = source.next(0); r.kind != planner::SourceRecord::Kind::kEnd; r = source.next(0)) {
+    ASSERT_EQ(r.kind, planner::SourceRecord::Kind::kFix);
+    EXPECT_EQ(source.checkpointLine(), r.line);
+    lines.push_back(r.line);
+  }
+  ASSERT_EQ(lines.size(), 155u);  // 151 … 300, 302 … 306
+  EXPECT_EQ(lines.front(), 151u);
+  EXPECT_EQ(lines[149], 300u);
+  EXPECT_EQ(lines[150], 302u);
+  EXPECT_EQ(lines.back(), 306u);
+  EXPECT_EQ(source.checkpointLine(), 306u);
 }
 
 }  // namespace
