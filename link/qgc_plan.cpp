@@ -79,13 +79,65 @@ json clockwiseLatLon(std::vector<json> ccw) {
   return json(std::move(ccw));
 }
 
-json inclusionPolygon(const planner::ApprovedFlight& r, const maps::PlaneFrame& frame) {
-  std::vector<json> ring;
-  for (const Eigen::Vector2d& xy : airspaceOutline(r.route, r.level2.hal_m)) {
-    const Eigen::Vector2d ll = frame.toLatLon(xy);
-    ring.push_back({roundToDeg8(ll.x()), roundToDeg8(ll.y())});
+/// A closed counter-clockwise polygon of a ring given counter-clockwise.
+BgPolygon bgPolygon(const std::vector<Eigen::Vector2d>& ring) {
+  BgPolygon out;
+  for (const Eigen::Vector2d& p : ring) bg::append(out.outer(), BgPoint(p.x(), p.y()));
+  bg::correct(out);
+  return out;
+}
+
+/// The union of the keep-in volumes whose zone is active at some instant of [t0, t1], in the map
+/// frame (their rings as the fence checks them); empty when none is.
+BgMulti activeKeepIn(const planner::Approver& a, const maps::GpsTime& t0, const maps::GpsTime& t1) {
+  BgMulti merged;
+  for (const geofence::KeepInVolume& k : a.obstructions().keepInVolumes()) {
+    if (!airspace::isActiveDuring(a.obstructions().zones()[k.zone], t0, t1)) continue;
+    BgMulti out;
+    bg::union_(merged, bgPolygon(k.ring), out);
+    merged = std::move(out);
   }
-  return {{"inclusion", true}, {"polygon", clockwiseLatLon(std::move(ring))}, {"version", 1}};
+  return merged;
+}
+
+/// The level-2 airspace the vehicle may fly in: its outline, cut to the active keep-in zones when
+/// there are any — the piece that holds the route's start (the route lies in both, so in one
+/// piece; else the largest), with the keep-in zones' holes inside it.
+BgPolygon fencedAirspace(const planner::ApprovedFlight& r, const planner::Approver& a) {
+  BgPolygon outline = bgPolygon(airspaceOutline(r.route, r.level2.hal_m));
+  const BgMulti keep_in = activeKeepIn(a, r.departure, r.departure.plus(r.route.back().eta_s));
+  if (keep_in.empty()) return outline;
+  BgMulti pieces;
+  bg::intersection(outline, keep_in, pieces);
+  if (pieces.empty()) return outline;  // not for an approved route (it lies in both); the airspace as it is
+  const BgPoint start(r.route.front().xyz.x(), r.route.front().xyz.y());
+  for (const BgPolygon& piece : pieces) {
+    if (bg::covered_by(start, piece)) return piece;
+  }
+  return *std::max_element(pieces.begin(), pieces.end(), [](const BgPolygon& x, const BgPolygon& y) { return bg::area(x) < bg::area(y); });
+}
+
+/// [[lat, lon], …] of a closed Boost.Geometry ring in the map frame, written clockwise.
+template <class Ring>
+json clockwiseLatLonOf(const Ring& ring, const maps::PlaneFrame& frame) {
+  std::vector<json> ccw;
+  for (const BgPoint& p : ring) {
+    const Eigen::Vector2d ll = frame.toLatLon(Eigen::Vector2d(p.x(), p.y()));
+    ccw.push_back({roundToDeg8(ll.x()), roundToDeg8(ll.y())});
+  }
+  if (ccw.size() > 1 && ccw.front() == ccw.back()) ccw.pop_back();
+  if (bg::area(ring) < 0) std::reverse(ccw.begin(), ccw.end());  // a hole's ring runs clockwise already
+  return clockwiseLatLon(std::move(ccw));
+}
+
+/// The inclusion polygon (fencedAirspace's outer ring) and, after it, an exclusion polygon for
+/// each hole the keep-in zones leave in it.
+void addAirspace(const planner::ApprovedFlight& r, const planner::Approver& a, json& polygons) {
+  const BgPolygon fenced = fencedAirspace(r, a);
+  polygons.push_back({{"inclusion", true}, {"polygon", clockwiseLatLonOf(fenced.outer(), a.frame())}, {"version", 1}});
+  for (const auto& hole : fenced.inners()) {
+    polygons.push_back({{"inclusion", false}, {"polygon", clockwiseLatLonOf(hole, a.frame())}, {"version", 1}});
+  }
 }
 
 /// The counted zones active at some instant of the flight, one fence per volume.
@@ -115,11 +167,7 @@ void addExclusions(const planner::ApprovedFlight& r, const planner::Approver& a,
 std::vector<Eigen::Vector2d> airspaceOutline(const std::vector<planner::RoutePoint>& route, double hal_m) {
   BgMulti merged;
   for (std::size_t i = 1; i < route.size(); ++i) {
-    BgPolygon box;
-    for (const Eigen::Vector2d& p : planner::segmentOutline(route[i - 1].xyz, route[i].xyz, hal_m)) {
-      bg::append(box.outer(), BgPoint(p.x(), p.y()));
-    }
-    bg::correct(box);  // closes the ring
+    const BgPolygon box = bgPolygon(planner::segmentOutline(route[i - 1].xyz, route[i].xyz, hal_m));
     BgMulti out;
     bg::union_(merged, box, out);
     merged = std::move(out);
@@ -162,7 +210,8 @@ nlohmann::json qgcPlan(planner::ApprovedFlight report, const planner::Approver& 
                   {"plannedHomePosition", {roundToDeg8(start.lat_rad), roundToDeg8(start.lon_rad), roundToMm(home_m)}},
                   {"vehicleType", vehicle.vehicle_type},
                   {"version", 2}};
-  json polygons = json::array({inclusionPolygon(report, approver.frame())});
+  json polygons = json::array();
+  addAirspace(report, approver, polygons);
   json circles = json::array();
   addExclusions(report, approver, polygons, circles);
   return {{"fileType", "Plan"},

@@ -11,7 +11,9 @@
 /// has reached the point. `cruiseSpeed` and `hoverSpeed` are the mission's cruise speed.
 ///
 /// The geoFence (version 2): the level-2 airspace — the union of every segment's box outline
-/// (planner::segmentOutline at HAL₂) — as one inclusion polygon, and every zone the policy counts
+/// (planner::segmentOutline at HAL₂), cut to the union of the keep-in zones active during the
+/// flight (the piece holding the route; a hole the keep-in zones leave in it written as an
+/// exclusion polygon) — as one inclusion polygon, and every zone the policy counts
 /// and that is active at some instant of the flight (departure to the last ETA) as an exclusion
 /// polygon or circle, each volume of a zone on its own. Polygons are written clockwise, as the
 /// format's description asks. One inclusion polygon, because an autopilot may require the vehicle

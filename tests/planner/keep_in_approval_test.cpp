@@ -2,6 +2,7 @@
 // checks every approved route's predicted samples with the exact predicates of airspace/ (CGAL
 // bounded side, exact segment-meets-disk), independently of the fence's own margins.
 #include "planner/approval.hpp"
+#include "link/qgc_plan.hpp"
 #include "planner/report_formats.hpp"
 #include "planner/tracking/tracker.hpp"
 
@@ -145,6 +146,75 @@ TEST(KeepInApproval, TheFenceSendsTheRouteTheLongWayRound) {
   double max_y = 0.0;
   for (const PredictedSample& s : free.predicted) max_y = std::max(max_y, s.xyz.y());
   EXPECT_GT(max_y, 60.0);
+}
+
+/// Even–odd point in polygon (the test's own, independent of Boost.Geometry and CGAL).
+bool insideRing(const std::vector<Eigen::Vector2d>& ring, const Eigen::Vector2d& p) {
+  bool in = false;
+  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
+    const Eigen::Vector2d& a = ring[i];
+    const Eigen::Vector2d& b = ring[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) in = !in;
+  }
+  return in;
+}
+
+/// The plan's fence polygons in the map frame: the inclusion ones and the exclusion ones.
+std::pair<std::vector<std::vector<Eigen::Vector2d>>, std::vector<std::vector<Eigen::Vector2d>>> fencePolygons(const json& plan) {
+  std::pair<std::vector<std::vector<Eigen::Vector2d>>, std::vector<std::vector<Eigen::Vector2d>>> out;
+  for (const json& poly : plan.at("geoFence").at("polygons")) {
+    std::vector<Eigen::Vector2d> ring;
+    for (const json& ll : poly.at("polygon")) {
+      ring.push_back(frame().toPlane(maps::deg2rad(ll[0].get<double>()), maps::deg2rad(ll[1].get<double>())));
+    }
+    (poly.at("inclusion").get<bool>() ? out.first : out.second).push_back(ring);
+  }
+  return out;
+}
+
+// The plan handed to the vehicle (QGroundControl .plan, and the FENCE upload made from it) keeps
+// it inside the keep-in zones: the level-2 airspace is cut to them, and a hole they leave in it
+// is an exclusion polygon. Checked by sampling points: inside the plan's fence exactly where
+// inside both the level-2 boxes and the keep-in zones' union.
+TEST(KeepInPlan, TheVehiclesFenceIsTheAirspaceCutToTheKeepInZonesWithTheirHole) {
+  // A (y −90 … 60) and a Π-shaped B (y 50 … 170, notched to 120 over x 600 … 900): their union
+  // leaves the hole [600, 900] × [60, 120], beside the route along y = 0.
+  const std::vector<Eigen::Vector2d> a{{-150, -90}, {1650, -90}, {1650, 60}, {-150, 60}};
+  const std::vector<Eigen::Vector2d> b{{-150, 50}, {600, 50}, {600, 120}, {900, 120}, {900, 50}, {1650, 50}, {1650, 170}, {-150, 170}};
+  Approver approver(missionOver({polygonFeature("A", "KEEP_IN", a), polygonFeature("B", "KEEP_IN", b)}, "keep_in_plan"));
+  const ApprovalReport r = approver.approve();
+  ASSERT_TRUE(r.approved) << (r.reasons.empty() ? "" : r.reasons.front().message);
+  const auto [inclusions, exclusions] = fencePolygons(link::qgcPlan(r, approver));
+  ASSERT_EQ(inclusions.size(), 1u);
+  ASSERT_EQ(exclusions.size(), 1u);  // the hole (the mission's zones are all keep-in)
+  const std::vector<Eigen::Vector2d> hole{{600, 60}, {900, 60}, {900, 120}, {600, 120}};
+  for (const Eigen::Vector2d& corner : hole) {
+    double nearest = 1e9;
+    for (const Eigen::Vector2d& v : exclusions[0]) nearest = std::min(nearest, (v - corner).norm());
+    EXPECT_LT(nearest, 0.05) << corner.transpose();
+  }
+  std::vector<RoutePoint> route = r.route;
+  for (RoutePoint& p : route) {
+    const Eigen::Vector2d xy = frame().toPlane(p.lat_rad, p.lon_rad);
+    p.xyz = Eigen::Vector3d(xy.x(), xy.y(), p.h_ell_m);
+  }
+  for (const RoutePoint& p : route) EXPECT_TRUE(insideRing(inclusions[0], p.xyz.head<2>()));
+  const std::vector<Eigen::Vector2d> outline = link::airspaceOutline(route, r.limits.level2.hal_m);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> ux(-400, 1900), uy(-400, 400);
+  int fenced = 0, wrong = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const Eigen::Vector2d p(ux(rng), uy(rng));
+    const bool expected = insideRing(outline, p) && (insideRing(a, p) || insideRing(b, p));
+    const bool given = insideRing(inclusions[0], p) && !insideRing(exclusions[0], p);
+    fenced += given;
+    wrong += expected != given;
+  }
+  EXPECT_LE(wrong, 2) << "of 20,000 points (only those within millimetres of an edge may differ)";
+  // The level-2 boxes (HAL₂ ≥ 170 m round the route) hold the union: 1,800 m × 260 m less the
+  // hole's 300 m × 60 m, of the 2,300 m × 800 m sampled — 4,891 of 20,000 expected (σ ≈ 61).
+  EXPECT_GE(r.limits.level2.hal_m, 170.0);
+  EXPECT_NEAR(fenced, 20000.0 * (1800.0 * 260.0 - 300.0 * 60.0) / (2300.0 * 800.0), 250.0);
 }
 
 // A prohibited circle cuts the fence in two: no route, and the reason names what blocks the leg.
