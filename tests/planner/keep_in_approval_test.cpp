@@ -148,17 +148,6 @@ TEST(KeepInApproval, TheFenceSendsTheRouteTheLongWayRound) {
   EXPECT_GT(max_y, 60.0);
 }
 
-/// Even–odd point in polygon (the test's own, independent of Boost.Geometry and CGAL).
-bool insideRing(const std::vector<Eigen::Vector2d>& ring, const Eigen::Vector2d& p) {
-  bool in = false;
-  for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
-    const Eigen::Vector2d& a = ring[i];
-    const Eigen::Vector2d& b = ring[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) in = !in;
-  }
-  return in;
-}
-
 /// The plan's fence polygons in the map frame: the inclusion ones and the exclusion ones.
 std::pair<std::vector<std::vector<Eigen::Vector2d>>, std::vector<std::vector<Eigen::Vector2d>>> fencePolygons(const json& plan) {
   std::pair<std::vector<std::vector<Eigen::Vector2d>>, std::vector<std::vector<Eigen::Vector2d>>> out;
@@ -198,15 +187,15 @@ TEST(KeepInPlan, TheVehiclesFenceIsTheAirspaceCutToTheKeepInZonesWithTheirHole) 
     const Eigen::Vector2d xy = frame().toPlane(p.lat_rad, p.lon_rad);
     p.xyz = Eigen::Vector3d(xy.x(), xy.y(), p.h_ell_m);
   }
-  for (const RoutePoint& p : route) EXPECT_TRUE(insideRing(inclusions[0], p.xyz.head<2>()));
+  for (const RoutePoint& p : route) EXPECT_TRUE(test::insideByCrossings(p.xyz.head<2>(), inclusions[0]));
   const std::vector<Eigen::Vector2d> outline = link::airspaceOutline(route, r.limits.level2.hal_m);
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> ux(-400, 1900), uy(-400, 400);
   int fenced = 0, wrong = 0;
   for (int k = 0; k < 20000; ++k) {
     const Eigen::Vector2d p(ux(rng), uy(rng));
-    const bool expected = insideRing(outline, p) && (insideRing(a, p) || insideRing(b, p));
-    const bool given = insideRing(inclusions[0], p) && !insideRing(exclusions[0], p);
+    const bool expected = test::insideByCrossings(p, outline) && (test::insideByCrossings(p, a) || test::insideByCrossings(p, b));
+    const bool given = test::insideByCrossings(p, inclusions[0]) && !test::insideByCrossings(p, exclusions[0]);
     fenced += given;
     wrong += expected != given;
   }
