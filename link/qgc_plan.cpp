@@ -33,7 +33,9 @@ using BgMulti = bg::model::multi_polygon<BgPolygon>;
 constexpr int kNavWaypoint = 16;
 constexpr int kNavLand = 21;
 constexpr int kNavTakeoff = 22;
+constexpr int kDoChangeSpeed = 178;
 constexpr int kFrameGlobalAmsl = 0;      ///< MAV_FRAME_GLOBAL: altitude above mean sea level
+constexpr int kFrameMission = 2;         ///< MAV_FRAME_MISSION: an item without a position
 constexpr int kQgcAltitudeAbsolute = 2;  ///< QGroundControl AltMode "Absolute" (frame 0)
 
 /// A SimpleItem: one MISSION_ITEM with its seven parameters (null where NaN).
@@ -56,6 +58,25 @@ double groundAmsl(const planner::Approver& a, const Eigen::Vector3d& stop, const
   return *ground_m - (near.h_ell_m - near.alt_amsl_m);
 }
 
+/// A DO_CHANGE_SPEED item (no position: frame 2, MAV_FRAME_MISSION): ground speed (param 1 = 1)
+/// of `speed_mps` for the legs after it, the throttle unchanged (param 3 = −1).
+json changeSpeedItem(int jump_id, double speed_mps) {
+  return {{"autoContinue", true}, {"command", kDoChangeSpeed}, {"doJumpId", jump_id}, {"frame", kFrameMission},
+          {"params", {1, roundToMm(speed_mps), -1, 0, 0, 0, 0}}, {"type", "SimpleItem"}};
+}
+
+/// The ground speed that flies leg i (to route point i) in its approved time: its horizontal
+/// length over the time from leaving point i − 1 (its ETA and hover) to point i's ETA. Where the
+/// approval timed the leg by its climb instead (height change at climb speed took longer), this
+/// is slower than the cruise speed and arrives at the same time. None for a leg without
+/// horizontal length or time.
+std::optional<double> legSpeed(const std::vector<planner::RoutePoint>& route, std::size_t i) {
+  const double length_m = (route[i].xyz - route[i - 1].xyz).head<2>().norm();
+  const double time_s = route[i].eta_s - (route[i - 1].eta_s + route[i - 1].hover_s);
+  if (!(length_m > 0.0) || !(time_s > 0.0)) return std::nullopt;
+  return length_m / time_s;
+}
+
 json missionItems(const planner::ApprovedFlight& r, const planner::Approver& a) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::vector<planner::RoutePoint>& route = r.route;
@@ -63,7 +84,13 @@ json missionItems(const planner::ApprovedFlight& r, const planner::Approver& a) 
   int id = 0;
   items.push_back(simpleItem(kNavTakeoff, ++id, {0.0, 0.0, 0.0, nan}, route.front().lat_rad, route.front().lon_rad,
                              route.front().alt_amsl_m));
+  double speed_mps = std::numeric_limits<double>::quiet_NaN();  // the vehicle's own until the first change
   for (std::size_t i = 1; i < route.size(); ++i) {
+    // The approved timing: a speed change before each leg whose speed differs (to the mm/s written).
+    if (const std::optional<double> v = legSpeed(route, i); v && !(std::abs(roundToMm(*v) - speed_mps) < 5e-4)) {
+      speed_mps = roundToMm(*v);
+      items.push_back(changeSpeedItem(++id, speed_mps));
+    }
     // params[0]: the hold time, the route point's hover (a multirotor stays that long).
     items.push_back(simpleItem(kNavWaypoint, ++id, {route[i].hover_s, r.level1.hal_m, 0.0, nan}, route[i].lat_rad,
                                route[i].lon_rad, route[i].alt_amsl_m));

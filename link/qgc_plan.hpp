@@ -8,7 +8,9 @@
 /// in frame 0 (MAV_FRAME_GLOBAL: altitude above mean sea level, the route's `alt_amsl_m`; QGC
 /// AltitudeMode 2, "Absolute"); the landing altitude is the ground's AMSL height under the goal.
 /// A waypoint's acceptance radius (param 2) is the level-1 HAL: a vehicle inside its corridor
-/// has reached the point. `cruiseSpeed` and `hoverSpeed` are the mission's cruise speed.
+/// has reached the point. `cruiseSpeed` and `hoverSpeed` are the mission's cruise speed (a ground
+/// station's estimates); a DO_CHANGE_SPEED (178) before each leg whose speed differs from the
+/// last one written gives the vehicle the ground speed that flies the leg in its approved time.
 ///
 /// The geoFence (version 2): the level-2 airspace — the union of every segment's box outline
 /// (planner::segmentOutline at HAL₂), cut to the union of the keep-in zones active during the

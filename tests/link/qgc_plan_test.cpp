@@ -71,8 +71,18 @@ TEST(QgcPlan, EveryFieldIsAsThePlanFormatDescribesIt) {
   EXPECT_DOUBLE_EQ(m.at("cruiseSpeed").get<double>(), e.approver->mission().cruise_speed_mps);
   EXPECT_DOUBLE_EQ(m.at("hoverSpeed").get<double>(), e.approver->mission().cruise_speed_mps);
   ASSERT_EQ(m.at("plannedHomePosition").size(), 3u);
-  const json& items = m.at("items");
-  ASSERT_EQ(items.size(), e.report.route.size() + 1);  // takeoff, a waypoint per later point, land
+  const json& all_items = m.at("items");
+  // takeoff, the cruise speed (the example's legs are flown at it), a waypoint per later point, land
+  ASSERT_EQ(all_items.size(), e.report.route.size() + 2);
+  const json& speed = all_items[1];
+  EXPECT_EQ(speed.at("command"), 178);  // MAV_CMD_DO_CHANGE_SPEED
+  EXPECT_EQ(speed.at("frame"), 2);      // MAV_FRAME_MISSION: no position
+  EXPECT_EQ(speed.at("doJumpId"), 2);
+  EXPECT_EQ(speed.at("params"), json({1, e.approver->mission().cruise_speed_mps, -1, 0, 0, 0, 0}));  // ground speed
+  json items = json::array();
+  for (std::size_t i = 0; i < all_items.size(); ++i) {
+    if (i != 1) items.push_back(all_items[i]);
+  }
   const std::set<std::string> keys{"AMSLAltAboveTerrain", "Altitude", "AltitudeMode", "autoContinue", "command",
                                    "doJumpId", "frame", "params", "type"};
   for (std::size_t i = 0; i < items.size(); ++i) {
@@ -81,8 +91,8 @@ TEST(QgcPlan, EveryFieldIsAsThePlanFormatDescribesIt) {
     for (const auto& [k, v] : it.items()) have.insert(k);
     EXPECT_EQ(have, keys) << it.dump();
     EXPECT_EQ(it.at("type"), "SimpleItem");
-    EXPECT_EQ(it.at("doJumpId"), static_cast<int>(i) + 1);  // auto-numbered from 1
-    EXPECT_EQ(it.at("frame"), 0);                            // MAV_FRAME_GLOBAL (AMSL)
+    EXPECT_EQ(it.at("doJumpId"), static_cast<int>(i == 0 ? 1 : i + 2));  // auto-numbered from 1
+    EXPECT_EQ(it.at("frame"), 0);                                        // MAV_FRAME_GLOBAL (AMSL)
     EXPECT_EQ(it.at("AltitudeMode"), 2);
     ASSERT_EQ(it.at("params").size(), 7u);
     EXPECT_EQ(it.at("params")[6], it.at("Altitude"));
@@ -157,6 +167,67 @@ TEST(QgcPlan, TheFenceReadsBackAsOneKeepInAroundEveryBoxAndTheCountedZonesOutsid
     }
   }
   EXPECT_EQ(corners, 4 * static_cast<int>(route.size() - 1));
+}
+
+// The vehicle flies the approved timing: a DO_CHANGE_SPEED before each leg whose speed differs,
+// so that skylane's own plan reader, timing the legs as the approval does (the horizontal length
+// at the leg's speed or the height change at the climb speed, whichever takes longer, after the
+// last point's hover), gives back every ETA.
+TEST(QgcPlan, TheVehicleIsGivenTheApprovedSpeedOfEveryLeg) {
+  const Example& e = example();
+  const planner::Approver& a = *e.approver;
+  const double climb_mps = a.mission().climb_speed_mps;
+  struct Leg {
+    Eigen::Vector3d d;
+    double speed_mps, hover_s;  // the leg's speed; the hover at its end
+  };
+  // 600 m and 400 m at 12 m/s, a 20 s hover, 300 m at 6 m/s, 50 m while climbing 60 m (the climb
+  // takes longer: flown at 50 m over the climb's time), 500 m at 8 m/s.
+  const std::vector<Leg> legs{{{600, 0, 0}, 12, 0}, {{0, 400, 0}, 12, 20}, {{300, 0, 0}, 6, 0}, {{50, 0, 60}, 12, 0},
+                              {{0, -500, 0}, 8, 0}};
+  const planner::RoutePoint& origin = e.report.route.front();
+  planner::ApprovedFlight f;
+  f.approved = true;
+  f.departure = e.report.departure;
+  f.level1 = e.report.limits.level1;
+  f.level2 = e.report.limits.level2;
+  Eigen::Vector3d p(0, 0, origin.h_ell_m);
+  double t = 0;
+  const auto addPoint = [&](double hover_s) {
+    planner::RoutePoint rp;
+    const Eigen::Vector2d ll = a.frame().toLatLon(p.head<2>());
+    rp.lat_rad = ll.x();
+    rp.lon_rad = ll.y();
+    rp.h_ell_m = p.z();
+    rp.alt_amsl_m = p.z() - (origin.h_ell_m - origin.alt_amsl_m);
+    rp.eta_s = t;
+    rp.hover_s = hover_s;
+    f.route.push_back(rp);
+  };
+  addPoint(0);
+  for (const Leg& l : legs) {
+    t += f.route.back().hover_s + std::max(l.d.head<2>().norm() / l.speed_mps, std::abs(l.d.z()) / climb_mps);
+    p += l.d;
+    addPoint(l.hover_s);
+  }
+  const json plan = qgcPlan(f, a);
+  std::vector<double> changes;
+  for (const json& it : plan.at("mission").at("items")) {
+    if (it.at("command") == 178) changes.push_back(it.at("params")[1].get<double>());
+  }
+  EXPECT_EQ(changes, (std::vector<double>{12, 6, std::round(50.0 / (60.0 / climb_mps) * 1e3) / 1e3, 8}));
+
+  const planner::QgcPlanRoute back = planner::parseQgcPlanRoute(plan, "timing.plan");
+  ASSERT_EQ(back.points.size(), f.route.size());
+  double eta = 0;
+  for (std::size_t i = 1; i < back.points.size(); ++i) {
+    const Eigen::Vector2d from = a.frame().toPlane(back.points[i - 1].lat_rad, back.points[i - 1].lon_rad);
+    const Eigen::Vector2d to = a.frame().toPlane(back.points[i].lat_rad, back.points[i].lon_rad);
+    const double dz = f.route[i].h_ell_m - f.route[i - 1].h_ell_m;
+    ASSERT_TRUE(back.flights[i].speed_mps) << "leg " << i;
+    eta += back.flights[i - 1].hover_s + std::max((to - from).norm() / *back.flights[i].speed_mps, std::abs(dz) / climb_mps);
+    EXPECT_NEAR(eta, f.route[i].eta_s, 0.01) << "point " << i;
+  }
 }
 
 TEST(QgcPlan, AReportWithoutARouteIsRefused) {
