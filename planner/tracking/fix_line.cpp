@@ -67,7 +67,7 @@ std::optional<TrackFix> plainFix(const PlainLine& p, const std::string& source) 
   if (std::abs(n[kLat]) > 90.0 || std::abs(n[kLon]) > 180.0 || std::abs(n[kHeight]) > 1e5) return std::nullopt;
   if (p.seen[kBaro] && std::abs(n[kBaro]) > 1e5) return std::nullopt;
   if (p.seen[kMag] && (n[kMag] < -360.0 || n[kMag] > 360.0)) return std::nullopt;
-  const auto t = maps::parseRfc3339(std::string(p.time));
+  const auto t = maps::parseRfc3339(p.time);
   if (!t) return std::nullopt;
   TrackFix f;
   f.source = source;
