@@ -138,10 +138,11 @@ class Pieces final : public FclPieces {
     }
     const QueryCylinder& q = queryCylinder();
     double d = std::numeric_limits<double>::max();
+    const fcl::Transform3d& X_piece = h.object->getTransform();
     if (h.cylinder != nullptr) {
-      solver.shapeDistance(*h.cylinder, h.object->getTransform(), *q.shape, q.object.getTransform(), &d, nullptr, nullptr);
+      solver.shapeDistance(*h.cylinder, X_piece, *q.shape, q.object.getTransform(), &d, nullptr, nullptr);
     } else {
-      solver.shapeDistance(*h.convex, h.object->getTransform(), *q.shape, q.object.getTransform(), &d, nullptr, nullptr);
+      solver.shapeDistance(*h.convex, X_piece, *q.shape, q.object.getTransform(), &d, nullptr, nullptr);
     }
     return d;
   }

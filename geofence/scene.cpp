@@ -631,8 +631,8 @@ std::vector<SceneHit> Scene::query(const ProtectionVolume& volume, double horizo
   return hits;
 }
 
-void Scene::query(const ProtectionVolume& volume, double horizon_m, const std::function<bool(PieceOwner, std::size_t)>& accept,
-                  std::vector<SceneHit>& hits) const {
+void Scene::query(const ProtectionVolume& volume, double horizon_m,
+                  const std::function<bool(PieceOwner, std::size_t)>& accept, std::vector<SceneHit>& hits) const {
   hits.clear();
   checkQuery(volume, horizon_m);
   // Broad phase: the AABB of the volume's cylinder grown by the horizon, against the grid.

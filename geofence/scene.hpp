@@ -113,8 +113,8 @@ class Scene {
                                             const std::function<bool(PieceOwner, std::size_t)>& accept) const;
   /// \brief The same into `hits`, cleared first: its storage is reused, so a caller that keeps
   /// one vector makes no allocation per query once it has grown.
-  void query(const ProtectionVolume& volume, double horizon_m, const std::function<bool(PieceOwner, std::size_t)>& accept,
-             std::vector<SceneHit>& hits) const;
+  void query(const ProtectionVolume& volume, double horizon_m,
+             const std::function<bool(PieceOwner, std::size_t)>& accept, std::vector<SceneHit>& hits) const;
 
   /// \brief Whether query(volume, 0, accept) reports any owner, found without FCL: a piece is
   /// reported at horizon 0 exactly when its margins put the volume in contact (deciding margin

@@ -141,7 +141,8 @@ BgPolygon fencedAirspace(const planner::ApprovedFlight& r, const planner::Approv
   for (const BgPolygon& piece : pieces) {
     if (bg::covered_by(start, piece)) return piece;
   }
-  return *std::max_element(pieces.begin(), pieces.end(), [](const BgPolygon& x, const BgPolygon& y) { return bg::area(x) < bg::area(y); });
+  return *std::max_element(pieces.begin(), pieces.end(),
+                           [](const BgPolygon& x, const BgPolygon& y) { return bg::area(x) < bg::area(y); });
 }
 
 /// [[lat, lon], …] of a closed Boost.Geometry ring in the map frame, written clockwise.

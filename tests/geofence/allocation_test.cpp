@@ -30,9 +30,10 @@ namespace {
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
-/// 40 zones along the path y = 0 (x 0 … 4 km; the fixes go on to 6 km, past the zones): squares and disks 20–60 m across, 30–90 m off the
-/// path on either side, floors 0–40 m and ceilings 150–200 m; zone 0 is a keep-in zone around
-/// the whole path. Identifiers and names fit std::string's inline buffer.
+/// 40 zones along the path y = 0 (x 0 … 4 km; the fixes go on to 6 km, past the zones): squares
+/// and disks 20–60 m across, 30–90 m off the path on either side, floors 0–40 m and ceilings
+/// 150–200 m; zone 0 is a keep-in zone around the whole path. Identifiers and names fit
+/// std::string's inline buffer.
 struct Scenario {
   std::vector<airspace::Zone> zones;
   std::vector<ScenePiece> pieces;
@@ -47,14 +48,16 @@ Scenario scenario() {
   keep.identifier = "KEEP";
   keep.keep_in = true;
   s.zones.push_back(keep);
-  s.keep_in.push_back({{Vector2d(-500, -500), Vector2d(6500, -500), Vector2d(6500, 500), Vector2d(-500, 500)}, 0.0, 400.0, 0});
+  s.keep_in.push_back(
+      {{Vector2d(-500, -500), Vector2d(6500, -500), Vector2d(6500, 500), Vector2d(-500, 500)}, 0.0, 400.0, 0});
   for (std::size_t z = 1; z <= 40; ++z) {
     airspace::Zone zone;
     zone.identifier = "Z" + std::to_string(z);
     zone.name = "zone " + std::to_string(z);
     zone.restriction = airspace::Restriction::kProhibited;
     s.zones.push_back(zone);
-    const double side = 20 + 40 * u(rng), x = 100.0 * static_cast<double>(z), y = (z % 2 == 0 ? 1 : -1) * (30 + 60 * u(rng));
+    const double side = 20 + 40 * u(rng), x = 100.0 * static_cast<double>(z);
+    const double y = (z % 2 == 0 ? 1 : -1) * (30 + 60 * u(rng));
     airspace::PlanarPrism p;
     p.floor_h_ell_m = 40 * u(rng);
     p.ceiling_h_ell_m = 150 + 50 * u(rng);
@@ -76,7 +79,9 @@ std::vector<TimedVolume> fixes() {
   const maps::GpsTime t{2400, 0.0};
   std::vector<TimedVolume> out;
   for (int i = 0; i < 400; ++i) {
-    out.push_back({t, t, {Vector3d(6000 * u(rng), 120 * (u(rng) - 0.5), 60 + 80 * u(rng)), 1 + 59 * u(rng), 1 + 59 * u(rng)}});
+    const Vector3d p(6000 * u(rng), 120 * (u(rng) - 0.5), 60 + 80 * u(rng));
+    const double hpl = 1 + 59 * u(rng), vpl = 1 + 59 * u(rng);
+    out.push_back({t, t, {p, hpl, vpl}});
   }
   return out;
 }

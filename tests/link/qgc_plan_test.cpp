@@ -225,7 +225,8 @@ TEST(QgcPlan, TheVehicleIsGivenTheApprovedSpeedOfEveryLeg) {
     const Eigen::Vector2d to = a.frame().toPlane(back.points[i].lat_rad, back.points[i].lon_rad);
     const double dz = f.route[i].h_ell_m - f.route[i - 1].h_ell_m;
     ASSERT_TRUE(back.flights[i].speed_mps) << "leg " << i;
-    eta += back.flights[i - 1].hover_s + std::max((to - from).norm() / *back.flights[i].speed_mps, std::abs(dz) / climb_mps);
+    const double flying_s = std::max((to - from).norm() / *back.flights[i].speed_mps, std::abs(dz) / climb_mps);
+    eta += back.flights[i - 1].hover_s + flying_s;
     EXPECT_NEAR(eta, f.route[i].eta_s, 0.01) << "point " << i;
   }
 }

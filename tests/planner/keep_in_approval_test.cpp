@@ -148,9 +148,11 @@ TEST(KeepInApproval, TheFenceSendsTheRouteTheLongWayRound) {
   EXPECT_GT(max_y, 60.0);
 }
 
+using Rings = std::vector<std::vector<Eigen::Vector2d>>;
+
 /// The plan's fence polygons in the map frame: the inclusion ones and the exclusion ones.
-std::pair<std::vector<std::vector<Eigen::Vector2d>>, std::vector<std::vector<Eigen::Vector2d>>> fencePolygons(const json& plan) {
-  std::pair<std::vector<std::vector<Eigen::Vector2d>>, std::vector<std::vector<Eigen::Vector2d>>> out;
+std::pair<Rings, Rings> fencePolygons(const json& plan) {
+  std::pair<Rings, Rings> out;
   for (const json& poly : plan.at("geoFence").at("polygons")) {
     std::vector<Eigen::Vector2d> ring;
     for (const json& ll : poly.at("polygon")) {
@@ -169,7 +171,8 @@ TEST(KeepInPlan, TheVehiclesFenceIsTheAirspaceCutToTheKeepInZonesWithTheirHole) 
   // A (y −90 … 60) and a Π-shaped B (y 50 … 170, notched to 120 over x 600 … 900): their union
   // leaves the hole [600, 900] × [60, 120], beside the route along y = 0.
   const std::vector<Eigen::Vector2d> a{{-150, -90}, {1650, -90}, {1650, 60}, {-150, 60}};
-  const std::vector<Eigen::Vector2d> b{{-150, 50}, {600, 50}, {600, 120}, {900, 120}, {900, 50}, {1650, 50}, {1650, 170}, {-150, 170}};
+  const std::vector<Eigen::Vector2d> b{{-150, 50},  {600, 50},   {600, 120},  {900, 120},
+                                       {900, 50},   {1650, 50},  {1650, 170}, {-150, 170}};
   Approver approver(missionOver({polygonFeature("A", "KEEP_IN", a), polygonFeature("B", "KEEP_IN", b)}, "keep_in_plan"));
   const ApprovalReport r = approver.approve();
   ASSERT_TRUE(r.approved) << (r.reasons.empty() ? "" : r.reasons.front().message);
@@ -194,7 +197,8 @@ TEST(KeepInPlan, TheVehiclesFenceIsTheAirspaceCutToTheKeepInZonesWithTheirHole) 
   int fenced = 0, wrong = 0;
   for (int k = 0; k < 20000; ++k) {
     const Eigen::Vector2d p(ux(rng), uy(rng));
-    const bool expected = test::insideByCrossings(p, outline) && (test::insideByCrossings(p, a) || test::insideByCrossings(p, b));
+    const bool in_keep_in = test::insideByCrossings(p, a) || test::insideByCrossings(p, b);
+    const bool expected = test::insideByCrossings(p, outline) && in_keep_in;
     const bool given = test::insideByCrossings(p, inclusions[0]) && !test::insideByCrossings(p, exclusions[0]);
     fenced += given;
     wrong += expected != given;
