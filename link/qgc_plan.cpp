@@ -58,11 +58,15 @@ double groundAmsl(const planner::Approver& a, const Eigen::Vector3d& stop, const
   return *ground_m - (near.h_ell_m - near.alt_amsl_m);
 }
 
+/// A speed to the cm/s: a report's positions (1e-8°, ≈ 1 mm) and ETAs (1 ms) give a short leg's
+/// speed to a few mm/s only, and a finer figure would write changes that are rounding.
+double roundToCmPerS(double v) { return std::round(v * 100.0) / 100.0; }
+
 /// A DO_CHANGE_SPEED item (no position: frame 2, MAV_FRAME_MISSION): ground speed (param 1 = 1)
 /// of `speed_mps` for the legs after it, the throttle unchanged (param 3 = −1).
 json changeSpeedItem(int jump_id, double speed_mps) {
   return {{"autoContinue", true}, {"command", kDoChangeSpeed}, {"doJumpId", jump_id}, {"frame", kFrameMission},
-          {"params", {1, roundToMm(speed_mps), -1, 0, 0, 0, 0}}, {"type", "SimpleItem"}};
+          {"params", {1, speed_mps, -1, 0, 0, 0, 0}}, {"type", "SimpleItem"}};
 }
 
 /// The ground speed that flies leg i (to route point i) in its approved time: its horizontal
@@ -86,9 +90,9 @@ json missionItems(const planner::ApprovedFlight& r, const planner::Approver& a) 
                              route.front().alt_amsl_m));
   double speed_mps = std::numeric_limits<double>::quiet_NaN();  // the vehicle's own until the first change
   for (std::size_t i = 1; i < route.size(); ++i) {
-    // The approved timing: a speed change before each leg whose speed differs (to the mm/s written).
-    if (const std::optional<double> v = legSpeed(route, i); v && !(std::abs(roundToMm(*v) - speed_mps) < 5e-4)) {
-      speed_mps = roundToMm(*v);
+    // The approved timing: a speed change before each leg whose speed differs (to the cm/s).
+    if (const std::optional<double> v = legSpeed(route, i); v && roundToCmPerS(*v) != speed_mps) {
+      speed_mps = roundToCmPerS(*v);
       items.push_back(changeSpeedItem(++id, speed_mps));
     }
     // params[0]: the hold time, the route point's hover (a multirotor stays that long).
