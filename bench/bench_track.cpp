@@ -211,7 +211,7 @@ void runTracking(benchmark::State& state, One&& one) {
       state.ResumeTiming();
     }
     const auto t0 = Clock::now();
-    const std::vector<planner::TrackEvent> ev = one(*tracker, c, k++);
+    const std::vector<planner::TrackEvent>& ev = one(*tracker, c, k++);
     latency_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
     events += ev.size();
     for (const planner::TrackEvent& e : ev) rejected += e.is("rejected_input");
@@ -231,21 +231,25 @@ void BM_TrackFixes(benchmark::State& state) {
 }
 BENCHMARK(BM_TrackFixes)->Unit(benchmark::kMicrosecond)->MinTime(2.0);
 
-/// End to end per line: parse, read the fix, process, dump the events (as `skylane track` does).
+/// End to end per line: parse, read the fix, process, dump the events (as `skylane track` does:
+/// one fix, one list of events and one line kept from line to line, so no allocation per line).
 void BM_TrackJsonLine(benchmark::State& state) {
   std::size_t out_bytes = 0;
-  std::string line;  // reused, as TrackingSession does
-  runTracking(state, [&out_bytes, &line](planner::Tracker& t, const TrackCity& c, std::size_t k) {
-    const std::string source = "bench.jsonl:" + std::to_string(k + 1);
-    planner::TrackFix fix = planner::parseTrackFixLine(c.lines[k], source);
+  std::string line, source;
+  planner::TrackFix fix;
+  std::vector<planner::TrackEvent> events;
+  runTracking(state, [&](planner::Tracker& t, const TrackCity& c, std::size_t k) -> const std::vector<planner::TrackEvent>& {
+    source.assign("bench.jsonl:");
+    source += std::to_string(k + 1);
+    planner::parseTrackFixLine(c.lines[k], source, fix);
     fix.line = k + 1;
-    std::vector<planner::TrackEvent> ev = t.process(fix);
-    for (const planner::TrackEvent& e : ev) {
+    t.process(fix, events);
+    for (const planner::TrackEvent& e : events) {
       line.clear();
       e.appendJsonLine(line);
       out_bytes += line.size();
     }
-    return ev;
+    return events;
   });
   const double lines = std::max<double>(1.0, static_cast<double>(state.iterations()));
   state.counters["out_bytes_per_line"] = static_cast<double>(out_bytes) / lines;

@@ -57,21 +57,28 @@ bool readPlainLine(std::string_view text, PlainLine& p) {
   return c.take('}') && c.atEnd();
 }
 
-/// The fix of a plain line when every value is one the general way accepts as it is.
-std::optional<TrackFix> plainFix(const PlainLine& p, const std::string& source) {
+/// Whether every value of a plain line is one the general way accepts as it is.
+bool plainValuesAccepted(const PlainLine& p) {
   const auto& n = p.number;
-  if (!p.seen[kTime] || !p.seen[kLat] || !p.seen[kLon] || !p.seen[kHeight]) return std::nullopt;
-  if (p.seen[kFlight] == p.seen[kVehicle] && p.seen[kFlight]) return std::nullopt;
-  if ((p.seen[kFlight] && p.flight.empty()) || (p.seen[kVehicle] && p.vehicle.empty())) return std::nullopt;
-  if (!p.seen[kHpl] || !p.seen[kVpl] || n[kHpl] < 0.0 || n[kVpl] < 0.0) return std::nullopt;  // PLs from elsewhere: the general way
-  if (std::abs(n[kLat]) > 90.0 || std::abs(n[kLon]) > 180.0 || std::abs(n[kHeight]) > 1e5) return std::nullopt;
-  if (p.seen[kBaro] && std::abs(n[kBaro]) > 1e5) return std::nullopt;
-  if (p.seen[kMag] && (n[kMag] < -360.0 || n[kMag] > 360.0)) return std::nullopt;
+  if (!p.seen[kTime] || !p.seen[kLat] || !p.seen[kLon] || !p.seen[kHeight]) return false;
+  if (p.seen[kFlight] == p.seen[kVehicle] && p.seen[kFlight]) return false;
+  if ((p.seen[kFlight] && p.flight.empty()) || (p.seen[kVehicle] && p.vehicle.empty())) return false;
+  if (!p.seen[kHpl] || !p.seen[kVpl] || n[kHpl] < 0.0 || n[kVpl] < 0.0) return false;  // PLs from elsewhere: the general way
+  if (std::abs(n[kLat]) > 90.0 || std::abs(n[kLon]) > 180.0 || std::abs(n[kHeight]) > 1e5) return false;
+  if (p.seen[kBaro] && std::abs(n[kBaro]) > 1e5) return false;
+  if (p.seen[kMag] && (n[kMag] < -360.0 || n[kMag] > 360.0)) return false;
+  return true;
+}
+
+/// The fix of a plain line into `f` when every value is one the general way accepts as it is.
+bool plainFix(const PlainLine& p, const std::string& source, TrackFix& f) {
+  if (!plainValuesAccepted(p)) return false;
   const auto t = maps::parseRfc3339(p.time);
-  if (!t) return std::nullopt;
-  TrackFix f;
-  f.source = source;
-  f.flight = std::string(p.seen[kFlight] ? p.flight : p.vehicle);
+  if (!t) return false;
+  const auto& n = p.number;
+  clearTrackFix(f);
+  f.source.assign(source);
+  f.flight.assign(p.seen[kFlight] ? p.flight : p.vehicle);
   f.time = *t;
   f.lat_rad = maps::deg2rad(n[kLat]);
   f.lon_rad = maps::deg2rad(n[kLon]);
@@ -80,20 +87,43 @@ std::optional<TrackFix> plainFix(const PlainLine& p, const std::string& source) 
   f.vpl_m = n[kVpl];
   if (p.seen[kBaro]) f.baro_h_m = n[kBaro];
   if (p.seen[kMag]) f.mag_heading_rad = maps::deg2rad(n[kMag]);
-  return f;
+  return true;
 }
 
 }  // namespace
 
-std::optional<TrackFix> parsePlainFixLine(std::string_view text, const std::string& source) {
+void clearTrackFix(TrackFix& fix) {
+  std::string flight = std::move(fix.flight), source = std::move(fix.source), note = std::move(fix.note);
+  fix = TrackFix{};
+  flight.clear();
+  source.clear();
+  note.clear();
+  fix.flight = std::move(flight);
+  fix.source = std::move(source);
+  fix.note = std::move(note);
+}
+
+bool parsePlainFixLine(std::string_view text, const std::string& source, TrackFix& out) {
   PlainLine p;
-  if (text.size() > 4096 || !readPlainLine(text, p)) return std::nullopt;
-  return plainFix(p, source);
+  if (text.size() > 4096 || !readPlainLine(text, p)) return false;
+  return plainFix(p, source, out);
+}
+
+std::optional<TrackFix> parsePlainFixLine(std::string_view text, const std::string& source) {
+  TrackFix f;
+  if (!parsePlainFixLine(text, source, f)) return std::nullopt;
+  return f;
+}
+
+void parseTrackFixLine(const std::string& text, const std::string& source, TrackFix& out) {
+  if (parsePlainFixLine(text, source, out)) return;
+  out = parseTrackFixJson(maps::parseJsonLine(text, source), source);
 }
 
 TrackFix parseTrackFixLine(const std::string& text, const std::string& source) {
-  if (std::optional<TrackFix> f = parsePlainFixLine(text, source)) return std::move(*f);
-  return parseTrackFixJson(maps::parseJsonLine(text, source), source);
+  TrackFix f;
+  parseTrackFixLine(text, source, f);
+  return f;
 }
 
 }  // namespace skylane::planner

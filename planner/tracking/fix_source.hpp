@@ -41,6 +41,9 @@ class FixSource {
   virtual ~FixSource() = default;
   /// \brief The next record; kIdle after `timeout_ms` with nothing on a live input.
   [[nodiscard]] virtual SourceRecord next(int timeout_ms) = 0;
+  /// \brief The same into `out` (all of it replaced). A source may read into out's storage, so
+  /// that a stream keeping one record allocates nothing per record (JSON lines do).
+  virtual void nextInto(int timeout_ms, SourceRecord& out) { out = next(timeout_ms); }
   /// \brief The input's name (messages, the resume table).
   [[nodiscard]] virtual const std::string& name() const = 0;
   /// \brief Whether the input goes quiet and comes back (stale flights are then swept on the
@@ -63,6 +66,7 @@ class JsonLinesFixSource final : public FixSource {
  public:
   explicit JsonLinesFixSource(std::unique_ptr<LineInput> in) : in_(std::move(in)) {}
   SourceRecord next(int timeout_ms) override;
+  void nextInto(int timeout_ms, SourceRecord& out) override;
   [[nodiscard]] const std::string& name() const override { return in_->name(); }
   [[nodiscard]] bool live() const override { return in_->live(); }
   [[nodiscard]] bool rereadable() const override { return in_->rereadable(); }
@@ -73,6 +77,8 @@ class JsonLinesFixSource final : public FixSource {
  private:
   std::unique_ptr<LineInput> in_;
   std::size_t line_ = 0, resume_line_ = 0;
+  std::string text_;    ///< the line being read (reused)
+  std::string source_;  ///< "input:line" of it (reused)
 };
 
 /// \brief NMEA 0183 sentences (GGA + GST, + GBS, RMC/ZDA for the date), one fix per epoch,

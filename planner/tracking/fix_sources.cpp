@@ -6,6 +6,7 @@
 #include "maps/parse_error.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <variant>
 
 namespace skylane::planner {
@@ -43,6 +44,25 @@ SourceRecord fixRecord(TrackFix fix) {
   return r;
 }
 
+/// `r` as a record of `kind` without an error (its fix left as it is: the kind says whether it
+/// is one; the strings keep their storage).
+void setKind(SourceRecord& r, SourceRecord::Kind kind) {
+  r.kind = kind;
+  r.where.clear();
+  r.line = 0;
+  r.error.clear();
+  r.flight.clear();
+}
+
+/// "input:line" into `out`, its storage reused.
+void setWhere(std::string& out, const std::string& input, std::size_t line) {
+  out.assign(input);
+  out += ':';
+  char digits[24];
+  const auto r = std::to_chars(digits, digits + sizeof digits, line);
+  out.append(digits, r.ptr);
+}
+
 SourceRecord kindRecord(SourceRecord::Kind kind) {
   SourceRecord r;
   r.kind = kind;
@@ -56,25 +76,33 @@ bool blank(const std::string& text) { return text.find_first_not_of(" \t\r") == 
 }  // namespace
 
 SourceRecord JsonLinesFixSource::next(int timeout_ms) {
-  std::string text;
+  SourceRecord r;
+  nextInto(timeout_ms, r);
+  return r;
+}
+
+void JsonLinesFixSource::nextInto(int timeout_ms, SourceRecord& out) {
   for (;;) {
-    const LineInput::Status st = in_->next(text, timeout_ms);
-    if (st == LineInput::Status::kEnd) return kindRecord(SourceRecord::Kind::kEnd);
-    if (st == LineInput::Status::kTimeout) return kindRecord(SourceRecord::Kind::kIdle);
+    const LineInput::Status st = in_->next(text_, timeout_ms);
+    if (st == LineInput::Status::kEnd) return setKind(out, SourceRecord::Kind::kEnd);
+    if (st == LineInput::Status::kTimeout) return setKind(out, SourceRecord::Kind::kIdle);
     ++line_;
     if (line_ <= resume_line_) continue;
-    if (st == LineInput::Status::kTooLong) return badRecord(name(), line_, tooLong());
-    if (blank(text)) continue;
-    const std::string source = name() + ":" + std::to_string(line_);
-    try {
-      TrackFix f = parseTrackFixLine(text, source);
-      f.line = line_;
-      return fixRecord(std::move(f));
-    } catch (const std::exception& e) {
-      SourceRecord bad = badRecord(name(), line_, e.what());
-      bad.flight = namedFlight(text);
-      return bad;
+    if (st == LineInput::Status::kTooLong) {
+      out = badRecord(name(), line_, tooLong());
+      return;
     }
+    if (blank(text_)) continue;
+    setWhere(source_, name(), line_);
+    try {
+      parseTrackFixLine(text_, source_, out.fix);  // into the record's storage
+      setKind(out, SourceRecord::Kind::kFix);
+      out.fix.line = line_;
+    } catch (const std::exception& e) {
+      out = badRecord(name(), line_, e.what());
+      out.flight = namedFlight(text_);
+    }
+    return;
   }
 }
 

@@ -229,7 +229,8 @@ bool requireProtectionLevels(const TrackedFlight& f, FixWork& w) {
 bool checkFence(const TrackerOptions& o, const TrackedFlight& f, FixWork& w) {
   w.volume = volumeAt(f, w.fix.time, w.pos, *w.hpl_m, *w.vpl_m);
   try {
-    w.verdict = fenceVerdict(o, f, w.volume);
+    // Into the fix's verdict, whose storage the tracker took from the previous fix's event.
+    geofence::checkVolume(*f.level1, *f.level2, f.approver->obstructions(), w.volume, o.horizon_m, w.verdict);
   } catch (const std::invalid_argument& e) {  // e.g. a volume beyond the modelled heights
     w.out.push_back(rejectedFix(w.fix, f.id, std::string("the fix cannot be checked: ") + e.what()));
     return false;

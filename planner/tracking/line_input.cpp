@@ -52,12 +52,15 @@ class PosixLineInput final : public LineInput {
   bool takeLine(std::string& line, Status& status);
   /// Reads more bytes; false on a quiet live input (or a signal).
   bool fill(int timeout_ms);
+  /// Forgets the bytes buffered.
+  void dropRead();
 
   std::string name_;
   int fd_ = -1;
   std::unique_ptr<DatagramSocket> udp_;  ///< a UDP input (fd_ is its socket)
   bool live_ = false, eof_ = false, skipping_ = false, regular_ = false;
   std::string buffer_;
+  std::size_t start_ = 0;  ///< where the lines not yet taken begin in buffer_
 };
 
 void PosixLineInput::openFile() {
@@ -71,28 +74,33 @@ void PosixLineInput::openFile() {
 }
 
 bool PosixLineInput::takeLine(std::string& line, Status& status) {
-  const auto nl = buffer_.find('\n');
+  const auto nl = buffer_.find('\n', start_);
   if (skipping_) {
     if (nl == std::string::npos) {
-      buffer_.clear();
+      dropRead();
       return false;
     }
-    buffer_.erase(0, nl + 1);
+    start_ = nl + 1;
     skipping_ = false;
     return takeLine(line, status);
   }
   if (nl == std::string::npos) {
-    if (buffer_.size() <= kMaxLineBytes) return false;
-    buffer_.clear();
+    if (buffer_.size() - start_ <= kMaxLineBytes) return false;
+    dropRead();
     skipping_ = true;
     status = Status::kTooLong;
     return true;
   }
-  line = buffer_.substr(0, nl);
-  buffer_.erase(0, nl + 1);
+  line.assign(buffer_, start_, nl - start_);  // into the caller's storage
+  start_ = nl + 1;
   if (!line.empty() && line.back() == '\r') line.pop_back();
   status = Status::kLine;
   return true;
+}
+
+void PosixLineInput::dropRead() {
+  buffer_.clear();
+  start_ = 0;
 }
 
 bool PosixLineInput::fill(int timeout_ms) {
@@ -111,6 +119,8 @@ bool PosixLineInput::fill(int timeout_ms) {
     if (!udp_) eof_ = true;
     return true;
   }
+  buffer_.erase(0, start_);  // the lines taken: once per read, not once per line
+  start_ = 0;
   buffer_.append(chunk, static_cast<std::size_t>(n));
   if (udp_ && buffer_.back() != '\n') buffer_.push_back('\n');  // a datagram ends its last line
   return true;
@@ -121,9 +131,9 @@ LineInput::Status PosixLineInput::next(std::string& line, int timeout_ms) {
     Status status = Status::kLine;
     if (takeLine(line, status)) return status;
     if (eof_ && !skipping_) {
-      if (buffer_.empty()) return Status::kEnd;
-      line.swap(buffer_);
-      buffer_.clear();
+      if (start_ == buffer_.size()) return Status::kEnd;
+      line.assign(buffer_, start_);  // the last line, without its newline
+      dropRead();
       return Status::kLine;
     }
     if (eof_) return Status::kEnd;

@@ -255,6 +255,20 @@ class LineWriter {
     s_ += '"';
     need_comma_ = true;
   }
+  /// An RFC 3339 time to the millisecond (maps::formatRfc3339's text, written without a string
+  /// of its own: the text has no character to escape).
+  void time(const maps::GpsTime& t) {
+    char buf[maps::kRfc3339MaxChars];
+    const char* end = maps::formatRfc3339To(buf, t, 3);
+    if (end == nullptr) {
+      string(maps::formatRfc3339(t, 3));  // a year outside 1–9998: the general form
+      return;
+    }
+    s_ += '"';
+    s_.append(static_cast<const char*>(buf), end);
+    s_ += '"';
+    need_comma_ = true;
+  }
   /// A value rounded to `decimals` places (roundToMm, roundToDeg8), as std::to_chars writes it.
   void rounded(double v, int decimals) {
     char buf[maps::kRoundedMaxChars];
@@ -439,7 +453,7 @@ void writeFixTail(LineWriter& w, const TrackEvent& e, const FixRecord& f) {
   w.integer(f.route_version);
   if (e.time) {
     w.key("time");
-    w.string(maps::formatRfc3339(*e.time, 3));
+    w.time(*e.time);
   }
   w.key("verdict");
   w.string(geofence::verdictName(f.verdict.verdict));

@@ -104,9 +104,17 @@ struct TrackFix {
 /// read directly, anything else through maps::parseJsonLine and parseTrackFixJson — the same fix
 /// and the same errors either way (fix_line.cpp). \throws maps::ParseError as parseTrackFixJson.
 [[nodiscard]] TrackFix parseTrackFixLine(const std::string& text, const std::string& source);
+/// \brief The same into `out` (all of it replaced): a plain line is read into out's storage, so a
+/// stream that keeps one fix allocates nothing per line once its strings have grown.
+void parseTrackFixLine(const std::string& text, const std::string& source, TrackFix& out);
 /// \brief The direct way alone: the fix of a plain line whose values parseTrackFixJson accepts,
 /// else none (never an error of its own).
 [[nodiscard]] std::optional<TrackFix> parsePlainFixLine(std::string_view text, const std::string& source);
+/// \brief The same into `out`: true when the line was read (all of `out` replaced), false (out
+/// untouched) when it goes the general way.
+[[nodiscard]] bool parsePlainFixLine(std::string_view text, const std::string& source, TrackFix& out);
+/// \brief `fix` as a default TrackFix, its strings keeping their storage.
+void clearTrackFix(TrackFix& fix);
 
 /// \brief A fix as one JSON-lines object (the file comment's schema; parseTrackFixJson reads
 /// it back: positions to 1e-9°, heights and ranges to 0.1 mm, increments with full precision).

@@ -221,7 +221,33 @@ void Tracker::acceptFix(TrackedFlight& f, FixWork& w) {
 }
 
 std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
-  const std::string id = fix.flight.empty() ? onlyFlight() : fix.flight;
+  std::vector<TrackEvent> events;
+  process(fix, events);
+  return events;
+}
+
+namespace {
+
+/// The storage of the previous fix's events for this fix: the list itself and the fix event's
+/// checks (the verdict is filled in place), so a stream of fixes allocates nothing once grown.
+void takeStorage(std::vector<TrackEvent>& events, FixWork& w) {
+  for (TrackEvent& e : events) {
+    if (e.fix) {
+      w.verdict.checks.swap(e.fix->verdict.checks);
+      break;
+    }
+  }
+  w.verdict.checks.clear();
+  events.clear();
+  w.out.swap(events);
+}
+
+}  // namespace
+
+void Tracker::process(const TrackFix& fix, std::vector<TrackEvent>& events) {
+  std::string only;  // the flight when the fix names none
+  if (fix.flight.empty()) only = onlyFlight();
+  const std::string& id = fix.flight.empty() ? only : fix.flight;
   const auto it = flights_.find(id);
   if (it == flights_.end()) {
     TrackEvent e = rejectedInput(fix.source, fix.line,
@@ -229,10 +255,18 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
                                                           " flights are tracked (give \"flight\")"
                                                     : "unknown flight \"" + fix.flight + "\" (no approval loaded for it)");
     e.flight = fix.flight;  // the flight the line named, known or not
-    return {e};
+    events.clear();
+    events.push_back(std::move(e));
+    return;
   }
-  TrackedFlight& f = *it->second;
   FixWork w(fix);
+  takeStorage(events, w);
+  runFixSteps(*it->second, w);
+  events.swap(w.out);
+}
+
+void Tracker::runFixSteps(TrackedFlight& f, FixWork& w) {
+  const TrackFix& fix = w.fix;
   w.note = fix.note;
   w.pos = {fix.lat_rad, fix.lon_rad, fix.h_ell_m};
   w.hpl_m = fix.hpl_m;
@@ -241,11 +275,11 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   // skylane's own PLs already: their source stays "raw"), else what the fix gave.
   w.source = fix.ranges.empty() ? fix.pl_source : PlSource::kOnboard;
   if (!fix.hpl_m && fix.ins) w.source = PlSource::kIns;
-  if (!checkOrder(options_, f, w, stream_time_)) return std::move(w.out);
+  if (!checkOrder(options_, f, w, stream_time_)) return;
   runGnssInsEpoch(f, w);
   solveSnapshot(f, w);
   applyInsNominalPl(w);
-  if (!requireProtectionLevels(f, w) || !checkFence(options_, f, w)) return std::move(w.out);
+  if (!requireProtectionLevels(f, w) || !checkFence(options_, f, w)) return;
   acceptFix(f, w);
   rerunMonitoring(options_, f, w);
   updatePersistence(options_, f, w);
@@ -253,7 +287,6 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
   holdReplanForHandoff(options_, f, w);
   writeFixEvent(f, w);
   replanIfPersistent(options_, f, w);
-  return std::move(w.out);
 }
 
 }  // namespace skylane::planner

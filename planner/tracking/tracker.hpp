@@ -98,6 +98,10 @@ class Tracker {
 
   /// \brief Processes one fix; returns its events (the `fix` event last but for a replan).
   [[nodiscard]] std::vector<TrackEvent> process(const TrackFix& fix);
+  /// \brief The same into `events` (its previous content replaced), whose storage is reused: a
+  /// caller that keeps one list makes no allocation per fix once it has grown (but for a flight
+  /// id longer than std::string keeps inline, and for events other than the `fix` event).
+  void process(const TrackFix& fix, std::vector<TrackEvent>& events);
   /// \brief process() with the events as JSON.
   [[nodiscard]] std::vector<nlohmann::json> processJson(const TrackFix& fix);
   /// \brief A `rejected_input` event for a record that could not be read.
@@ -133,6 +137,8 @@ class Tracker {
  private:
   /// The step that accepts a checked fix: stream time, the stale sweep, the flight's counters.
   void acceptFix(TrackedFlight& f, FixWork& w);
+  /// The steps of process() for a known flight (the file comment's 1–6), into w.out.
+  void runFixSteps(TrackedFlight& f, FixWork& w);
   TrackerOptions options_;
   std::map<std::string, std::unique_ptr<TrackedFlight>> flights_;
   std::map<std::string, std::shared_ptr<Approver>> approvers_;  ///< by mission file

@@ -95,7 +95,8 @@ void TrackingSession::checkpoint(bool force) {
 void TrackingSession::submit(const TrackFix& fix) {
   beginBatch();
   try {
-    emit(tracker_.process(fix));
+    tracker_.process(fix, events_);
+    emit(events_);
   } catch (const std::exception& e) {  // a fix the tracker cannot take never ends the stream
     emit({tracker_.rejectedInput(fix.source, fix.line, e.what())});
     log_("skipped " + fix.source + ": " + e.what());
@@ -185,7 +186,8 @@ SessionSummary TrackingSession::run(FixSource& source) {
   };
   if (source.droppedDatagrams()) summary_.dropped = 0;
   while (!stop_) {
-    SourceRecord r = source.next(kIdlePollMs);
+    source.nextInto(kIdlePollMs, record_);  // one record, its storage reused
+    const SourceRecord& r = record_;
     reportDrops(r.kind == SourceRecord::Kind::kIdle);
     tick();
     if (r.kind == SourceRecord::Kind::kEnd) break;

@@ -110,6 +110,8 @@ class TrackingSession {
   std::map<std::string, std::string> report_of_;  ///< flight id → approval report file
   std::set<std::string> touched_;                 ///< flights changed since the last checkpoint
   std::string line_;                              ///< the event line being written (reused)
+  SourceRecord record_;                           ///< the record being processed (reused)
+  std::vector<TrackEvent> events_;                ///< a fix's events (reused: Tracker::process)
   std::map<std::string, std::uint64_t> dropped_;  ///< UDP input → kernel drops reported so far
   int pending_ = 0;
   FixSource* source_ = nullptr;  ///< the source being run (its checkpoint line)
