@@ -5,6 +5,7 @@
 #include "maps/geoid.hpp"
 #include "maps/time.hpp"
 
+#include <chrono>
 #include <cmath>
 
 namespace skylane::link::mavlink {
@@ -21,6 +22,9 @@ constexpr double kWeek_s = 604800.0;
 constexpr std::size_t kMaxOtherFrames = 256;
 /// Records read ahead of the session at most (a live link's backlog beyond stays in the kernel).
 constexpr std::size_t kMaxReady = 4096;
+/// While records wait, a live link is looked at again no sooner than this: a reply behind a
+/// backlog is read within it, and the tracking does not ask the kernel once per record.
+constexpr std::chrono::milliseconds kReadAheadPeriod{10};
 
 /// The GPS time of a UTC instant given in microseconds since the UNIX epoch (leap seconds applied).
 maps::GpsTime gpsFromUnix(std::uint64_t time_usec) {
@@ -132,7 +136,14 @@ void MavlinkFixSource::parseReady() {
   }
 }
 
+bool MavlinkFixSource::readAheadDue() {
+  if (ready_.empty()) return true;
+  const auto now = std::chrono::steady_clock::now();
+  return now - last_read_ahead_ >= kReadAheadPeriod;
+}
+
 void MavlinkFixSource::readAhead() {
+  last_read_ahead_ = std::chrono::steady_clock::now();
   parseReady();
   while (!ended_ && ready_.size() < kMaxReady) {
     bytes_.clear();
@@ -157,7 +168,7 @@ planner::SourceRecord MavlinkFixSource::next(int timeout_ms) {
   for (;;) {
     // A live link is read ahead: the mission protocol's frames behind a backlog of telemetry
     // reach the hand-off at its next tick, not after every fix before them has been tracked.
-    if (link_->live()) readAhead();
+    if (link_->live() && readAheadDue()) readAhead();
     if (!ready_.empty()) return takeReady();
     if (auto trouble = parserTrouble()) return *trouble;
     if (ended_) return endOfInput();

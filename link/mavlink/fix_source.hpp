@@ -24,6 +24,7 @@
 #include "link/mavlink/wire.hpp"
 #include "planner/tracking/fix_source.hpp"
 
+#include <chrono>
 #include <deque>
 #include <memory>
 #include <optional>
@@ -74,6 +75,8 @@ class MavlinkFixSource final : public planner::FixSource {
   void parseReady();
   /// parseReady, then what the link has now (no waiting), until ready_ is full.
   void readAhead();
+  /// Whether to read ahead now: nothing waits, or kReadAheadPeriod has passed since the last time.
+  [[nodiscard]] bool readAheadDue();
   /// The first waiting record.
   planner::SourceRecord takeReady();
   /// The record a frame makes, if any.
@@ -95,6 +98,7 @@ class MavlinkFixSource final : public planner::FixSource {
   std::deque<Ready> ready_;
   std::size_t returned_frame_ = 0;
   std::vector<std::uint8_t> bytes_;  ///< the last read, reused
+  std::chrono::steady_clock::time_point last_read_ahead_{};
   bool ended_ = false, truncation_reported_ = false;
 };
 

@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -263,6 +264,7 @@ class ChunkLink final : public ByteLink {
  public:
   ChunkLink(std::vector<std::vector<std::uint8_t>> chunks, bool live) : chunks_(std::move(chunks)), live_(live) {}
   Status read(std::vector<std::uint8_t>& out, int /*timeout_ms*/) override {
+    ++reads_;
     if (next_ == chunks_.size()) return live_ ? Status::kTimeout : Status::kEnd;
     out.insert(out.end(), chunks_[next_].begin(), chunks_[next_].end());
     ++next_;
@@ -272,8 +274,11 @@ class ChunkLink final : public ByteLink {
   [[nodiscard]] bool live() const override { return live_; }
   [[nodiscard]] bool rereadable() const override { return !live_; }
   [[nodiscard]] const std::string& name() const override { return name_; }
+  /// How many times the link was read (each a system call on a real one).
+  [[nodiscard]] int reads() const { return reads_; }
 
  private:
+  int reads_ = 0;
   std::vector<std::vector<std::uint8_t>> chunks_;
   std::size_t next_ = 0;
   bool live_;
@@ -339,6 +344,24 @@ TEST(MavlinkFixSource, ALiveLinkIsReadAheadSoAMissionRequestBehindABacklogIsAnsw
   }
   EXPECT_EQ(source.next(0).kind, planner::SourceRecord::Kind::kIdle);
   EXPECT_EQ(source.checkpointLine(), static_cast<std::size_t>(kBacklog + 6));
+}
+
+TEST(MavlinkFixSource, ABacklogIsHandedOutWithoutReadingTheLinkForEveryRecord) {
+  // 3,000 fixes arrived at once on a live link: the first record reads them all (and finds the
+  // link quiet); the others wait in memory, and the link is looked at again only every 10 ms —
+  // not once per record, a system call each on a real link.
+  constexpr int kBacklog = 3000;
+  auto link = std::make_shared<ChunkLink>(backlogThenRequest(kBacklog), true);
+  MavlinkFixSource source(link, "F");
+  const auto start = std::chrono::steady_clock::now();
+  int fixes = 0;
+  for (planner::SourceRecord r = source.next(0); r.kind == planner::SourceRecord::Kind::kFix; r = source.next(0)) ++fixes;
+  const double elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(fixes, kBacklog + 5);
+  // Two reads for the backlog and the request, one that finds the link quiet, one per 10 ms
+  // spent, and the last that ends the loop with kIdle.
+  EXPECT_LE(link->reads(), 6 + static_cast<int>(elapsed_ms / 10.0)) << elapsed_ms << " ms";
+  EXPECT_LT(link->reads(), kBacklog / 10);
 }
 
 TEST(MavlinkFixSource, AFileIsReadAsItComesAndResumesAfterAFrame) {
