@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <random>
 #include <string>
 #include <vector>
@@ -161,6 +162,38 @@ TEST(FixLine, EveryOtherLineGoesTheGeneralWayWithItsFixOrItsError) {
     changed[rng() % changed.size()] = static_cast<char>(rng() % 256);
     (void)checkBothWays(changed);
   }
+}
+
+TEST(FixLine, ReadingIntoOneFixReplacesAllItHeld) {
+  // A stream reads every line into one TrackFix (parseTrackFixLine(text, source, fix)), keeping
+  // its strings' storage: nothing of a line may stay for the next — not the pseudoranges, IMU
+  // increments or INS block of a general line before a plain one, nor a plain line's barometric
+  // height before one without. Lines of every kind in random order, each compared with a fresh
+  // reading of it.
+  std::vector<std::string> lines;
+  for (const char* file : {"raw.jsonl", "imu.jsonl", "gnss_ins.jsonl", "onboard.jsonl"}) {
+    std::ifstream in(std::string(SKYLANE_TEST_DATA) + "/../../fuzz/corpus/track/" + file);
+    for (std::string l; std::getline(in, l);) {
+      if (!l.empty()) lines.push_back(l);
+    }
+  }
+  ASSERT_GE(lines.size(), 8u);
+  std::mt19937 rng(11);
+  for (int i = 0; i < 40; ++i) lines.push_back(plainLine(rng, 0));
+  TrackFix kept;
+  std::size_t general_ones = 0;
+  for (int i = 0; i < 600; ++i) {
+    const std::string& line = lines[rng() % lines.size()];
+    const std::string source = "a/long/path/to/the/stream.jsonl:" + std::to_string(i + 1);
+    parseTrackFixLine(line, source, kept);
+    const TrackFix fresh = parseTrackFixLine(line, source);
+    EXPECT_EQ(trackFixJson(kept), trackFixJson(fresh)) << line;
+    EXPECT_EQ(kept.source, fresh.source);
+    EXPECT_EQ(kept.note, fresh.note);
+    EXPECT_EQ(kept.pl_source, fresh.pl_source);
+    general_ones += !parsePlainFixLine(line, source).has_value();
+  }
+  EXPECT_GT(general_ones, 50u);  // both ways were taken, each after the other
 }
 
 }  // namespace
