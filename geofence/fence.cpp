@@ -6,6 +6,7 @@
 #include "maps/geodesy.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <iterator>
 #include <cmath>
 #include <sstream>
@@ -35,16 +36,41 @@ void stableSortByInsertion(Iterator first, Iterator last, Less less) {
   for (Iterator i = first; i != last; ++i) std::rotate(std::upper_bound(first, i, *i, less), i, std::next(i));
 }
 
-Check boxCheck(Level level, const Containment& c) {
-  Check out;
+/// This thread's spare checks: those a list held beyond the ones filled again (CheckSlots), the
+/// one of the lowest slot last, their strings keeping their storage for a longer list.
+std::vector<Check>& spareChecks() {
+  thread_local std::vector<Check> spare;
+  return spare;
+}
+
+/// `c` as a new check, its strings' storage kept.
+void resetCheck(Check& c) {
+  // Member by member (once per check of every fix); a member added to Check changes its size and
+  // stops the build here until it is reset too.
+  static_assert(sizeof(void*) != 8 || sizeof(Check) == 152, "a member was added to Check: reset it below, then this size");
+  c.level = Level::kCorridor;
+  c.verdict = Verdict::kInside;
+  c.index = 0;
+  c.subject.clear();
+  c.name.clear();
+  c.restriction.clear();
+  c.margin_h_m = c.margin_v_m = 0.0;
+  c.clearance_m.reset();
+  c.across_joint = c.exact = false;
+}
+
+/// The check of one box level into `out` (reset): its deciding segment ("segment N").
+void fillBoxCheck(Level level, const Containment& c, Check& out) {
   out.level = level;
   out.verdict = c.verdict;
   out.index = c.segment;
-  out.subject = "segment " + std::to_string(c.segment);
+  out.subject.assign("segment ");
+  char digits[24];
+  const auto r = std::to_chars(digits, digits + sizeof digits, c.segment);
+  out.subject.append(digits, static_cast<std::size_t>(r.ptr - digits));
   out.margin_h_m = c.margin_h_m;
   out.margin_v_m = c.margin_v_m;
   out.across_joint = c.across_joint;
-  return out;
 }
 
 /// Appends the convex pieces of a ring given in latitude/longitude [rad] (either winding), each
@@ -203,18 +229,45 @@ std::optional<ProtectionVolume> Obstructions::sceneVolume(const ProtectionVolume
   return volume;
 }
 
-Check Obstructions::hitCheck(const SceneHit& h) const {
+CheckSlots::~CheckSlots() {
+  if (!finished_ && checks_.size() > used_) checks_.resize(used_);
+}
+
+Check& CheckSlots::next() {
+  if (used_ < checks_.size()) {
+    resetCheck(checks_[used_]);
+    return checks_[used_++];
+  }
+  std::vector<Check>& spare = spareChecks();
+  if (spare.empty()) {
+    ++used_;
+    return checks_.emplace_back();
+  }
+  Check& c = checks_.emplace_back(std::move(spare.back()));
+  spare.pop_back();
+  resetCheck(c);
+  ++used_;
+  return c;
+}
+
+void CheckSlots::finish() {
+  std::vector<Check>& spare = spareChecks();
+  for (std::size_t k = checks_.size(); k > used_; --k) spare.push_back(std::move(checks_[k - 1]));
+  checks_.resize(used_);
+  finished_ = true;
+}
+
+void Obstructions::fillHitCheck(const SceneHit& h, Check& c) const {
   const Separation& s = h.separation;
-  Check c;
   c.level = h.owner == PieceOwner::kZone ? Level::kZone : Level::kObstacle;
   c.index = h.owner_index;
   if (c.level == Level::kZone) {
     const airspace::Zone& z = zones_[h.owner_index];
-    c.subject = z.identifier;
-    c.name = z.name;
-    c.restriction = airspace::restrictionLabel(z);
+    c.subject.assign(z.identifier);
+    c.name.assign(z.name);
+    c.restriction.assign(airspace::restrictionLabel(z));
   } else {
-    c.subject = buildings_[h.owner_index].feature;
+    c.subject.assign(buildings_[h.owner_index].feature);
   }
   c.margin_h_m = s.margin_h_m;
   c.margin_v_m = s.margin_v_m;
@@ -224,22 +277,29 @@ Check Obstructions::hitCheck(const SceneHit& h) const {
   const double deciding_m = std::max(s.margin_h_m, s.margin_v_m);
   c.verdict = s.meets ? (deciding_m >= -options_.tolerance_m ? Verdict::kIndeterminate : Verdict::kOutside)
                       : (deciding_m <= options_.tolerance_m ? Verdict::kIndeterminate : Verdict::kInside);
-  return c;
 }
 
 void Obstructions::appendChecks(const TimedVolume& v, double horizon_m, std::vector<Check>& out) const {
+  CheckSlots slots(out, out.size());
+  appendChecks(v, horizon_m, slots);
+  slots.finish();
+}
+
+void Obstructions::appendChecks(const TimedVolume& v, double horizon_m, CheckSlots& slots) const {
   const std::optional<ProtectionVolume> volume = sceneVolume(v.volume);
   if (!volume) return;
   thread_local std::vector<SceneHit> hits;  // this thread's scratch: no allocation once grown
   scene_.query(*volume, horizon_m, [&](PieceOwner owner, std::size_t i) { return takes(owner, i, v); }, hits);
   // One check per zone or obstacle, from the piece that decides it.
-  const std::size_t first = out.size();
-  for (const SceneHit& h : hits) out.push_back(hitCheck(h));
-  stableSortByInsertion(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(), [](const Check& a, const Check& b) {
-    if (a.level != b.level) return a.level < b.level;
-    if (severity(a.verdict) != severity(b.verdict)) return severity(a.verdict) > severity(b.verdict);
-    return *a.clearance_m < *b.clearance_m;
-  });
+  const std::size_t first = slots.size();
+  for (const SceneHit& h : hits) fillHitCheck(h, slots.next());
+  const auto begin = slots.checks().begin();
+  stableSortByInsertion(begin + static_cast<std::ptrdiff_t>(first), begin + static_cast<std::ptrdiff_t>(slots.size()),
+                        [](const Check& a, const Check& b) {
+                          if (a.level != b.level) return a.level < b.level;
+                          if (severity(a.verdict) != severity(b.verdict)) return severity(a.verdict) > severity(b.verdict);
+                          return *a.clearance_m < *b.clearance_m;
+                        });
 }
 
 std::vector<Check> Obstructions::check(const TimedVolume& v, double horizon_m) const {
@@ -268,21 +328,32 @@ Verdict Obstructions::keepInVerdict(const KeepInMargins& m) const {
                                               : Verdict::kIndeterminate;
 }
 
+void Obstructions::fillKeepInCheck(const KeepInMargins& m, const std::vector<const KeepInVolume*>& active,
+                                   Check& c) const {
+  const airspace::Zone& z = zones_[active[m.nearest]->zone];
+  c.level = Level::kKeepIn;
+  c.index = active[m.nearest]->zone;
+  c.subject.assign(z.identifier);
+  c.name.assign(z.name);
+  c.restriction.assign(airspace::restrictionLabel(z));
+  c.margin_h_m = m.margin_h_m;
+  c.margin_v_m = m.margin_v_m;
+  c.verdict = keepInVerdict(m);
+}
+
 std::optional<Check> Obstructions::keepIn(const TimedVolume& v) const {
   thread_local std::vector<const KeepInVolume*> active;  // this thread's scratch
   const std::optional<KeepInMargins> m = keepInMarginsAt(v, active);
   if (!m) return std::nullopt;
-  const airspace::Zone& z = zones_[active[m->nearest]->zone];
   Check c;
-  c.level = Level::kKeepIn;
-  c.index = active[m->nearest]->zone;
-  c.subject = z.identifier;
-  c.name = z.name;
-  c.restriction = std::string(airspace::restrictionLabel(z));
-  c.margin_h_m = m->margin_h_m;
-  c.margin_v_m = m->margin_v_m;
-  c.verdict = keepInVerdict(*m);
+  fillKeepInCheck(*m, active, c);
   return c;
+}
+
+void Obstructions::appendKeepIn(const TimedVolume& v, CheckSlots& slots) const {
+  thread_local std::vector<const KeepInVolume*> active;  // this thread's scratch
+  const std::optional<KeepInMargins> m = keepInMarginsAt(v, active);
+  if (m) fillKeepInCheck(*m, active, slots.next());
 }
 
 std::optional<Check> Obstructions::firstConflict(const TimedVolume& v, bool with_keep_in) const {
@@ -330,16 +401,16 @@ FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const O
 void checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions, const TimedVolume& v,
                  double horizon_m, FenceVerdict& out) {
   const double tol = obstructions.options().tolerance_m;
-  std::optional<Check> keep_in = obstructions.keepIn(v);
-  out.checks.clear();  // the storage stays: no allocation per check once it has grown
+  CheckSlots slots(out.checks);  // filled again in place: no allocation once grown
   out.verdict = Verdict::kInside;
   out.violated.reset();
   out.deciding.reset();
   const auto [in1, in2] = level1.containsWith(level2, v.volume, tol);
-  out.checks.push_back(boxCheck(Level::kCorridor, in1));
-  out.checks.push_back(boxCheck(Level::kAirspace, in2));
-  if (keep_in) out.checks.push_back(std::move(*keep_in));
-  obstructions.appendChecks(v, horizon_m, out.checks);
+  fillBoxCheck(Level::kCorridor, in1, slots.next());
+  fillBoxCheck(Level::kAirspace, in2, slots.next());
+  obstructions.appendKeepIn(v, slots);
+  obstructions.appendChecks(v, horizon_m, slots);
+  slots.finish();
 
   for (int wanted : {2, 1}) {
     for (std::size_t i = 0; i < out.checks.size() && !out.deciding; ++i) {

@@ -121,6 +121,32 @@ struct TimedVolume {
   ProtectionVolume volume;
 };
 
+/// \brief A list of checks filled again in place: slot k is the k-th check the list held
+/// before, every member reset but its strings' storage, so that a verdict filled fix after fix
+/// allocates nothing once grown — not even for identifiers and names longer than a std::string
+/// keeps inline. Checks the list held beyond the ones filled wait, strings and all, in this
+/// thread's spare checks for a longer list.
+class CheckSlots {
+ public:
+  /// \brief Fills `checks` again from slot `first` on (the checks before it stay).
+  explicit CheckSlots(std::vector<Check>& checks, std::size_t first = 0) : checks_(checks), used_(first) {}
+  CheckSlots(const CheckSlots&) = delete;
+  CheckSlots& operator=(const CheckSlots&) = delete;
+  /// \brief Without finish() (an exception on the way): the list ends at the checks filled.
+  ~CheckSlots();
+  /// \brief The next check, reset.
+  [[nodiscard]] Check& next();
+  /// \brief The list ends at the checks filled; the ones after them go to the spare checks.
+  void finish();
+  [[nodiscard]] std::size_t size() const { return used_; }
+  [[nodiscard]] std::vector<Check>& checks() { return checks_; }
+
+ private:
+  std::vector<Check>& checks_;
+  std::size_t used_;
+  bool finished_ = false;
+};
+
 /// \brief What a volume must stay clear of — the zones (those the policy counts, when active)
 /// and the obstacles of a scene — and inside of: the active keep-in zones. Shared by the fence
 /// (a protection volume) and the route planner (the vehicle inflated to its first-level box).
@@ -138,12 +164,16 @@ class Obstructions {
   [[nodiscard]] std::vector<Check> check(const TimedVolume& v) const;
   /// \brief The same within `horizon_m`.
   [[nodiscard]] std::vector<Check> check(const TimedVolume& v, double horizon_m) const;
-  /// \brief The same appended to `out` (what checkVolume fills a verdict with): no allocation
-  /// once `out` has grown, but for a name or identifier longer than std::string keeps inline.
+  /// \brief The same appended to `out`.
   void appendChecks(const TimedVolume& v, double horizon_m, std::vector<Check>& out) const;
+  /// \brief The same into the next slots (what checkVolume fills a verdict with): no allocation
+  /// once the list has grown.
+  void appendChecks(const TimedVolume& v, double horizon_m, CheckSlots& slots) const;
   /// \brief The keep-in check: the volume against the union of the keep-in zones active at some
   /// instant of [t0, t1); none when no keep-in zone is active then.
   [[nodiscard]] std::optional<Check> keepIn(const TimedVolume& v) const;
+  /// \brief The same into the next slot when a keep-in zone is active.
+  void appendKeepIn(const TimedVolume& v, CheckSlots& slots) const;
   /// \brief The first of: the keep-in check when it is not inside (unless `with_keep_in` is
   /// false); the worst zone or obstacle the volume meets or may meet (indeterminate). None when
   /// the volume is clear of everything.
@@ -161,8 +191,11 @@ class Obstructions {
   [[nodiscard]] bool zoneCounts(std::size_t i) const { return zone_counts_.at(i); }
 
  private:
-  /// The check of one scene hit (its zone's or obstacle's names, the verdict of its separation).
-  [[nodiscard]] Check hitCheck(const SceneHit& h) const;
+  /// The check of one scene hit (its zone's or obstacle's names, the verdict of its separation)
+  /// into `c`, whose members are reset.
+  void fillHitCheck(const SceneHit& h, Check& c) const;
+  /// The keep-in check of margins `m` over the active zones `active` into `c` (reset).
+  void fillKeepInCheck(const KeepInMargins& m, const std::vector<const KeepInVolume*>& active, Check& c) const;
   /// Whether the zone or obstacle counts for a check over [v.t0, v.t1).
   [[nodiscard]] bool takes(PieceOwner owner, std::size_t i, const TimedVolume& v) const;
   /// The keep-in zones active in [v.t0, v.t1) (into `active`) and the volume's margins in their
@@ -195,7 +228,9 @@ class Obstructions {
 [[nodiscard]] FenceVerdict checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions,
                                        const TimedVolume& v, double horizon_m);
 /// \brief The same into `out`, whose storage is reused: a caller that keeps one verdict makes no
-/// allocation per check once it has grown (but for names longer than std::string keeps inline).
+/// allocation per check once it has grown: its checks are filled again in place (CheckSlots), so
+/// identifiers and names longer than std::string keeps inline need no new storage once the
+/// strings have grown.
 void checkVolume(const Corridor& level1, const Corridor& level2, const Obstructions& obstructions, const TimedVolume& v,
                  double horizon_m, FenceVerdict& out);
 

@@ -229,7 +229,8 @@ std::vector<TrackEvent> Tracker::process(const TrackFix& fix) {
 namespace {
 
 /// The storage of the previous fix's events for this fix: the list itself and the fix event's
-/// checks (the verdict is filled in place), so a stream of fixes allocates nothing once grown.
+/// checks (the fence check fills the verdict in place, its checks' strings reused), so a stream
+/// of fixes allocates nothing once grown.
 void takeStorage(std::vector<TrackEvent>& events, FixWork& w) {
   for (TrackEvent& e : events) {
     if (e.fix) {
@@ -237,7 +238,6 @@ void takeStorage(std::vector<TrackEvent>& events, FixWork& w) {
       break;
     }
   }
-  w.verdict.checks.clear();
   events.clear();
   w.out.swap(events);
 }

@@ -1,5 +1,6 @@
 // A stream of fence checks makes no allocation once its verdict has grown: the check writes
-// into the caller's verdict (Fence::check(v, out)) and the scene's and the keep-in check's
+// into the caller's verdict (Fence::check(v, out)), its checks' strings are reused (the k-th
+// check of a verdict gets the k-th of the one before), and the scene's and the keep-in check's
 // scratch is per thread. Its own executable: it counts every operator new of the process.
 #include "geofence/fence.hpp"
 
@@ -32,8 +33,9 @@ using Eigen::Vector3d;
 
 /// 40 zones along the path y = 0 (x 0 … 4 km; the fixes go on to 6 km, past the zones): squares
 /// and disks 20–60 m across, 30–90 m off the path on either side, floors 0–40 m and ceilings
-/// 150–200 m; zone 0 is a keep-in zone around the whole path. Identifiers and names fit
-/// std::string's inline buffer.
+/// 150–200 m; zone 0 is a keep-in zone around the whole path. Identifiers and names are longer
+/// than std::string keeps inline, as real ones are, and every other zone's restriction word
+/// (REQ_AUTHORISATION) too.
 struct Scenario {
   std::vector<airspace::Zone> zones;
   std::vector<ScenePiece> pieces;
@@ -45,16 +47,18 @@ Scenario scenario() {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   airspace::Zone keep;
-  keep.identifier = "KEEP";
+  keep.identifier = "OPERATOR-SITE-KEEP-IN-FENCE";
+  keep.name = "the operator's site fence (keep in)";
   keep.keep_in = true;
   s.zones.push_back(keep);
   s.keep_in.push_back(
       {{Vector2d(-500, -500), Vector2d(6500, -500), Vector2d(6500, 500), Vector2d(-500, 500)}, 0.0, 400.0, 0});
   for (std::size_t z = 1; z <= 40; ++z) {
     airspace::Zone zone;
-    zone.identifier = "Z" + std::to_string(z);
-    zone.name = "zone " + std::to_string(z);
-    zone.restriction = airspace::Restriction::kProhibited;
+    zone.identifier = "LS-GENERATED-ZONE-" + std::to_string(z);
+    zone.name = std::string(z % 4 == 0 ? "a zone with a name longer than its neighbours' " : "zone number ") +
+                std::to_string(z);
+    zone.restriction = z % 2 == 0 ? airspace::Restriction::kReqAuthorisation : airspace::Restriction::kProhibited;
     s.zones.push_back(zone);
     const double side = 20 + 40 * u(rng), x = 100.0 * static_cast<double>(z);
     const double y = (z % 2 == 0 ? 1 : -1) * (30 + 60 * u(rng));
