@@ -3,27 +3,12 @@
 // check of a verdict gets the k-th of the one before), and the scene's and the keep-in check's
 // scratch is per thread. Its own executable: it counts every operator new of the process.
 #include "geofence/fence.hpp"
+#include "tests/allocation_counter.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdlib>
-#include <new>
 #include <random>
-
-namespace {
-thread_local bool g_counting = false;
-thread_local long g_allocations = 0;
-}  // namespace
-
-// Out of line, so that GCC does not pair an inlined std::free with a new-expression.
-__attribute__((noinline)) void* operator new(std::size_t bytes) {
-  if (g_counting) ++g_allocations;
-  if (void* p = std::malloc(bytes == 0 ? 1 : bytes)) return p;
-  throw std::bad_alloc();
-}
-__attribute__((noinline)) void operator delete(void* p) noexcept { std::free(p); }
-__attribute__((noinline)) void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace skylane::geofence {
 namespace {
@@ -124,11 +109,10 @@ TEST(FenceAllocation, AStreamOfChecksIntoOneVerdictAllocatesNothingOnceGrown) {
   EXPECT_GE(most, 5u);   // … to several, so that the verdict shrinks and grows
   EXPECT_GT(outside, 10u);
 
-  g_allocations = 0;
-  g_counting = true;
-  for (const TimedVolume& v : volumes) fence.check(v, reused);
-  g_counting = false;
-  EXPECT_EQ(g_allocations, 0);
+  EXPECT_EQ(test::allocationsOf([&] {
+              for (const TimedVolume& v : volumes) fence.check(v, reused);
+            }),
+            0);
 
   // The reused verdict says what a fresh one says, fix after fix.
   for (const TimedVolume& v : volumes) {
@@ -143,13 +127,9 @@ TEST(FenceAllocation, AStreamOfChecksIntoOneVerdictAllocatesNothingOnceGrown) {
 }
 
 TEST(FenceAllocation, TheCounterSeesAnAllocation) {
-  g_allocations = 0;
-  g_counting = true;
   std::vector<SceneHit> grown;
-  grown.resize(3);  // the library's way of allocating
-  g_counting = false;
+  EXPECT_EQ(test::allocationsOf([&] { grown.resize(3); }), 1);  // the library's way of allocating
   EXPECT_EQ(grown.size(), 3u);
-  EXPECT_EQ(g_allocations, 1);
 }
 
 }  // namespace

@@ -11,28 +11,13 @@
 #include "planner/tracking/fix_source.hpp"
 #include "planner/tracking/tracker.hpp"
 #include "planner/tracking/tracking_session.hpp"
+#include "tests/allocation_counter.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <new>
-
-namespace {
-thread_local bool g_counting = false;
-thread_local long g_allocations = 0;
-}  // namespace
-
-// Out of line, so that GCC does not pair an inlined std::free with a new-expression.
-__attribute__((noinline)) void* operator new(std::size_t bytes) {
-  if (g_counting) ++g_allocations;
-  if (void* p = std::malloc(bytes == 0 ? 1 : bytes)) return p;
-  throw std::bad_alloc();
-}
-__attribute__((noinline)) void operator delete(void* p) noexcept { std::free(p); }
-__attribute__((noinline)) void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace skylane::planner {
 namespace {
@@ -85,17 +70,16 @@ TEST(TrackingAllocations, ReadingTrackingAndWritingAFixAllocateNothingOnceGrown)
   std::string source, out;
   long allocations = 0, fix_events = 0;
   for (std::size_t k = 0; k < text.size(); ++k) {
-    g_allocations = 0;
-    g_counting = k >= 20;  // the first fixes grow the storage
     source.assign("a/path/to/the/input/fixes.jsonl:");  // longer than a string keeps inline
     source += std::to_string(k + 1);
-    parseTrackFixLine(text[k], source, fix);
-    fix.line = k + 1;
-    tracker.process(fix, events);
-    out.clear();
-    for (const TrackEvent& e : events) e.appendJsonLine(out);
-    g_counting = false;
-    allocations += g_allocations;
+    const long made = test::allocationsOf([&] {
+      parseTrackFixLine(text[k], source, fix);
+      fix.line = k + 1;
+      tracker.process(fix, events);
+      out.clear();
+      for (const TrackEvent& e : events) e.appendJsonLine(out);
+    });
+    if (k >= 20) allocations += made;  // the first fixes grow the storage
     for (const TrackEvent& e : events) fix_events += e.is("fix") && e.fix->verdict.verdict == geofence::Verdict::kInside;
   }
   EXPECT_EQ(fix_events, 60);  // every fix taken and inside: the path measured is the common one
@@ -136,13 +120,10 @@ long sessionAllocations(const std::vector<std::string>& text, long& events) {
   CountingSink sink;
   session.addSink(sink);
   JsonLinesFixSource source(openLineInput(file.string()));
-  g_allocations = 0;
-  g_counting = true;
-  (void)session.run(source);
-  g_counting = false;
+  const long made = test::allocationsOf([&] { (void)session.run(source); });
   events = sink.events;
   std::filesystem::remove(file);
-  return g_allocations;
+  return made;
 }
 
 TEST(TrackingAllocations, ASessionOverAFileAllocatesNothingPerFix) {
