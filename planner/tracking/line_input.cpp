@@ -54,6 +54,8 @@ class PosixLineInput final : public LineInput {
   bool fill(int timeout_ms);
   /// Forgets the bytes buffered.
   void dropRead();
+  /// Takes a line's CR off (a CR LF line end).
+  static void dropCarriageReturn(std::string& line);
 
   std::string name_;
   int fd_ = -1;
@@ -93,9 +95,13 @@ bool PosixLineInput::takeLine(std::string& line, Status& status) {
   }
   line.assign(buffer_, start_, nl - start_);  // into the caller's storage
   start_ = nl + 1;
-  if (!line.empty() && line.back() == '\r') line.pop_back();
+  dropCarriageReturn(line);
   status = Status::kLine;
   return true;
+}
+
+void PosixLineInput::dropCarriageReturn(std::string& line) {
+  if (!line.empty() && line.back() == '\r') line.pop_back();
 }
 
 void PosixLineInput::dropRead() {
@@ -132,7 +138,8 @@ LineInput::Status PosixLineInput::next(std::string& line, int timeout_ms) {
     if (takeLine(line, status)) return status;
     if (eof_ && !skipping_) {
       if (start_ == buffer_.size()) return Status::kEnd;
-      line.assign(buffer_, start_);  // the last line, without its newline
+      line.assign(buffer_, start_);  // the last line, without its newline (a CR LF cut after the CR too)
+      dropCarriageReturn(line);
       dropRead();
       return Status::kLine;
     }
