@@ -7,7 +7,10 @@
 ///   default date; every epoch it releases goes through `trackFixFromNmea`.
 /// Each must return or throw ParseError naming its source ("fuzz.jsonl:<line>",
 /// "fuzz.nmea:<line>", "fuzz.nmea epoch <n>"). The direct reading of plain lines
-/// (`parsePlainFixLine`) gives a fix only where the general one does, and the same fix.
+/// (`parsePlainFixLine`) gives a fix only where the general one does, and the same fix. Every
+/// line is also read the way a stream reads it, into one fix kept over the whole input
+/// (`parseTrackFixLine(text, source, fix)`): the same fix as a fresh reading of the line, or the
+/// same error, whatever the lines before it left in the kept fix.
 ///
 /// Every fix that parses: finite latitude and longitude within ±90° and ±180° (in radians), a
 /// finite height and time, its own source, both PLs or neither and each ≥ 0, every pseudorange
@@ -99,6 +102,28 @@ void checkDirectReading(const std::string& line, const std::string& source, cons
   SKYLANE_FUZZ_CHECK(same, source + ": the direct and the general reading give different fixes");
 }
 
+/// Reading the line into `kept` (the stream's way) gives what a fresh reading gives: the same
+/// fix, or the same error.
+void checkReadingInPlace(const std::string& line, const std::string& source, planner::TrackFix& kept) {
+  std::string fresh_error, kept_error;
+  std::optional<planner::TrackFix> fresh;
+  try {
+    fresh = planner::parseTrackFixLine(line, source);
+  } catch (const integrity::ParseError& e) {
+    fresh_error = e.what();
+  }
+  try {
+    planner::parseTrackFixLine(line, source, kept);
+  } catch (const integrity::ParseError& e) {
+    kept_error = e.what();
+  }
+  SKYLANE_FUZZ_CHECK(kept_error == fresh_error, source + ": read in place '" + kept_error + "', fresh '" + fresh_error + "'");
+  if (!fresh) return;
+  const bool same = planner::trackFixJson(kept) == planner::trackFixJson(*fresh) && kept.source == fresh->source &&
+                    kept.note == fresh->note && kept.pl_source == fresh->pl_source && kept.line == fresh->line;
+  SKYLANE_FUZZ_CHECK(same, source + ": the fix read in place differs from a fresh reading");
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   integrity::NmeaEpochAssembler assembler(integrity::NmeaDate{{0.0}, 2026, 11, 23});
@@ -111,6 +136,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   };
   std::istringstream in(text);
   std::string line;
+  planner::TrackFix kept;  // read into line after line, as a stream does
   int n = 0;
   while (std::getline(in, line)) {
     ++n;
@@ -125,6 +151,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                          });
     }
     checkDirectReading(line, json_source, general);
+    checkReadingInPlace(line, json_source, kept);
     const std::string nmea_source = "fuzz.nmea:" + std::to_string(n);
     fuzz::parseThenUse(nmea_source, [&] { return integrity::parseNmeaSentence(line, nmea_source); },
                        [&](const integrity::NmeaSentence& s) { fromEpoch(assembler.add(s)); });
