@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <random>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -84,14 +85,15 @@ geofence::Fence makeFence(const BenchScene& s, double area_m) {
                          geofence::Scene(s.pieces));
 }
 
-void runChecks(benchmark::State& state, const BenchScene& scene, const geofence::Fence& fence, double area_m, bool near) {
+/// The million volumes of a run: uniform positions over the area, or (`near`) within 200 m of a
+/// zone's centre; heights 380–800 m, HPL and VPL 2–50 m.
+std::vector<geofence::TimedVolume> benchVolumes(const BenchScene& scene, double area_m, bool near, int count) {
   const maps::GpsTime t{2400, 0.0};
-  constexpr int kChecks = 1000000;
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::vector<geofence::TimedVolume> volumes;
-  volumes.reserve(kChecks);
-  for (int i = 0; i < kChecks; ++i) {
+  volumes.reserve(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) {
     Eigen::Vector2d p(area_m * u(rng), area_m * u(rng));
     if (near) {
       const double a = 2 * M_PI * u(rng), r = 200.0 * std::sqrt(u(rng));
@@ -99,18 +101,52 @@ void runChecks(benchmark::State& state, const BenchScene& scene, const geofence:
     }
     volumes.push_back({t, t, {Eigen::Vector3d(p.x(), p.y(), 380.0 + 420.0 * u(rng)), 2.0 + 48.0 * u(rng), 2.0 + 48.0 * u(rng)}});
   }
-  std::vector<double> latency_us(kChecks);
+  return volumes;
+}
+
+struct CheckTally {
   std::size_t outside = 0, zone_checks = 0;
-  geofence::FenceVerdict v;  // one verdict, its storage reused check after check (as fence check's stream does)
+};
+
+/// Checks volumes [begin, end) one after the other into one verdict (its storage reused check
+/// after check, as fence check's stream does), each check's latency into latency_us.
+CheckTally timeChecks(const geofence::Fence& fence, const std::vector<geofence::TimedVolume>& volumes, std::size_t begin,
+                      std::size_t end, std::vector<double>& latency_us) {
+  CheckTally tally;
+  geofence::FenceVerdict v;
+  for (std::size_t i = begin; i < end; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    fence.check(volumes[i], v);
+    const auto t1 = std::chrono::steady_clock::now();
+    latency_us[i] = std::chrono::duration<double, std::micro>(t1 - t0).count();
+    tally.outside += v.verdict == geofence::Verdict::kOutside;
+    tally.zone_checks += v.checks.size() - 2;
+  }
+  return tally;
+}
+
+/// A million checks, on `threads` threads at once (each its share of the volumes, in order).
+void runChecks(benchmark::State& state, const BenchScene& scene, const geofence::Fence& fence, double area_m, bool near,
+               int threads = 1) {
+  constexpr int kChecks = 1000000;
+  const std::vector<geofence::TimedVolume> volumes = benchVolumes(scene, area_m, near, kChecks);
+  std::vector<double> latency_us(kChecks);
+  CheckTally total;
   for (auto _ : state) {
-    outside = zone_checks = 0;
-    for (int i = 0; i < kChecks; ++i) {
-      const auto t0 = std::chrono::steady_clock::now();
-      fence.check(volumes[i], v);
-      const auto t1 = std::chrono::steady_clock::now();
-      latency_us[i] = std::chrono::duration<double, std::micro>(t1 - t0).count();
-      outside += v.verdict == geofence::Verdict::kOutside;
-      zone_checks += v.checks.size() - 2;
+    std::vector<CheckTally> tally(static_cast<std::size_t>(threads));
+    const auto share = [&](int t) {
+      const auto from = static_cast<std::size_t>(kChecks) * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
+      const auto to = static_cast<std::size_t>(kChecks) * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(threads);
+      tally[static_cast<std::size_t>(t)] = timeChecks(fence, volumes, from, to, latency_us);
+    };
+    std::vector<std::thread> others;
+    for (int t = 1; t < threads; ++t) others.emplace_back(share, t);
+    share(0);
+    for (std::thread& o : others) o.join();
+    total = {};
+    for (const CheckTally& c : tally) {
+      total.outside += c.outside;
+      total.zone_checks += c.zone_checks;
     }
   }
   std::vector<double> sorted = latency_us;
@@ -121,9 +157,9 @@ void runChecks(benchmark::State& state, const BenchScene& scene, const geofence:
   state.counters["checks_per_s"] = benchmark::Counter(static_cast<double>(kChecks) * state.iterations(), benchmark::Counter::kIsRate);
   state.counters["p50_us"] = p50;
   state.counters["p99_us"] = p99;
-  state.counters["zones_reported_per_check"] = static_cast<double>(zone_checks) / kChecks;
+  state.counters["zones_reported_per_check"] = static_cast<double>(total.zone_checks) / kChecks;
   state.counters["pieces"] = static_cast<double>(scene.pieces.size());
-  benchmark::DoNotOptimize(outside);
+  benchmark::DoNotOptimize(total.outside);
 }
 
 const BenchScene& sparseScene() {
@@ -139,10 +175,19 @@ void BM_FenceCheck10kZones(benchmark::State& state) { runChecks(state, sparseSce
 void BM_FenceCheck10kZonesNearZones(benchmark::State& state) {
   runChecks(state, sparseScene(), sparseFence(), kArea_m, true);
 }
-void BM_FenceCheck10kZonesDense(benchmark::State& state) {
+const BenchScene& denseScene() {
   static const BenchScene scene = makeScene(10000, kDenseArea_m);
-  static const geofence::Fence fence = makeFence(scene, kDenseArea_m);
-  runChecks(state, scene, fence, kDenseArea_m, false);
+  return scene;
+}
+const geofence::Fence& denseFence() {
+  static const geofence::Fence fence = makeFence(denseScene(), kDenseArea_m);
+  return fence;
+}
+void BM_FenceCheck10kZonesDense(benchmark::State& state) { runChecks(state, denseScene(), denseFence(), kDenseArea_m, false); }
+/// The dense scene on both of the machine's processors (the rate in wall time; `fence check`
+/// streams on every processor).
+void BM_FenceCheck10kZonesDenseTwoThreads(benchmark::State& state) {
+  runChecks(state, denseScene(), denseFence(), kDenseArea_m, false, 2);
 }
 /// 4,096 volumes spread uniformly over the sparse scene (positions, heights and PLs as in
 /// runChecks).
@@ -230,5 +275,6 @@ BENCHMARK(BM_OneZone)->Arg(0)->Arg(4)->Arg(8)->Arg(16)->Arg(64);
 BENCHMARK(BM_FenceCheck10kZones)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_FenceCheck10kZonesNearZones)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_FenceCheck10kZonesDense)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_FenceCheck10kZonesDenseTwoThreads)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
 
 }  // namespace
